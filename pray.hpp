@@ -1,0 +1,271 @@
+/* pray — a portable CSG ray tracer with the PRAY scene language.
+   MIT License, see LICENSE. The manual follows the declarations below.
+
+   Two files are the whole library: pray.hpp (this header) and pray.cpp.
+       c++ -O2 -c pray.cpp                      the library
+       c++ -O2 -DPRAY_MAIN pray.cpp -o pray     the command-line program
+*/
+#ifndef PRAY_HPP
+#define PRAY_HPP
+
+#define PRAY_VERSION_MAJOR 0
+#define PRAY_VERSION_MINOR 1
+#define PRAY_VERSION_PATCH 0
+#define PRAY_VERSION_STRING "0.1.0"
+
+/* ---------------------------------------------------------------------------------------------
+   Configuration. Every macro is optional; define it on the command line or in a header named by
+   PRAY_USER_CONFIG. None of them changes the layout of a type declared here.
+
+   @@ PRAY_USER_CONFIG "file.h"   include this file first (a port's settings, see ports/)
+   @@ PRAY_REAL float|double      arithmetic of the renderer (default double); the API is double
+   @@ PRAY_NO_INTERP              leave out the PRAY interpreter (pray_run_* fail with PRAY_ERR_ARG)
+   @@ PRAY_NO_STDIO               no file access: write images through callbacks only
+   @@ PRAY_NO_PNG                 no PNG output even when <stb/stb_image_write.h> is present
+   @@ PRAY_NO_THREADS             no threads (DOS, bare targets)
+   @@ PRAY_NO_DEFAULT_ALLOC       no malloc-based allocator: pray_new_with must be given one
+   @@ PRAY_MAX_ALLOC bytes        default memory cap of a context (0 = none)
+   @@ PRAY_TEMP_SUFFIX ".tmp"     appended to a file name while it is being written
+   @@ PRAY_MAIN                   compile the command-line program (main) from pray.cpp
+   ------------------------------------------------------------------------------------------- */
+#ifdef PRAY_USER_CONFIG
+#include PRAY_USER_CONFIG
+#endif
+
+#include <stddef.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---------------------------------------------------------------------------------------------
+   Status codes. The numbers are stable; the detail is in the context's message.
+   ------------------------------------------------------------------------------------------- */
+typedef enum pray_status {
+    PRAY_OK = 0,
+    PRAY_ERR_NOMEM = 1,   /* out of memory, or over the context's memory cap */
+    PRAY_ERR_IO = 2,      /* a file could not be read or written */
+    PRAY_ERR_SYNTAX = 3,  /* the PRAY program is malformed */
+    PRAY_ERR_RUNTIME = 4, /* the PRAY program failed while running (type error, ...) */
+    PRAY_ERR_LIMIT = 5,   /* a limit was reached (maxsteps, image size, ...) */
+    PRAY_ERR_ARG = 6      /* a bad argument to an API function */
+} pray_status;
+
+/* The text of a status code ("ok", "out of memory", ...). Never NULL. */
+const char *pray_status_text(pray_status s);
+/* "0.1.0". */
+const char *pray_version(void);
+/* The configuration compiled in, e.g. "interp stdio png threads real=double". */
+const char *pray_features(void);
+
+/* ---------------------------------------------------------------------------------------------
+   Plain types. Coordinates are world coordinates, Z up by convention of the default camera.
+   ------------------------------------------------------------------------------------------- */
+typedef struct pray_vec { double x, y, z; } pray_vec; /* a point or a vector */
+typedef struct pray_rgb { double r, g, b; } pray_rgb; /* an intensity; 1 = full */
+
+/* A rendered image: width*height pixels, 3 floats each (R, G, B), rows from the top.
+   Values are linear and may exceed 1; writers clamp to [0, 1]. Free with pray_image_free. */
+typedef struct pray_image {
+    int width, height;
+    float *pixels;
+} pray_image;
+
+/* Opaque handles. All belong to the context that made them and die with it. */
+typedef struct pray_ctx pray_ctx;       /* one context per thread of use */
+typedef struct pray_object pray_object; /* a solid: a primitive or a CSG tree */
+typedef struct pray_model pray_model;   /* a lighting model (material) */
+typedef struct pray_light pray_light;   /* a set of light sources */
+
+/* Memory: like Lua's lua_Alloc. nsize == 0 frees ptr and returns NULL; otherwise returns a block
+   of nsize bytes holding the first min(osize, nsize) bytes of ptr (ptr may be NULL), or NULL. */
+typedef void *(*pray_alloc_fn)(void *ud, void *ptr, size_t osize, size_t nsize);
+/* Output of the PRAY `print` statement, and any byte sink (image writers). */
+typedef void (*pray_write_fn)(void *ud, const void *data, size_t n);
+/* Progress of a render: rows done of rows total. Return non-zero to cancel (PRAY_ERR_LIMIT). */
+typedef int (*pray_progress_fn)(void *ud, int done, int total);
+/* A frame rendered by `rendertiff`. When set, it is called instead of writing the file; `name` is
+   the file name the frame would have been written to. Return PRAY_OK to continue. */
+typedef pray_status (*pray_frame_fn)(void *ud, const pray_image *img, const char *name);
+
+/* ---------------------------------------------------------------------------------------------
+   Context.
+   ------------------------------------------------------------------------------------------- */
+/* A new context with the default allocator (malloc). NULL when out of memory. */
+pray_ctx *pray_new(void);
+/* A new context with your allocator; every byte pray uses goes through it. */
+pray_ctx *pray_new_with(pray_alloc_fn alloc, void *ud);
+/* Free the context and everything made in it (objects, models, lights, but not images). */
+void pray_free(pray_ctx *ctx);
+/* The last error: "name:line:col: error: message" for program errors, "error: message" else.
+   "" when there was none. Valid until the next call on the context. */
+const char *pray_error(const pray_ctx *ctx);
+/* The status of the last failing call (PRAY_OK if none failed since pray_clear_error). */
+pray_status pray_last_status(const pray_ctx *ctx);
+void pray_clear_error(pray_ctx *ctx);
+/* Cap the bytes a context may hold at once (0 = no cap). Over the cap, calls fail with
+   PRAY_ERR_NOMEM. */
+void pray_set_memory_limit(pray_ctx *ctx, size_t bytes);
+/* Where `print` writes (default: standard output; NULL fn discards). */
+void pray_set_print(pray_ctx *ctx, pray_write_fn fn, void *ud);
+/* Progress callback for renders (default none). */
+void pray_set_progress(pray_ctx *ctx, pray_progress_fn fn, void *ud);
+/* Frame callback for `rendertiff` (default none: frames are written to files). */
+void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
+
+/* ---------------------------------------------------------------------------------------------
+   Options: the same names as the PRAY `option` statement (see the manual below).
+   ------------------------------------------------------------------------------------------- */
+/* Set a numeric option. Unknown names and bad values fail with PRAY_ERR_ARG. An option that was
+   fixed by pray_option_fix keeps its fixed value and the call succeeds without effect. */
+pray_status pray_option(pray_ctx *ctx, const char *name, double value);
+/* Set the one string option, "output" (the file name of rendertiff). */
+pray_status pray_option_string(pray_ctx *ctx, const char *name, const char *value);
+/* Set an option from text ("width=640" style values, as `-D name=value`) and fix it: later
+   pray_option calls and `option` statements of programs no longer change it. */
+pray_status pray_option_fix(pray_ctx *ctx, const char *name, const char *value);
+/* The value of a numeric option; NaN for an unknown name. */
+double pray_option_get(const pray_ctx *ctx, const char *name);
+
+/* ---------------------------------------------------------------------------------------------
+   Running PRAY programs.
+   ------------------------------------------------------------------------------------------- */
+/* Run a program held in memory. `name` is used in messages and for the default output name
+   (name with its extension replaced by .tif). `text` need not be NUL-terminated. */
+pray_status pray_run_string(pray_ctx *ctx, const char *name, const char *text, size_t len);
+/* Run a program file. */
+pray_status pray_run_file(pray_ctx *ctx, const char *path);
+/* The number of frames the last run rendered. */
+int pray_frames(const pray_ctx *ctx);
+
+/* ---------------------------------------------------------------------------------------------
+   Building scenes directly. Every maker returns NULL on error (message in the context); a NULL
+   argument makes the result NULL without a new message, so a chain of calls can be checked once
+   at its end. Handles are reference counted: pass them freely; pray_release drops yours.
+   ------------------------------------------------------------------------------------------- */
+/* Models. */
+pray_model *pray_phong(pray_ctx *ctx, pray_rgb diffuse, pray_rgb specular, pray_rgb ambient,
+                       double exponent);
+pray_model *pray_mirror(pray_ctx *ctx, pray_rgb weight);
+pray_model *pray_transparent(pray_ctx *ctx, pray_rgb weight, double index);
+pray_model *pray_color(pray_ctx *ctx, pray_rgb colour);
+pray_model *pray_model_add(pray_ctx *ctx, pray_model *a, pray_model *b);
+pray_model *pray_model_scale(pray_ctx *ctx, pray_model *m, pray_rgb factor);
+
+/* Solids. */
+pray_object *pray_sphere(pray_ctx *ctx, pray_model *m, pray_vec centre, double radius);
+pray_object *pray_plane(pray_ctx *ctx, pray_model *m, pray_vec point, pray_vec normal);
+pray_object *pray_cylinder(pray_ctx *ctx, pray_model *m, pray_vec point, pray_vec axis,
+                           double radius);
+pray_object *pray_one(pray_ctx *ctx, pray_model *m);
+pray_object *pray_nothing(pray_ctx *ctx);
+
+typedef enum pray_op {
+    PRAY_UNION = 0,
+    PRAY_INTERSECTION = 1,
+    PRAY_DIFFERENCE = 2
+} pray_op;
+/* a op b; chains of one operation become one n-ary node, as in the language. */
+pray_object *pray_csg(pray_ctx *ctx, pray_op op, pray_object *a, pray_object *b);
+pray_object *pray_complement(pray_ctx *ctx, pray_object *a);
+/* The `.` transformations: uniform scale about the origin (s != 0), translation, and rotation by
+   degrees about X, then Y, then Z. They return a new object; `a` is unchanged. */
+pray_object *pray_scale(pray_ctx *ctx, pray_object *a, double s);
+pray_object *pray_translate(pray_ctx *ctx, pray_object *a, pray_vec offset);
+pray_object *pray_rotate(pray_ctx *ctx, pray_object *a, pray_vec degrees);
+/* Primitives in the tree (what `print` shows as "object (N primitives)"). */
+int pray_object_primitives(const pray_object *a);
+
+/* Lights. */
+pray_light *pray_dirlight(pray_ctx *ctx, pray_rgb intensity, pray_vec direction);
+pray_light *pray_pointlight(pray_ctx *ctx, pray_rgb intensity, pray_vec position);
+pray_light *pray_light_add(pray_ctx *ctx, pray_light *a, pray_light *b);
+
+/* Drop a reference (any of the three handle kinds; NULL is ignored). */
+void pray_release(pray_ctx *ctx, void *handle);
+
+/* Camera and background, as the statements of the same names. */
+pray_status pray_perspective(pray_ctx *ctx, pray_vec x, pray_vec y, pray_vec eye, pray_vec point);
+pray_status pray_parallel(pray_ctx *ctx, pray_vec x, pray_vec y, pray_vec eye, pray_vec point);
+pray_status pray_background(pray_ctx *ctx, pray_rgb top, pray_rgb bottom);
+
+/* ---------------------------------------------------------------------------------------------
+   Rendering and images.
+   ------------------------------------------------------------------------------------------- */
+/* Statistics of the last render of a context. */
+typedef struct pray_stats {
+    long primitives;                 /* primitives in the rendered object */
+    long nodes;                      /* CSG nodes after flattening */
+    double rays_primary, rays_shadow, rays_reflected, rays_refracted;
+    double intersection_tests;       /* ray/primitive tests */
+    double time_parse, time_prepare, time_render; /* seconds */
+} pray_stats;
+
+/* Render `root` lit by `lights` (NULL = no light) with the context's camera, background and
+   options into `out` (allocated here; free with pray_image_free). */
+pray_status pray_render(pray_ctx *ctx, pray_object *root, pray_light *lights, pray_image *out);
+void pray_stats_get(const pray_ctx *ctx, pray_stats *out);
+void pray_image_free(pray_ctx *ctx, pray_image *img);
+
+/* Write an image; the format comes from the extension: .tif/.tiff (bits 8 or 16), .ppm (bits 8
+   or 16), .png (8 bits, when built with stb_image_write). The file is written under a temporary
+   name and renamed when complete; on failure nothing is left behind. */
+pray_status pray_write_image(pray_ctx *ctx, const pray_image *img, const char *path, int bits);
+/* The same formats into a byte sink. */
+pray_status pray_write_tiff(pray_ctx *ctx, const pray_image *img, int bits, pray_write_fn fn,
+                            void *ud);
+pray_status pray_write_ppm(pray_ctx *ctx, const pray_image *img, int bits, pray_write_fn fn,
+                           void *ud);
+
+/* One call: run a program file with optional fixed options ("name=value" strings). */
+pray_status pray_render_file(const char *program, const char *const *options, int noptions,
+                             char *message, size_t message_size);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* PRAY_HPP */
+
+/* =============================================================================================
+   MANUAL
+   =============================================================================================
+
+   1. About
+   pray renders scenes described as CSG (constructive solid geometry) trees of half-spaces,
+   spheres and infinite cylinders, with Whitted ray tracing: Phong shading, shadows, mirrors and
+   refraction. Scenes come from PRAY programs (the language of Pavel Zemcik's 1995 thesis
+   "Realistic Rendering", fixed by docs/pray-language.md) or from the calls above.
+
+   2. Building
+   Copy pray.hpp and pray.cpp into your project and compile pray.cpp with it. It needs a C++98
+   compiler and the C library's math; no exceptions or RTTI. `-DPRAY_MAIN` adds main().
+
+   3. A host program
+       pray_ctx *c = pray_new();
+       pray_model *red = pray_phong(c, rgb(0.8,0.1,0.1), rgb(0.3,0.3,0.3), rgb(0,0,0), 3);
+       pray_object *s = pray_sphere(c, red, vec(0,0,0), 0.2);
+       pray_light *l = pray_dirlight(c, rgb(1,1,1), vec(1,1,1));
+       pray_image img;
+       if (pray_render(c, s, l, &img) == PRAY_OK) {
+           pray_write_image(c, &img, "red.tif", 8);
+           pray_image_free(c, &img);
+       } else fprintf(stderr, "%s\n", pray_error(c));
+       pray_free(c);
+   Running the same scene as a program: pray_run_string(c, "red.ray", text, strlen(text)).
+
+   4. Errors
+   Every failing call returns a status (or NULL) and leaves "where: error: what" in
+   pray_error(ctx). Program errors carry "name:line:col". pray never calls exit or abort.
+
+   5. Threads
+   A context is used by one thread at a time; two contexts may render at once. No global state.
+
+   6. The language
+   See docs/pray-language.md for the full manual. A program:
+       RedSurface = phong({0.8, 0.1, 0.1}, {0.3, 0.3, 0.3}, 3)
+       Light = dirlight({1}, norm(<1, 1, 1>))
+       Centre = [0, 0, 0]
+       Sphere = sphere(RedSurface, Centre, 0.2)
+       rendertiff Sphere, Light
+*/
