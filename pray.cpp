@@ -177,6 +177,14 @@ struct Options {
     char output[1024];
 };
 
+// Options, camera and background: what statements and API calls set before a render.
+struct Setup {
+    Options opt;
+    int parallel;
+    pray_vec cam_x, cam_y, cam_eye, cam_point;
+    pray_rgb bg_top, bg_bottom;
+};
+
 struct pray_ctx {
     pray_alloc_fn alloc;
     void *alloc_ud;
@@ -191,11 +199,10 @@ struct pray_ctx {
     void *progress_ud;
     pray_frame_fn frame_fn;
     void *frame_ud;
-    Options opt;
+    Setup cur;       // in force now
+    Setup base;      // what the host set; every run starts from it and ends back at it
+    int running;     // a program is running: its settings change `cur` only
     unsigned fixed;  // bit per option: set from the command line, programs cannot change it
-    int parallel;
-    pray_vec cam_x, cam_y, cam_eye, cam_point;
-    pray_rgb bg_top, bg_bottom;
     pray_stats stats;
     int frames;
 };
@@ -842,12 +849,15 @@ const char *opt_check(int i, double v) {
     return NULL;
 }
 
-void opts_default(Options *o) {
-    for (int i = 0; i < OPT_COUNT; i++) o->v[i] = OPTS[i].def;
-    o->output[0] = 0;
+void setup_default(Setup *s) {
+    memset(s, 0, sizeof *s);
+    for (int i = 0; i < OPT_COUNT; i++) s->opt.v[i] = OPTS[i].def;
+    s->cam_x = vmake(1, 0, 0);
+    s->cam_y = vmake(0, 0, -1);
+    s->cam_eye = vmake(0, -4, 0);
 }
 
-int opt_int(const pray_ctx *c, int i) { return (int)c->opt.v[i]; }
+int opt_int(const pray_ctx *c, int i) { return (int)c->cur.opt.v[i]; }
 
 pray_status opt_unknown(pray_ctx *c, const char *name) {
     Suggest s;
@@ -1419,19 +1429,19 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
         L.v = src.point ? r3of(src.v) : r3of(vmul(src.v, -1.0 / vlen(src.v)));
         if (!s->lights.push(c, L)) return c->status;
     }
-    s->parallel = c->parallel;
-    s->eye = r3of(c->cam_eye);
-    s->point = r3of(c->cam_point);
-    s->cx = r3of(c->cam_x);
-    s->cy = r3of(c->cam_y);
+    s->parallel = c->cur.parallel;
+    s->eye = r3of(c->cur.cam_eye);
+    s->point = r3of(c->cur.cam_point);
+    s->cx = r3of(c->cur.cam_x);
+    s->cy = r3of(c->cur.cam_y);
     s->dir = unit(s->point - s->eye);
     s->width = opt_int(c, OPT_WIDTH);
     s->height = opt_int(c, OPT_HEIGHT);
     s->depth = opt_int(c, OPT_DEPTH);
     s->shadows = opt_int(c, OPT_SHADOWS);
     s->antialias = opt_int(c, OPT_ANTIALIAS);
-    s->bg_top = c->bg_top;
-    s->bg_bottom = c->bg_bottom;
+    s->bg_top = c->cur.bg_top;
+    s->bg_bottom = c->cur.bg_bottom;
     return PRAY_OK;
 }
 
@@ -1701,11 +1711,8 @@ pray_ctx *pray_new_with(pray_alloc_fn alloc, void *ud) {
     c->alloc_ud = ud;
     c->limit = PRAY_MAX_ALLOC;
     c->blocks.next = c->blocks.prev = &c->blocks;
-    opts_default(&c->opt);
-    c->cam_x = vmake(1, 0, 0);
-    c->cam_y = vmake(0, 0, -1);
-    c->cam_eye = vmake(0, -4, 0);
-    c->cam_point = vmake(0, 0, 0);
+    setup_default(&c->cur);
+    c->base = c->cur;
     return c;
 }
 
@@ -1750,7 +1757,8 @@ pray_status pray_option(pray_ctx *c, const char *name, double value) {
     if (i == OPT_OUTPUT) return fail(c, PRAY_ERR_ARG, "option 'output' takes a string");
     const char *why = opt_check(i, value);
     if (why) return fail(c, PRAY_ERR_ARG, "option '%s': %g is %s", name, value, why);
-    if (!(c->fixed & (1u << i))) c->opt.v[i] = value;
+    if (!(c->fixed & (1u << i))) c->cur.opt.v[i] = value;
+    if (!c->running) c->base = c->cur;
     return PRAY_OK;
 }
 
@@ -1759,9 +1767,10 @@ pray_status pray_option_string(pray_ctx *c, const char *name, const char *value)
     if (i < 0) return opt_unknown(c, name ? name : "");
     if (i != OPT_OUTPUT) return fail(c, PRAY_ERR_ARG, "option '%s' takes a number", name);
     if (!value || !*value) return fail(c, PRAY_ERR_ARG, "option 'output': empty file name");
-    if (strlen(value) >= sizeof c->opt.output)
+    if (strlen(value) >= sizeof c->cur.opt.output)
         return fail(c, PRAY_ERR_ARG, "option 'output': file name too long");
-    if (!(c->fixed & (1u << i))) strcpy(c->opt.output, value);
+    if (!(c->fixed & (1u << i))) strcpy(c->cur.opt.output, value);
+    if (!c->running) c->base = c->cur;
     return PRAY_OK;
 }
 
@@ -1785,7 +1794,7 @@ pray_status pray_option_fix(pray_ctx *c, const char *name, const char *text) {
 double pray_option_get(const pray_ctx *c, const char *name) {
     int i = name ? opt_find(name) : -1;
     if (i < 0 || i == OPT_OUTPUT) return HUGE_VAL - HUGE_VAL;
-    return c->opt.v[i];
+    return c->cur.opt.v[i];
 }
 
 namespace {
@@ -1974,11 +1983,12 @@ const char *camera_problem(bool parallel, pray_vec x, pray_vec y, pray_vec e, pr
 pray_status set_camera(pray_ctx *c, int parallel, pray_vec x, pray_vec y, pray_vec e, pray_vec p) {
     const char *why = camera_problem(parallel != 0, x, y, e, p);
     if (why) return fail(c, PRAY_ERR_ARG, "%s: %s", parallel ? "parallel" : "perspective", why);
-    c->parallel = parallel;
-    c->cam_x = x;
-    c->cam_y = y;
-    c->cam_eye = e;
-    c->cam_point = p;
+    c->cur.parallel = parallel;
+    c->cur.cam_x = x;
+    c->cur.cam_y = y;
+    c->cur.cam_eye = e;
+    c->cur.cam_point = p;
+    if (!c->running) c->base = c->cur;
     return PRAY_OK;
 }
 } // namespace
@@ -1991,8 +2001,9 @@ pray_status pray_parallel(pray_ctx *c, pray_vec x, pray_vec y, pray_vec e, pray_
 }
 pray_status pray_background(pray_ctx *c, pray_rgb top, pray_rgb bottom) {
     if (bad_rgb(c, top, "background") || bad_rgb(c, bottom, "background")) return c->status;
-    c->bg_top = top;
-    c->bg_bottom = bottom;
+    c->cur.bg_top = top;
+    c->cur.bg_bottom = bottom;
+    if (!c->running) c->base = c->cur;
     return PRAY_OK;
 }
 
@@ -3687,7 +3698,7 @@ pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
         all = l;
     }
     char base[1024], name[1100];
-    if (c->opt.output[0]) snprintf(base, sizeof base, "%s", c->opt.output);
+    if (c->cur.opt.output[0]) snprintf(base, sizeof base, "%s", c->cur.opt.output);
     else {
         const char *ext = file_ext(I.name);
         int keep = ext ? (int)(ext - 1 - I.name) : (int)strlen(I.name);
@@ -3726,7 +3737,7 @@ pray_status exec_block(Interp &I, Stmt **body, int n);
 
 pray_status step(Interp &I, const Stmt *s) {
     I.steps += 1;
-    double lim = I.c->opt.v[OPT_MAXSTEPS];
+    double lim = I.c->cur.opt.v[OPT_MAXSTEPS];
     if (lim > 0 && I.steps > lim)
         return perr(I.c, I.name, s->line, s->col, PRAY_ERR_LIMIT,
                     "the program was stopped after %.0f statements (option maxsteps)", lim);
@@ -3899,19 +3910,9 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
 // [SECTION] 15 One-call helpers and the running of programs
 // =============================================================================================
 namespace {
-// A run starts from the defaults, except for the options fixed by the host.
+// A run starts from what the host set (the defaults, unless it set more) and ends back there.
 void reset_run(pray_ctx *c) {
-    Options keep = c->opt;
-    opts_default(&c->opt);
-    for (int i = 0; i < OPT_COUNT; i++)
-        if (c->fixed & (1u << i)) c->opt.v[i] = keep.v[i];
-    if (c->fixed & (1u << OPT_OUTPUT)) memcpy(c->opt.output, keep.output, sizeof keep.output);
-    c->parallel = 0;
-    c->cam_x = vmake(1, 0, 0);
-    c->cam_y = vmake(0, 0, -1);
-    c->cam_eye = vmake(0, -4, 0);
-    c->cam_point = vmake(0, 0, 0);
-    c->bg_top = c->bg_bottom = cmake(0, 0, 0);
+    c->cur = c->base;
     memset(&c->stats, 0, sizeof c->stats);
     c->frames = 0;
     c->status = PRAY_OK;
@@ -3924,7 +3925,11 @@ pray_status pray_run_string(pray_ctx *c, const char *name, const char *text, siz
     reset_run(c);
     if (!text) return fail(c, PRAY_ERR_ARG, "no program text");
 #if PRAY_HAS_INTERP
-    return run_program(c, name && *name ? name : "pray", text, len);
+    c->running = 1;
+    pray_status st = run_program(c, name && *name ? name : "pray", text, len);
+    c->running = 0;
+    c->cur = c->base;
+    return st;
 #else
     (void)name;
     (void)len;
