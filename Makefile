@@ -19,7 +19,7 @@ PRAY  = pray$(EXE)
 TESTS = tests/pray_tests$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
-.PHONY: all examples check deps matrix clean
+.PHONY: all examples check deps matrix clean embed
 
 all: $(PRAY)
 
@@ -47,7 +47,15 @@ examples: $(PRAY)
 $(TESTS): $(TEST_SRC) tests/testkit.hpp pray.cpp pray.hpp
 	$(CXX) $(TESTFLAGS) $(TEST_SRC) -o $@ $(LDLIBS) -lpthread
 
-check: deps $(PRAY) $(TESTS)
+# The C example: pray.hpp must be usable from C.
+tests/embed$(EXE): examples/embed.c pray.cpp pray.hpp
+	$(CC) -std=c99 -pedantic -Wall -Wextra -Werror -I. -c examples/embed.c -o tests/embed.o
+	$(CXX) -std=c++98 $(CXXFLAGS) -c pray.cpp -o tests/pray.o
+	$(CXX) tests/embed.o tests/pray.o -o $@ $(LDLIBS)
+embed: tests/embed$(EXE)
+
+check: deps $(PRAY) $(TESTS) tests/embed$(EXE)
+	$(RUN) ./tests/embed$(EXE) tests/embed.ppm
 	$(RUN) ./$(TESTS)
 
 # Every configuration macro on its own, float and double, C++98/11/17, warnings as errors.
@@ -61,4 +69,4 @@ matrix:
 	  echo ok; done; done
 
 clean:
-	rm -rf $(PRAY) $(TESTS) out
+	rm -rf $(PRAY) $(TESTS) tests/embed$(EXE) tests/*.o tests/*.ppm out

@@ -108,6 +108,11 @@
 namespace {
 
 typedef PRAY_REAL real;
+#if defined(__GNUC__)
+#define PRAY_PRINTF(f, a) __attribute__((format(printf, f, a)))
+#else
+#define PRAY_PRINTF(f, a)
+#endif
 #define PRAY_STRINGIFY2(x) #x
 #define PRAY_STRINGIFY(x) PRAY_STRINGIFY2(x)
 
@@ -220,6 +225,7 @@ void *default_alloc(void *, void *ptr, size_t, size_t nsize) {
 #endif
 
 // Record an error "error: ..." and return its status.
+pray_status fail(pray_ctx *c, pray_status s, const char *fmt, ...) PRAY_PRINTF(3, 4);
 pray_status fail(pray_ctx *c, pray_status s, const char *fmt, ...) {
     va_list ap;
     va_start(ap, fmt);
@@ -2159,6 +2165,8 @@ struct Lexer {
     Array<Tok> toks;
 };
 
+pray_status perr(pray_ctx *c, const char *name, int line, int col, pray_status s, const char *fmt, ...)
+    PRAY_PRINTF(6, 7);
 pray_status perr(pray_ctx *c, const char *name, int line, int col, pray_status s, const char *fmt, ...) {
     va_list ap;
     va_start(ap, fmt);
@@ -2502,8 +2510,14 @@ Tok &cur(Parser &P) { return P.t[P.pos]; }
 bool is_op(const Tok &t, int op) { return t.kind == T_OP && t.op == op; }
 bool is_word(const Tok &t, const char *w) { return t.kind == T_NAME && strcmp(t.s, w) == 0; }
 
-pray_status syn(Parser &P, const Tok &t, const char *fmt, const char *arg = "") {
-    return perr(P.c, P.name, t.line, t.col, PRAY_ERR_SYNTAX, fmt, arg);
+pray_status syn(Parser &P, const Tok &t, const char *fmt, ...) PRAY_PRINTF(3, 4);
+pray_status syn(Parser &P, const Tok &t, const char *fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    char tmp[800];
+    vsnprintf(tmp, sizeof tmp, fmt, ap);
+    va_end(ap);
+    return perr(P.c, P.name, t.line, t.col, PRAY_ERR_SYNTAX, "%s", tmp);
 }
 
 // How a token reads in a message.
@@ -2574,7 +2588,7 @@ bool parse_list(Parser &P, Array<Expr *> *out, bool additive) {
 
 Expr **freeze_list(Parser &P, Array<Expr *> &a) {
     Expr **p = (Expr **)P.arena->get(P.c, sizeof(Expr *) * (size_t)(a.n ? a.n : 1));
-    if (p) memcpy(p, a.p, sizeof(Expr *) * (size_t)a.n);
+    if (p && a.n) memcpy(p, a.p, sizeof(Expr *) * (size_t)a.n);
     return p;
 }
 
@@ -2905,7 +2919,7 @@ bool stmt_args(Parser &P, Stmt *s, const Tok &word, int lo, int hi) {
 
 Stmt **freeze_stmts(Parser &P, Array<Stmt *> &a) {
     Stmt **p = (Stmt **)P.arena->get(P.c, sizeof(Stmt *) * (size_t)(a.n ? a.n : 1));
-    if (p) memcpy(p, a.p, sizeof(Stmt *) * (size_t)a.n);
+    if (p && a.n) memcpy(p, a.p, sizeof(Stmt *) * (size_t)a.n);
     return p;
 }
 
@@ -3035,7 +3049,10 @@ Stmt *parse_statement(Parser &P) {
         return NULL;
     }
     if (P.t[P.pos + 1].kind == T_NL && !is_reserved(t.s)) {
-        syn(P, t, "'%s' alone is not a statement (did you mean an assignment '%s = ...'?)", t.s);
+        char msg[200];
+        snprintf(msg, sizeof msg, "'%.60s' alone is not a statement (did you mean an assignment '%.60s = ...'?)",
+                 t.s, t.s);
+        syn(P, t, "%s", msg);
         return NULL;
     }
     Suggest sg;
@@ -3133,6 +3150,7 @@ void vrelease(Interp &I, Value &v) {
     v.t = V_NONE;
 }
 
+pray_status rerr(Interp &I, const Expr *e, pray_status s, const char *fmt, ...) PRAY_PRINTF(4, 5);
 pray_status rerr(Interp &I, const Expr *e, pray_status s, const char *fmt, ...) {
     va_list ap;
     va_start(ap, fmt);

@@ -114,17 +114,25 @@ void pray_set_progress(pray_ctx *ctx, pray_progress_fn fn, void *ud);
 void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
 
 /* ---------------------------------------------------------------------------------------------
-   Options: the same names as the PRAY `option` statement (see the manual below).
+   Options: the same names as the PRAY `option` statement: width, height (pixels, default 256),
+   depth (ray depth, 5), antialias (samples per pixel side, 1), adaptive (0), grid (-1 =
+   automatic), freeze, merge, bounds, shadows (1/0, default 1), brute (1 = the brute-force
+   reference renderer, 0), threads (0 = automatic), maxsteps (statements a program may execute,
+   10000000; 0 = no limit), bits (8 or 16 per sample in TIFF/PPM files), and the string option
+   output (file name of `rendertiff`).
+
+   What the host sets here (options, camera, background) is where every program run starts;
+   what a program sets lasts until the end of its run.
    ------------------------------------------------------------------------------------------- */
 /* Set a numeric option. Unknown names and bad values fail with PRAY_ERR_ARG. An option that was
    fixed by pray_option_fix keeps its fixed value and the call succeeds without effect. */
 pray_status pray_option(pray_ctx *ctx, const char *name, double value);
-/* Set the one string option, "output" (the file name of rendertiff). */
+/* Set the one string option, "output". */
 pray_status pray_option_string(pray_ctx *ctx, const char *name, const char *value);
-/* Set an option from text ("width=640" style values, as `-D name=value`) and fix it: later
-   pray_option calls and `option` statements of programs no longer change it. */
+/* Set an option from its text (as `-D name=value` does) and fix it: later pray_option calls and
+   `option` statements of programs no longer change it. This is how the command line wins. */
 pray_status pray_option_fix(pray_ctx *ctx, const char *name, const char *value);
-/* The value of a numeric option; NaN for an unknown name. */
+/* The value of a numeric option; NaN for an unknown name or "output". */
 double pray_option_get(const pray_ctx *ctx, const char *name);
 
 /* ---------------------------------------------------------------------------------------------
@@ -192,7 +200,8 @@ pray_status pray_background(pray_ctx *ctx, pray_rgb top, pray_rgb bottom);
 /* ---------------------------------------------------------------------------------------------
    Rendering and images.
    ------------------------------------------------------------------------------------------- */
-/* Statistics of the last render of a context. */
+/* Statistics: totals over the renders of the current (or last) program run, or since the context
+   was made for renders outside runs; primitives and nodes are those of the last render. */
 typedef struct pray_stats {
     long primitives;                 /* primitives in the rendered object */
     long nodes;                      /* CSG nodes after flattening */
