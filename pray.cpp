@@ -2493,7 +2493,6 @@ const char *const KEYWORDS[] = {"if", "then", "else", "endif", "while", "endwhil
 // Variable names are interned at parse time; a variable is a slot.
 struct Var {
     const char *name;
-    int defined;
 };
 
 struct Parser {
@@ -2504,6 +2503,7 @@ struct Parser {
     int depth;
     Arena *arena;
     Array<Var> *vars;
+    Array<int> hash;  // open addressing: slot + 1, 0 = empty; size a power of two
 };
 
 Tok &cur(Parser &P) { return P.t[P.pos]; }
@@ -2554,13 +2554,38 @@ bool is_reserved(const char *s) {
     return builtin_find(s) != NULL;
 }
 
+unsigned name_hash(const char *s) {
+    unsigned h = 2166136261u;
+    for (; *s; s++) h = (h ^ (unsigned char)*s) * 16777619u;
+    return h;
+}
+
+// The slot of a variable name, made on first sight. Programs written by generators may have
+// many thousands of names, so they are hashed.
 int var_slot(Parser &P, const char *name) {
-    for (int i = 0; i < P.vars->n; i++)
-        if (strcmp((*P.vars)[i].name, name) == 0) return i;
+    Array<int> &h = P.hash;
+    if (2 * (P.vars->n + 1) > h.n) {  // grow and rehash
+        int size = h.n ? 2 * h.n : 64;
+        Array<int> nh;
+        nh.init();
+        if (!nh.reserve(P.c, size)) return -1;
+        nh.n = size;
+        memset(nh.p, 0, sizeof(int) * (size_t)size);
+        for (int i = 0; i < P.vars->n; i++) {
+            unsigned k = name_hash((*P.vars)[i].name) & (unsigned)(size - 1);
+            while (nh[(int)k]) k = (k + 1) & (unsigned)(size - 1);
+            nh[(int)k] = i + 1;
+        }
+        h.release(P.c);
+        h = nh;
+    }
+    unsigned k = name_hash(name) & (unsigned)(h.n - 1);
+    for (; h[(int)k]; k = (k + 1) & (unsigned)(h.n - 1))
+        if (strcmp((*P.vars)[h[(int)k] - 1].name, name) == 0) return h[(int)k] - 1;
     Var v;
     v.name = name;
-    v.defined = 0;
     if (!P.vars->push(P.c, v)) return -1;
+    h[(int)k] = P.vars->n;
     return P.vars->n - 1;
 }
 
@@ -3901,9 +3926,11 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
         P.depth = 0;
         P.arena = &arena;
         P.vars = &I.vars;
+        P.hash.init();
         const char *stop = NULL;
         if (!parse_block(P, &prog, &stop)) st = c->status;
         else if (stop) st = syn(P, cur(P), "'%s' without a matching 'if' or 'while'", stop);
+        P.hash.release(c);
     }
     if (st == PRAY_OK && I.vars.n && !I.vals.reserve(c, I.vars.n)) st = c->status;
     c->stats.time_parse += clock_seconds() - t0;
