@@ -902,13 +902,20 @@ inline R3 unit(R3 a) {
 
 // Element codes of the flattened tree: primitive i is 2i, node j is 2j+1; two constants stand
 // for a subtree that folded to all of space or to nothing.
+const real REAL_BIG = (real)HUGE_VAL;
 const int E_ALL = -1;
 const int E_NONE = -2;
 inline bool e_is_node(int e) { return (e & 1) != 0; }
 inline int e_index(int e) { return e >> 1; }
 
+// An axis-aligned box; sides may be infinite. Empty when lo > hi on some axis.
+struct Box {
+    real lo[3], hi[3];
+};
+
 struct Prim {
     int kind;           // O_SPHERE, O_PLANE, O_CYLINDER
+    Box box;            // contains the solid
     R3 p;               // centre, point on the plane, point on the axis
     R3 n;               // unit outward normal of a plane, unit axis of a cylinder
     real r, r2, d;      // radius, radius squared, plane offset n.p
@@ -919,9 +926,11 @@ struct Prim {
 
 struct Node {
     int op;      // O_UNION, O_INTER, O_DIFF, O_COMPL
-    int n;       // children
+    int n;       // children: Scene::kids[k0 .. k0+n)
+    int k0;
     int parent;
     unsigned char first;
+    Box box;     // contains the solid (infinite for complements)
 };
 
 struct Light {
@@ -930,10 +939,15 @@ struct Light {
     pray_rgb intensity;
 };
 
+struct Accel;
+
 struct Scene {
     Array<Prim> prims;
     Array<Node> nodes;
+    Array<int> kids;  // element codes of the nodes' children
     int root;
+    int prune;        // drop parts that bounds show cannot matter
+    Accel *accel;     // NULL: the brute-force reference
     Array<Light> lights;
     int parallel;
     R3 eye, point, cx, cy, dir;
@@ -941,7 +955,12 @@ struct Scene {
     pray_rgb bg_top, bg_bottom;
 };
 
+void accel_release(pray_ctx *, Accel *) {}
+
 void scene_release(pray_ctx *c, Scene *s) {
+    accel_release(c, s->accel);
+    s->accel = NULL;
+    s->kids.release(c);
     s->prims.release(c);
     s->nodes.release(c);
     s->lights.release(c);
@@ -957,20 +976,178 @@ void set_parent(Scene *s, int e, int parent, bool first) {
     }
 }
 
+// ---- boxes ----
+Box box_all() {
+    Box b;
+    for (int i = 0; i < 3; i++) {
+        b.lo[i] = -REAL_BIG;
+        b.hi[i] = REAL_BIG;
+    }
+    return b;
+}
+bool box_empty(const Box &b) {
+    return b.lo[0] > b.hi[0] || b.lo[1] > b.hi[1] || b.lo[2] > b.hi[2];
+}
+bool box_finite(const Box &b) {
+    for (int i = 0; i < 3; i++)
+        if (b.lo[i] <= -REAL_BIG || b.hi[i] >= REAL_BIG) return false;
+    return true;
+}
+bool box_overlap(const Box &a, const Box &b) {
+    for (int i = 0; i < 3; i++)
+        if (a.hi[i] < b.lo[i] || b.hi[i] < a.lo[i]) return false;
+    return true;
+}
+void box_hull(Box *a, const Box &b) {
+    for (int i = 0; i < 3; i++) {
+        if (b.lo[i] < a->lo[i]) a->lo[i] = b.lo[i];
+        if (b.hi[i] > a->hi[i]) a->hi[i] = b.hi[i];
+    }
+}
+void box_clip(Box *a, const Box &b) {
+    for (int i = 0; i < 3; i++) {
+        if (b.lo[i] > a->lo[i]) a->lo[i] = b.lo[i];
+        if (b.hi[i] < a->hi[i]) a->hi[i] = b.hi[i];
+    }
+}
+real comp(R3 v, int i) { return i == 0 ? v.x : i == 1 ? v.y : v.z; }
+
+Box prim_box(const Prim &q) {
+    Box b = box_all();
+    for (int i = 0; i < 3; i++) {
+        real p = comp(q.p, i), n = comp(q.n, i);
+        if (q.kind == O_SPHERE) {
+            b.lo[i] = p - q.r;
+            b.hi[i] = p + q.r;
+        } else if (q.kind == O_CYLINDER) {
+            if (n == 0) {  // the axis is perpendicular to this coordinate axis
+                b.lo[i] = p - q.r;
+                b.hi[i] = p + q.r;
+            }
+        } else {
+            // a half-space is bounded on one side only when its normal is a coordinate axis
+            int others = (comp(q.n, (i + 1) % 3) == 0) + (comp(q.n, (i + 2) % 3) == 0);
+            if (others == 2 && n > 0) b.hi[i] = q.d / n;
+            if (others == 2 && n < 0) b.lo[i] = q.d / n;
+        }
+    }
+    return b;
+}
+
+// Shrink box `b` to the box of the convex polyhedron { x : n.x <= d for the planes } within it:
+// the planes of an intersection in any orientation (a tilted cube, a prism) get an exact box.
+// Vertices are triples of constraints (the planes and the box sides) that meet all the others.
+void polyhedron_box(const Scene *s, const int *kids, int n, Box *b) {
+    double N[64][3], D[64];
+    int m = 0;
+    for (int k = 0; k < n && m < 40; k++) {
+        if (e_is_node(kids[k]) || s->prims[e_index(kids[k])].kind != O_PLANE) continue;
+        const Prim &q = s->prims[e_index(kids[k])];
+        N[m][0] = q.n.x;
+        N[m][1] = q.n.y;
+        N[m][2] = q.n.z;
+        D[m++] = q.d;
+    }
+    if (m < 2 || m >= 40) return;
+    const double BIG = 1e30;
+    for (int i = 0; i < 3; i++) {  // the box sides, infinite ones at a huge distance
+        N[m][0] = N[m][1] = N[m][2] = 0;
+        N[m][i] = 1;
+        D[m++] = b->hi[i] >= REAL_BIG ? BIG : (double)b->hi[i];
+        N[m][0] = N[m][1] = N[m][2] = 0;
+        N[m][i] = -1;
+        D[m++] = b->lo[i] <= -REAL_BIG ? BIG : -(double)b->lo[i];
+    }
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    int found = 0;
+    for (int i = 0; i < m; i++)
+        for (int j = i + 1; j < m; j++)
+            for (int k = j + 1; k < m; k++) {
+                const double *a = N[i], *bb = N[j], *cc = N[k];
+                double c0 = bb[1] * cc[2] - bb[2] * cc[1], c1 = bb[2] * cc[0] - bb[0] * cc[2],
+                       c2 = bb[0] * cc[1] - bb[1] * cc[0];
+                double det = a[0] * c0 + a[1] * c1 + a[2] * c2;
+                if (fabs(det) < 1e-12) continue;
+                // Cramer's rule
+                double x[3];
+                double r0 = D[i], r1 = D[j], r2 = D[k];
+                x[0] = (r0 * c0 + r1 * (cc[1] * a[2] - cc[2] * a[1]) + r2 * (a[1] * bb[2] - a[2] * bb[1])) / det;
+                x[1] = (r0 * c1 + r1 * (cc[2] * a[0] - cc[0] * a[2]) + r2 * (a[2] * bb[0] - a[0] * bb[2])) / det;
+                x[2] = (r0 * c2 + r1 * (cc[0] * a[1] - cc[1] * a[0]) + r2 * (a[0] * bb[1] - a[1] * bb[0])) / det;
+                bool ok = true;
+                for (int l = 0; l < m && ok; l++) {
+                    double v = N[l][0] * x[0] + N[l][1] * x[1] + N[l][2] * x[2] - D[l];
+                    ok = v <= 1e-9 * (fabs(D[l]) + fabs(x[0]) + fabs(x[1]) + fabs(x[2]) + 1);
+                }
+                if (!ok) continue;
+                found = 1;
+                for (int l = 0; l < 3; l++) {
+                    if (x[l] < lo[l]) lo[l] = x[l];
+                    if (x[l] > hi[l]) hi[l] = x[l];
+                }
+            }
+    if (!found) return;  // numerically empty: keep the plain box, never fold on this evidence
+    for (int l = 0; l < 3; l++) {
+        double pad = 1e-9 * (fabs(lo[l]) + fabs(hi[l]) + 1);
+        if (lo[l] > -BIG / 2 && lo[l] - pad > (double)b->lo[l]) b->lo[l] = (real)(lo[l] - pad);
+        if (hi[l] < BIG / 2 && hi[l] + pad < (double)b->hi[l]) b->hi[l] = (real)(hi[l] + pad);
+    }
+}
+
+const Box &elem_box(const Scene *s, int e) {
+    return e_is_node(e) ? s->nodes[e_index(e)].box : s->prims[e_index(e)].box;
+}
+
 // A node over the given children; returns its element code, or -3 when out of memory.
 int add_node(pray_ctx *c, Scene *s, int op, const int *kids, int n) {
     Node nd;
+    memset(&nd, 0, sizeof nd);
     nd.op = op;
     nd.n = n;
+    nd.k0 = s->kids.n;
     nd.parent = -1;
-    nd.first = 0;
+    if (op == O_INTER) {
+        nd.box = box_all();
+        for (int i = 0; i < n; i++) box_clip(&nd.box, elem_box(s, kids[i]));
+        polyhedron_box(s, kids, n, &nd.box);
+    } else if (op == O_UNION) {
+        for (int l = 0; l < 3; l++) {
+            nd.box.lo[l] = REAL_BIG;
+            nd.box.hi[l] = -REAL_BIG;
+        }
+        for (int i = 0; i < n; i++) box_hull(&nd.box, elem_box(s, kids[i]));
+    } else if (op == O_DIFF) {
+        nd.box = elem_box(s, kids[0]);
+    } else {
+        nd.box = box_all();
+    }
+    for (int i = 0; i < n; i++)
+        if (!s->kids.push(c, kids[i])) return -3;
     if (!s->nodes.push(c, nd)) return -3;
     for (int i = 0; i < n; i++) set_parent(s, kids[i], s->nodes.n - 1, i == 0);
     return 2 * (s->nodes.n - 1) + 1;
 }
 
+int flatten(pray_ctx *c, Scene *s, const pray_object *o);
+
+// Add element e as a child of an `op` node being built: a node of the same operation (for a
+// difference, only as its first child) gives its children instead, so chains stay one node.
+bool add_kid(pray_ctx *c, Scene *s, Array<int> *kids, int op, int e) {
+    if (e_is_node(e)) {
+        const Node &nd = s->nodes[e_index(e)];
+        if (nd.op == op && (op == O_UNION || op == O_INTER || (op == O_DIFF && kids->n == 0))) {
+            if (!kids->reserve(c, kids->n + nd.n)) return false;
+            for (int i = 0; i < nd.n; i++) kids->push(c, s->kids[nd.k0 + i]);
+            return true;
+        }
+    }
+    return kids->push(c, e);
+}
+
 // Flatten the object into the scene's arrays in post-order (children before parents), folding
-// `one` and `nothing` away. Returns the element code, or -3 when out of memory.
+// `one` and `nothing` away and merging chains; with s->prune, also dropping what bounds prove
+// cannot matter. Parts left out stay in the arrays without a parent until scene_compact.
+// Returns the element code, or -3 when out of memory.
 int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
     switch (o->kind) {
     case O_ONE: return E_ALL;
@@ -994,6 +1171,7 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
             q.r = (real)o->r;
         }
         q.r2 = q.r * q.r;
+        q.box = prim_box(q);
         if (!s->prims.push(c, q)) return -3;
         return 2 * (s->prims.n - 1);
     }
@@ -1008,19 +1186,27 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
         if (e == -3) result = -3;
         else if (op == O_UNION) {
             if (e == E_ALL) result = E_ALL;
-            else if (e != E_NONE && !kids.push(c, e)) result = -3;
+            else if (e != E_NONE && !add_kid(c, s, &kids, op, e)) result = -3;
         } else if (op == O_INTER) {
             if (e == E_NONE) result = E_NONE;
-            else if (e != E_ALL && !kids.push(c, e)) result = -3;
+            else if (e != E_ALL && !add_kid(c, s, &kids, op, e)) result = -3;
         } else if (op == O_DIFF) {
             if (i == 0 && e == E_NONE) result = E_NONE;
             else if (i > 0 && e == E_ALL) result = E_NONE;
-            else if (!(i > 0 && e == E_NONE) && !kids.push(c, e)) result = -3;
+            else if (i > 0 && e == E_NONE) continue;
+            else if (i > 0 && s->prune && kids[0] != E_ALL && !box_overlap(elem_box(s, kids[0]), elem_box(s, e)))
+                continue;  // a subtracted part that cannot touch the base
+            else if (!add_kid(c, s, &kids, op, e)) result = -3;
         } else {  // complement
             if (e == E_ALL) result = E_NONE;
             else if (e == E_NONE) result = E_ALL;
             else if (!kids.push(c, e)) result = -3;
         }
+    }
+    if (result == -4 && op == O_INTER && s->prune) {
+        Box b = box_all();
+        for (int i = 0; i < kids.n; i++) box_clip(&b, elem_box(s, kids[i]));
+        if (box_empty(b)) result = E_NONE;  // parts whose boxes cannot meet
     }
     if (result == -4) {
         if (op == O_DIFF && kids[0] == E_ALL) {
@@ -1036,6 +1222,82 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
     }
     kids.release(c);
     return result;
+}
+
+// Keep only what the root reaches, renumbered in post-order (flattening leaves folded and
+// pruned parts behind).
+pray_status scene_compact(pray_ctx *c, Scene *s) {
+    if (s->root < 0) {
+        s->prims.n = s->nodes.n = s->kids.n = 0;
+        return PRAY_OK;
+    }
+    Array<Prim> prims;
+    Array<Node> nodes;
+    Array<int> kids, stack, done;
+    prims.init();
+    nodes.init();
+    kids.init();
+    stack.init();
+    done.init();
+    pray_status st = PRAY_OK;
+    // iterative post-order: `stack` holds (element, next child) pairs; `done` the new codes of
+    // finished elements whose parent is not finished yet
+    if (!stack.push(c, s->root) || !stack.push(c, 0)) st = c->status;
+    while (st == PRAY_OK && stack.n) {
+        int e = stack[stack.n - 2], k = stack[stack.n - 1];
+        int code;
+        if (!e_is_node(e)) {
+            Prim q = s->prims[e_index(e)];
+            q.parent = -1;
+            if (!prims.push(c, q)) st = c->status;
+            code = 2 * (prims.n - 1);
+        } else {
+            const Node &nd = s->nodes[e_index(e)];
+            if (k < nd.n) {
+                stack[stack.n - 1] = k + 1;
+                if (!stack.push(c, s->kids[nd.k0 + k]) || !stack.push(c, 0)) st = c->status;
+                continue;
+            }
+            Node m = nd;
+            m.k0 = kids.n;
+            m.parent = -1;
+            for (int i = 0; i < nd.n && st == PRAY_OK; i++)
+                if (!kids.push(c, done[done.n - nd.n + i])) st = c->status;
+            done.n -= nd.n;
+            if (!nodes.push(c, m)) st = c->status;
+            code = 2 * (nodes.n - 1) + 1;
+        }
+        stack.n -= 2;
+        if (st == PRAY_OK && !done.push(c, code)) st = c->status;
+    }
+    if (st == PRAY_OK) {
+        // re-link the parents
+        for (int j = 0; j < nodes.n; j++)
+            for (int i = 0; i < nodes[j].n; i++) {
+                int e = kids[nodes[j].k0 + i];
+                if (e_is_node(e)) {
+                    nodes[e_index(e)].parent = j;
+                    nodes[e_index(e)].first = i == 0;
+                } else {
+                    prims[e_index(e)].parent = j;
+                    prims[e_index(e)].first = i == 0;
+                }
+            }
+        s->prims.release(c);
+        s->nodes.release(c);
+        s->kids.release(c);
+        s->prims = prims;
+        s->nodes = nodes;
+        s->kids = kids;
+        s->root = done[0];
+    } else {
+        prims.release(c);
+        nodes.release(c);
+        kids.release(c);
+    }
+    stack.release(c);
+    done.release(c);
+    return st;
 }
 
 // =============================================================================================
@@ -1425,8 +1687,10 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     s->prims.init();
     s->nodes.init();
     s->lights.init();
+    s->kids.init();
+    s->prune = opt_int(c, OPT_BOUNDS) && !opt_int(c, OPT_BRUTE);
     s->root = flatten(c, s, root);
-    if (s->root == -3) return c->status;
+    if (s->root == -3 || scene_compact(c, s)) return c->status;
     for (int i = 0; lights && i < lights->n; i++) {
         const LightSrc &src = lights->src[i];
         Light L;
