@@ -1133,7 +1133,7 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o);
 // Add element e as a child of an `op` node being built: a node of the same operation (for a
 // difference, only as its first child) gives its children instead, so chains stay one node.
 bool add_kid(pray_ctx *c, Scene *s, Array<int> *kids, int op, int e) {
-    if (e_is_node(e)) {
+    if (e >= 0 && e_is_node(e)) {
         const Node &nd = s->nodes[e_index(e)];
         if (nd.op == op && (op == O_UNION || op == O_INTER || (op == O_DIFF && kids->n == 0))) {
             if (!kids->reserve(c, kids->n + nd.n)) return false;
@@ -1222,6 +1222,93 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
     }
     kids.release(c);
     return result;
+}
+
+// Surfaces that are meant to coincide (a face of A on a face of B in A \ B) but were computed
+// along different paths differ in their last bits, and would speckle. Primitives of one kind whose
+// surfaces agree to within a few units in the last place are given exactly the same parameters
+// (opposite normals exactly negated), so their crossings get exactly the same t.
+struct SnapKey {
+    int prim;
+    int sign;     // +1, or -1 when the normal was flipped to its canonical orientation
+    double v[7];  // kind, then the canonical parameters
+};
+
+int snap_cmp(const void *pa, const void *pb) {
+    const SnapKey *a = (const SnapKey *)pa, *b = (const SnapKey *)pb;
+    for (int i = 0; i < 7; i++) {
+        if (a->v[i] < b->v[i]) return -1;
+        if (a->v[i] > b->v[i]) return 1;
+    }
+    return a->prim - b->prim;
+}
+
+void snap_key(const Prim &q, SnapKey *k) {
+    double n[3] = {q.n.x, q.n.y, q.n.z}, p[3] = {q.p.x, q.p.y, q.p.z};
+    k->sign = 1;
+    k->v[0] = q.kind;
+    if (q.kind == O_SPHERE) {
+        for (int i = 0; i < 3; i++) k->v[1 + i] = p[i];
+        k->v[4] = q.r;
+        k->v[5] = k->v[6] = 0;
+        return;
+    }
+    int big = 0;  // canonical orientation: the largest component positive
+    for (int i = 1; i < 3; i++)
+        if (fabs(n[i]) > fabs(n[big])) big = i;
+    if (n[big] < 0) k->sign = -1;
+    for (int i = 0; i < 3; i++) k->v[1 + i] = n[i] * k->sign;
+    if (q.kind == O_PLANE) {
+        k->v[4] = q.d * k->sign;
+        k->v[5] = k->v[6] = 0;
+    } else {  // cylinder: the radius, then the point of the axis nearest the origin
+        double t = p[0] * n[0] + p[1] * n[1] + p[2] * n[2];
+        k->v[4] = q.r;
+        k->v[5] = p[0] - t * n[0];
+        k->v[6] = p[1] - t * n[1];
+    }
+}
+
+bool snap_close(const Prim &a, const Prim &b, int sa, int sb) {
+    const double tol = 64 * (sizeof(real) == sizeof(float) ? FLT_EPSILON : DBL_EPSILON);
+    double scale = 1;
+    R3 na = a.n * (real)sa, nb = b.n * (real)sb;
+    R3 dn = na - nb, dp = a.p - b.p;
+    scale += fabs((double)a.p.x) + fabs((double)a.p.y) + fabs((double)a.p.z) + fabs((double)a.r);
+    if (a.kind == O_SPHERE) return fabs((double)dot(dp, dp)) <= tol * tol * scale * scale && fabs((double)(a.r - b.r)) <= tol * scale;
+    if (fabs((double)dn.x) > tol || fabs((double)dn.y) > tol || fabs((double)dn.z) > tol) return false;
+    if (a.kind == O_PLANE) return fabs((double)(a.d * (real)sa - b.d * (real)sb)) <= tol * (1 + fabs((double)a.d));
+    R3 perp = dp - na * dot(dp, na);  // axes: the same line within tolerance
+    return fabs((double)(a.r - b.r)) <= tol * scale && (double)dot(perp, perp) <= tol * tol * scale * scale;
+}
+
+pray_status snap_coincident(pray_ctx *c, Scene *s) {
+    int n = s->prims.n;
+    if (n < 2) return PRAY_OK;
+    SnapKey *k = (SnapKey *)mem_alloc(c, sizeof(SnapKey) * (size_t)n);
+    if (!k) return c->status;
+    for (int i = 0; i < n; i++) {
+        k[i].prim = i;
+        snap_key(s->prims[i], &k[i]);
+    }
+    qsort(k, (size_t)n, sizeof(SnapKey), snap_cmp);
+    for (int i = 0; i < n;) {
+        const Prim &a = s->prims[k[i].prim];
+        int j = i + 1;
+        for (; j < n && k[j].v[0] == k[i].v[0]; j++) {
+            Prim &b = s->prims[k[j].prim];
+            if (!snap_close(a, b, k[i].sign, k[j].sign)) break;
+            int f = k[i].sign * k[j].sign;  // +1 same orientation, -1 opposite
+            b.p = a.p;
+            b.r = a.r;
+            b.r2 = a.r2;
+            b.n = a.n * (real)f;
+            b.d = a.d * (real)f;
+        }
+        i = j;
+    }
+    mem_free(c, k);
+    return PRAY_OK;
 }
 
 // Keep only what the root reaches, renumbered in post-order (flattening leaves folded and
@@ -1690,7 +1777,7 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     s->kids.init();
     s->prune = opt_int(c, OPT_BOUNDS) && !opt_int(c, OPT_BRUTE);
     s->root = flatten(c, s, root);
-    if (s->root == -3 || scene_compact(c, s)) return c->status;
+    if (s->root == -3 || scene_compact(c, s) || snap_coincident(c, s)) return c->status;
     for (int i = 0; lights && i < lights->n; i++) {
         const LightSrc &src = lights->src[i];
         Light L;
@@ -3477,7 +3564,10 @@ Str *str_new(pray_ctx *c, const char *s, size_t n) {
     return p;
 }
 
-void fmt_num(char *buf, size_t n, double x) { snprintf(buf, n, "%g", x); }
+void fmt_num(char *buf, size_t n, double x) {
+    if (x == 0) x = 0;  // no "-0"
+    snprintf(buf, n, "%g", x);
+}
 
 // Text of a value as `print` writes it.
 bool value_text(pray_ctx *c, const Value &v, Text *out) {
