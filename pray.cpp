@@ -173,7 +173,7 @@ struct Block {
 // Options by index; the table in section 6 has their names, defaults and ranges.
 enum {
     OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_DEPTH, OPT_FREEZE,
-    OPT_GRID, OPT_HEIGHT, OPT_MAXSTEPS, OPT_MERGE, OPT_OUTPUT, OPT_SHADOWS, OPT_THREADS,
+    OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_MAXSTEPS, OPT_MERGE, OPT_OUTPUT, OPT_SHADOWS, OPT_THREADS,
     OPT_WIDTH, OPT_COUNT
 };
 
@@ -383,6 +383,8 @@ pray_rgb cmul(pray_rgb a, pray_rgb b) { return cmake(a.r * b.r, a.g * b.g, a.b *
 pray_rgb cscale(pray_rgb a, double s) { return cmake(a.r * s, a.g * s, a.b * s); }
 bool cfinite(pray_rgb a) { return finite_num(a.r) && finite_num(a.g) && finite_num(a.b); }
 bool czero(pray_rgb a) { return a.r == 0 && a.g == 0 && a.b == 0; }
+
+double cbrt_pos(double x) { return x > 0 ? pow(x, 1.0 / 3.0) : 0; }
 
 // Sine and cosine of an angle in degrees, exact at whole multiples of 90 degrees.
 void sincos_deg(double deg, double *s, double *c) {
@@ -798,7 +800,8 @@ struct OptDef {
 const OptDef OPTS[OPT_COUNT] = {
     {"adaptive", 0, 0, 1e9, 0},   {"antialias", 1, 1, 64, 1}, {"bits", 8, 8, 16, 1},
     {"bounds", 1, 0, 1, 1},       {"brute", 0, 0, 1, 1},      {"depth", 5, 1, 64, 1},
-    {"freeze", 1, 0, 1, 1},       {"grid", -1, -1, 4096, 1},  {"height", 256, 1, MAX_IMAGE_SIDE, 1},
+    {"freeze", 1, 0, 1, 1},       {"grid", -1, -1, 4096, 1},  {"gridmem", 64, 1, 65536, 1},
+    {"height", 256, 1, MAX_IMAGE_SIDE, 1},
     {"maxsteps", 1e7, 0, 1e15, 1}, {"merge", 1, 0, 1, 1},     {"output", 0, 0, 0, 0},
     {"shadows", 1, 0, 1, 1},      {"threads", 0, 0, 1024, 1}, {"width", 256, 1, MAX_IMAGE_SIDE, 1},
 };
@@ -955,7 +958,7 @@ struct Scene {
     pray_rgb bg_top, bg_bottom;
 };
 
-void accel_release(pray_ctx *, Accel *) {}
+void accel_release(pray_ctx *c, Accel *a);
 
 void scene_release(pray_ctx *c, Scene *s) {
     accel_release(c, s->accel);
@@ -1492,6 +1495,7 @@ struct Cross {
 struct Counters {
     double rays[4];  // primary, shadow, reflected, refracted
     double tests;
+    double steps, moves, set_in, set_out, checks, frozen;
 };
 enum { RAY_PRIMARY, RAY_SHADOW, RAY_REFLECT, RAY_REFRACT };
 
@@ -1500,6 +1504,16 @@ struct Scratch {
     unsigned char *pstat, *nstat, *nfirst;
     int *cnt;
     Counters k;
+    // per ray, stamped with the ray number (thesis 3.5: no explicit unfreezing)
+    unsigned ray;
+    unsigned *span_stamp;           // the primitive's interval along this ray is known
+    unsigned char *span_kind;
+    real *span_t0, *span_t1;
+    unsigned *pfrozen, *nfrozen;    // frozen for this ray: actions do nothing
+    unsigned *nfixed;               // status known for the rest of this ray ...
+    unsigned char *nfixval;         // ... and its value
+    int root_fixed;                 // the root's status cannot change any more on this ray
+    Array<int> stack;
 };
 
 bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
@@ -1510,10 +1524,30 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->nstat = (unsigned char *)mem_zalloc(c, nn);
     w->nfirst = (unsigned char *)mem_zalloc(c, nn);
     w->cnt = (int *)mem_zalloc(c, sizeof(int) * nn);
-    return w->cross && w->pstat && w->nstat && w->nfirst && w->cnt;
+    w->span_stamp = (unsigned *)mem_zalloc(c, sizeof(unsigned) * np);
+    w->span_kind = (unsigned char *)mem_zalloc(c, np);
+    w->span_t0 = (real *)mem_zalloc(c, sizeof(real) * np);
+    w->span_t1 = (real *)mem_zalloc(c, sizeof(real) * np);
+    w->pfrozen = (unsigned *)mem_zalloc(c, sizeof(unsigned) * np);
+    w->nfrozen = (unsigned *)mem_zalloc(c, sizeof(unsigned) * nn);
+    w->nfixed = (unsigned *)mem_zalloc(c, sizeof(unsigned) * nn);
+    w->nfixval = (unsigned char *)mem_zalloc(c, nn);
+    w->stack.init();
+    if (!w->stack.reserve(c, s->prims.n + s->nodes.n + 1)) return false;
+    return w->cross && w->pstat && w->nstat && w->nfirst && w->cnt && w->span_stamp && w->span_kind &&
+           w->span_t0 && w->span_t1 && w->pfrozen && w->nfrozen && w->nfixed && w->nfixval;
 }
 
 void scratch_release(pray_ctx *c, Scratch *w) {
+    mem_free(c, w->span_stamp);
+    mem_free(c, w->span_kind);
+    mem_free(c, w->span_t0);
+    mem_free(c, w->span_t1);
+    mem_free(c, w->pfrozen);
+    mem_free(c, w->nfrozen);
+    mem_free(c, w->nfixed);
+    mem_free(c, w->nfixval);
+    w->stack.release(c);
     mem_free(c, w->cross);
     mem_free(c, w->pstat);
     mem_free(c, w->nstat);
@@ -1672,6 +1706,817 @@ struct ShadowHit {
 };
 
 // =============================================================================================
+// [SECTION] 9b Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
+// =============================================================================================
+// Classes of a node against a region of space (thesis 3.4).
+enum { CL_OUT = 0, CL_IN = 1, CL_BD = 2 };
+
+// An action list, stored in Accel::data at off[L]:
+//   [na, np, set_inside, set_outside, na x (node, count, first), np x primitive]
+// The active nodes are listed children first; `count` and `first` are the node's children that
+// are constant in the region, summed up: the thesis' "set inside" / "set outside" actions of
+// one node done at once. Then the "check" actions: the active primitives. List 0 is the empty
+// list of a region where the root is constant, so nothing can be hit there.
+struct Accel {
+    int n[3];          // voxels per axis; all 0 without a grid
+    real org[3], h;    // low corner of the grid and side of a voxel
+    int *voxel;        // list of each voxel, x fastest
+    Array<int> data, off;
+    int outer;         // list of the space outside the grid (everything without a grid)
+    int freeze, merge, bounds;
+    long areas;
+    double memory;
+};
+
+void accel_release(pray_ctx *c, Accel *a) {
+    if (!a) return;
+    mem_free(c, a->voxel);
+    a->data.release(c);
+    a->off.release(c);
+    mem_free(c, a);
+}
+
+// Class of a primitive against a closed box.
+int classify_prim(const Prim &q, const real *lo, const real *hi) {
+    real cen[3], half[3];
+    for (int i = 0; i < 3; i++) {
+        cen[i] = (lo[i] + hi[i]) / 2;
+        half[i] = (hi[i] - lo[i]) / 2;
+    }
+    R3 c = r3(cen[0], cen[1], cen[2]);
+    switch (q.kind) {
+    case O_SPHERE: {
+        real near2 = 0, far2 = 0;
+        for (int i = 0; i < 3; i++) {
+            real d = (real)fabs((double)(cen[i] - comp(q.p, i)));
+            real dn = d - half[i] > 0 ? d - half[i] : 0, df = d + half[i];
+            near2 += dn * dn;
+            far2 += df * df;
+        }
+        if (near2 > q.r2) return CL_OUT;
+        if (far2 < q.r2) return CL_IN;
+        return CL_BD;
+    }
+    case O_PLANE: {
+        real sc = dot(q.n, c) - q.d;
+        real rad = (real)fabs((double)q.n.x) * half[0] + (real)fabs((double)q.n.y) * half[1] +
+                   (real)fabs((double)q.n.z) * half[2];
+        if (sc - rad > 0) return CL_OUT;
+        if (sc + rad < 0) return CL_IN;
+        return CL_BD;
+    }
+    default: {  // cylinder: exact inside (convex: all corners), conservative outside
+        bool all_in = true;
+        for (int k = 0; k < 8 && all_in; k++) {
+            R3 x = r3(k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]) - q.p;
+            R3 perp = x - q.n * dot(x, q.n);
+            all_in = dot(perp, perp) < q.r2;
+        }
+        if (all_in) return CL_IN;
+        R3 x = c - q.p;
+        R3 perp = x - q.n * dot(x, q.n);
+        real rad = (real)sqrt((double)(half[0] * half[0] + half[1] * half[1] + half[2] * half[2]));
+        real dist = (real)sqrt((double)dot(perp, perp));
+        if (dist > q.r + rad) return CL_OUT;
+        return CL_BD;
+    }
+    }
+}
+
+// Builds action lists from the classes of the primitives a region touches; all others are
+// outside there. Bottom-up over the touched nodes, then top-down over the active part.
+struct ListBuilder {
+    pray_ctx *c;
+    const Scene *s;
+    Accel *a;
+    unsigned char *dflt;   // class of each element when all primitives are outside, by code
+    int *base_in;          // per node: children inside by default (a difference: not its first)
+    unsigned stamp, *mark; // per node: touched in the current region
+    int *acc_in, *acc_bd;  // per node: children inside / on the boundary
+    unsigned char *first_cls, *cls;  // per node: class of the first child; class (by code)
+    int *head, *next;      // per node: touched children (a list through `next`, by code)
+    Array<int> touched, out, hash;
+};
+
+int elem_parent(const Scene *s, int e) {
+    return e_is_node(e) ? s->nodes[e_index(e)].parent : s->prims[e_index(e)].parent;
+}
+bool elem_first(const Scene *s, int e) {
+    return (e_is_node(e) ? s->nodes[e_index(e)].first : s->prims[e_index(e)].first) != 0;
+}
+
+int node_class(const Node &nd, int in, int bd, int first) {
+    switch (nd.op) {
+    case O_UNION: return in > 0 ? CL_IN : bd > 0 ? CL_BD : CL_OUT;
+    case O_INTER: return in + bd < nd.n ? CL_OUT : bd > 0 ? CL_BD : CL_IN;
+    case O_DIFF:
+        if (first == CL_OUT || in > 0) return CL_OUT;
+        return first == CL_IN && bd == 0 ? CL_IN : CL_BD;
+    default: return first == CL_BD ? CL_BD : first == CL_IN ? CL_OUT : CL_IN;  // complement
+    }
+}
+
+bool lb_init(ListBuilder &b, pray_ctx *c, const Scene *s, Accel *a) {
+    memset(&b, 0, sizeof b);
+    b.c = c;
+    b.s = s;
+    b.a = a;
+    size_t ne = 2 * (size_t)(s->prims.n > s->nodes.n ? s->prims.n : s->nodes.n) + 2, nn = (size_t)s->nodes.n + 1;
+    b.dflt = (unsigned char *)mem_zalloc(c, ne);
+    b.cls = (unsigned char *)mem_zalloc(c, ne);
+    b.next = (int *)mem_zalloc(c, sizeof(int) * ne);
+    b.base_in = (int *)mem_zalloc(c, sizeof(int) * nn);
+    b.mark = (unsigned *)mem_zalloc(c, sizeof(unsigned) * nn);
+    b.acc_in = (int *)mem_zalloc(c, sizeof(int) * nn);
+    b.acc_bd = (int *)mem_zalloc(c, sizeof(int) * nn);
+    b.first_cls = (unsigned char *)mem_zalloc(c, nn);
+    b.head = (int *)mem_zalloc(c, sizeof(int) * nn);
+    b.touched.init();
+    b.out.init();
+    b.hash.init();
+    if (!b.dflt || !b.cls || !b.next || !b.base_in || !b.mark || !b.acc_in || !b.acc_bd || !b.first_cls || !b.head)
+        return false;
+    for (int j = 0; j < s->nodes.n; j++) {  // children before parents
+        const Node &nd = s->nodes[j];
+        int in = 0, first = CL_OUT;
+        for (int i = 0; i < nd.n; i++) {
+            int k = s->kids[nd.k0 + i];
+            if (i == 0 && (nd.op == O_DIFF || nd.op == O_COMPL)) first = b.dflt[k];
+            else in += b.dflt[k] == CL_IN;
+        }
+        b.base_in[j] = in;
+        b.dflt[2 * j + 1] = (unsigned char)node_class(nd, in, 0, first);
+    }
+    return true;
+}
+
+void lb_release(ListBuilder &b) {
+    pray_ctx *c = b.c;
+    mem_free(c, b.dflt);
+    mem_free(c, b.cls);
+    mem_free(c, b.next);
+    mem_free(c, b.base_in);
+    mem_free(c, b.mark);
+    mem_free(c, b.acc_in);
+    mem_free(c, b.acc_bd);
+    mem_free(c, b.first_cls);
+    mem_free(c, b.head);
+    b.touched.release(c);
+    b.out.release(c);
+    b.hash.release(c);
+}
+
+int int_cmp(const void *pa, const void *pb) {
+    int a = *(const int *)pa, b = *(const int *)pb;
+    return a < b ? -1 : a > b;
+}
+
+// Record that element e has class cl in the current region.
+void lb_contribute(ListBuilder &b, int e, int cl) {
+    b.cls[e] = (unsigned char)cl;
+    int p = elem_parent(b.s, e);
+    if (p < 0) return;
+    const Node &nd = b.s->nodes[p];
+    b.next[e] = b.head[p];
+    b.head[p] = e;
+    if (elem_first(b.s, e) && (nd.op == O_DIFF || nd.op == O_COMPL)) b.first_cls[p] = (unsigned char)cl;
+    else {
+        b.acc_in[p] += (cl == CL_IN) - (b.dflt[e] == CL_IN);
+        b.acc_bd[p] += cl == CL_BD;
+    }
+}
+
+// Store the list in b.out (deduplicated); returns its number.
+int lb_store(ListBuilder &b) {
+    Accel *a = b.a;
+    int n = b.out.n;
+    unsigned h = 2166136261u;
+    for (int i = 0; i < n; i++) h = (h ^ (unsigned)b.out[i]) * 16777619u;
+    if (2 * (a->off.n + 1) > b.hash.n) {  // grow the table
+        int size = b.hash.n ? 2 * b.hash.n : 1024;
+        Array<int> nh;
+        nh.init();
+        if (!nh.reserve(b.c, size)) return -1;
+        nh.n = size;
+        memset(nh.p, 0, sizeof(int) * (size_t)size);
+        for (int L = 1; L < a->off.n; L++) {
+            const int *d = a->data.p + a->off[L];
+            int len = 4 + 3 * d[0] + d[1];
+            unsigned g = 2166136261u;
+            for (int i = 0; i < len; i++) g = (g ^ (unsigned)d[i]) * 16777619u;
+            unsigned k = g & (unsigned)(size - 1);
+            while (nh[(int)k]) k = (k + 1) & (unsigned)(size - 1);
+            nh[(int)k] = L;
+        }
+        b.hash.release(b.c);
+        b.hash = nh;
+    }
+    unsigned k = h & (unsigned)(b.hash.n - 1);
+    for (; b.hash[(int)k]; k = (k + 1) & (unsigned)(b.hash.n - 1)) {
+        int L = b.hash[(int)k];
+        const int *d = a->data.p + a->off[L];
+        if (4 + 3 * d[0] + d[1] == n && memcmp(d, b.out.p, sizeof(int) * (size_t)n) == 0) return L;
+    }
+    if (!a->off.push(b.c, a->data.n) || !a->data.reserve(b.c, a->data.n + n)) return -1;
+    memcpy(a->data.p + a->data.n, b.out.p, sizeof(int) * (size_t)n);
+    a->data.n += n;
+    b.hash[(int)k] = a->off.n - 1;
+    return a->off.n - 1;
+}
+
+// The list of a region, given the primitives it touches and their classes there.
+int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int n) {
+    const Scene *s = b.s;
+    b.stamp++;
+    b.touched.n = 0;
+    int root_cls = s->root >= 0 ? (int)b.dflt[s->root] : (int)CL_OUT;
+    for (int i = 0; i < n; i++) {  // touch the ancestors
+        for (int p = s->prims[prims[i]].parent; p >= 0 && b.mark[p] != b.stamp; p = s->nodes[p].parent) {
+            b.mark[p] = b.stamp;
+            b.acc_in[p] = b.base_in[p];
+            b.acc_bd[p] = 0;
+            b.head[p] = -1;
+            const Node &nd = s->nodes[p];
+            b.first_cls[p] = (nd.op == O_DIFF || nd.op == O_COMPL) ? b.dflt[s->kids[nd.k0]] : (unsigned char)CL_OUT;
+            if (!b.touched.push(b.c, p)) return -1;
+        }
+    }
+    for (int i = 0; i < n; i++) {
+        int e = 2 * prims[i];
+        lb_contribute(b, e, classes[i]);
+        if (e == s->root) root_cls = classes[i];
+    }
+    qsort(b.touched.p, (size_t)b.touched.n, sizeof(int), int_cmp);
+    for (int i = 0; i < b.touched.n; i++) {
+        int p = b.touched[i];
+        int cl = node_class(s->nodes[p], b.acc_in[p], b.acc_bd[p], b.first_cls[p]);
+        lb_contribute(b, 2 * p + 1, cl);
+        if (2 * p + 1 == s->root) root_cls = cl;
+    }
+    if (root_cls != CL_BD) return 0;
+    // the active part: boundary nodes reached from the root through boundary nodes
+    b.out.n = 0;
+    int h[4] = {0, 0, 0, 0};
+    for (int i = 0; i < 4; i++)
+        if (!b.out.push(b.c, 0)) return -1;
+    Array<int> &stk = b.touched;  // reused: the touched nodes are done with
+    stk.n = 0;
+    if (!stk.push(b.c, s->root)) return -1;
+    Array<int> nodes, prims_out;
+    nodes.init();
+    prims_out.init();
+    bool ok = true;
+    while (ok && stk.n) {
+        int e = stk[--stk.n];
+        if (!e_is_node(e)) {
+            ok = prims_out.push(b.c, e_index(e));
+            continue;
+        }
+        int p = e_index(e);
+        ok = nodes.push(b.c, p);
+        for (int k = b.head[p]; ok && k >= 0; k = b.next[k])
+            if (b.cls[k] == CL_BD) ok = stk.push(b.c, k);
+    }
+    if (ok) {
+        qsort(nodes.p, (size_t)nodes.n, sizeof(int), int_cmp);
+        qsort(prims_out.p, (size_t)prims_out.n, sizeof(int), int_cmp);
+        for (int i = 0; ok && i < nodes.n; i++) {
+            int p = nodes[i];
+            const Node &nd = s->nodes[p];
+            bool fd = nd.op == O_DIFF || nd.op == O_COMPL;
+            int cnt = nd.op == O_COMPL ? 0 : b.acc_in[p];
+            int first = nd.op == O_DIFF && b.first_cls[p] == CL_IN;
+            int bd = b.acc_bd[p] + (fd && b.first_cls[p] == CL_BD);
+            h[0]++;
+            h[2] += cnt + first;
+            h[3] += nd.n - cnt - first - bd;
+            ok = b.out.push(b.c, p) && b.out.push(b.c, cnt) && b.out.push(b.c, first);
+        }
+        for (int i = 0; ok && i < prims_out.n; i++) {
+            h[1]++;
+            ok = b.out.push(b.c, prims_out[i]);
+        }
+    }
+    nodes.release(b.c);
+    prims_out.release(b.c);
+    if (!ok) return -1;
+    for (int i = 0; i < 4; i++) b.out[i] = h[i];
+    return lb_store(b);
+}
+
+// Side of the grid's voxels: about cbrt(primitives) of them per axis times a factor found by
+// measurement (see docs/benchmarks.md), no grid for a handful of primitives.
+int auto_grid(int bounded) {
+    if (bounded < 8) return 0;
+    int n = (int)ceil(2.0 * cbrt_pos((double)bounded));
+    return n < 4 ? 4 : n > 160 ? 160 : n;
+}
+
+// Build the acceleration structure: the lists of the grid's voxels and of the space around it.
+pray_status accel_build(pray_ctx *c, Scene *s) {
+    Accel *a = (Accel *)mem_zalloc(c, sizeof(Accel));
+    if (!a) return c->status;
+    s->accel = a;
+    a->data.init();
+    a->off.init();
+    a->freeze = opt_int(c, OPT_FREEZE);
+    a->merge = opt_int(c, OPT_MERGE);
+    a->bounds = opt_int(c, OPT_BOUNDS);
+    if (!a->off.push(c, 0)) return c->status;  // list 0: nothing can be hit
+    for (int i = 0; i < 4; i++)
+        if (!a->data.push(c, 0)) return c->status;
+    ListBuilder b;
+    if (!lb_init(b, c, s, a)) {
+        lb_release(b);
+        return c->status;
+    }
+    pray_status st = PRAY_OK;
+    int np = s->prims.n;
+    // The grid's box: around the primitives with finite boxes, and with bounds, no larger than
+    // the root's box.
+    Box region;
+    int bounded = 0;
+    for (int l = 0; l < 3; l++) {
+        region.lo[l] = REAL_BIG;
+        region.hi[l] = -REAL_BIG;
+    }
+    for (int i = 0; i < np; i++)
+        if (box_finite(s->prims[i].box)) {
+            box_hull(&region, s->prims[i].box);
+            bounded++;
+        }
+    if (a->bounds && s->root >= 0) box_clip(&region, elem_box(s, s->root));
+    int want = opt_int(c, OPT_GRID);
+    if (want < 0) want = auto_grid(bounded);
+    if (box_empty(region) || bounded == 0 || s->root < 0) want = 0;
+    double ext = 0;
+    for (int l = 0; want > 0 && l < 3; l++)
+        if ((double)(region.hi[l] - region.lo[l]) > ext) ext = (double)(region.hi[l] - region.lo[l]);
+    if (!(ext > 0) || !finite_num(ext)) want = 0;
+    // voxels are cubes; the margin keeps classification safe from rounding in the traversal
+    double mag = 0;
+    for (int l = 0; want > 0 && l < 3; l++) {
+        double m = fabs((double)region.lo[l]) > fabs((double)region.hi[l]) ? fabs((double)region.lo[l]) : fabs((double)region.hi[l]);
+        if (m > mag) mag = m;
+    }
+    const double eps = sizeof(real) == sizeof(float) ? FLT_EPSILON : DBL_EPSILON;
+    double budget = opt_int(c, OPT_GRIDMEM) * 1048576.0;
+    if (want > 0) {
+        for (;;) {
+            double hh = ext / want;
+            double vox = 1;
+            for (int l = 0; l < 3; l++) vox *= ceil((double)(region.hi[l] - region.lo[l]) / hh * (1 + 1e-9)) + 1;
+            if (vox * sizeof(int) * 2 <= budget || want <= 1) break;
+            want = (int)(want * 0.8);
+        }
+    }
+    Array<int> cand, start;
+    Array<unsigned char> cls;
+    cand.init();
+    start.init();
+    cls.init();
+    if (want > 0) {
+        a->h = (real)(ext / want);
+        double margin = (double)a->h * 1e-6 + 64 * eps * (mag + ext) * (want + 4);
+        long nv = 1;
+        for (int l = 0; l < 3; l++) {
+            double len = (double)(region.hi[l] - region.lo[l]) + 2 * margin;
+            a->n[l] = (int)ceil(len / (double)a->h);
+            if (a->n[l] < 1) a->n[l] = 1;
+            // centre the grid on the region
+            a->org[l] = (real)((double)(region.lo[l] + region.hi[l]) / 2 - a->n[l] * (double)a->h / 2);
+            nv *= a->n[l];
+        }
+        a->voxel = (int *)mem_zalloc(c, sizeof(int) * (size_t)nv);
+        if (!a->voxel) st = c->status;
+        // candidates per voxel, in two passes (count, then fill)
+        if (st == PRAY_OK && !start.reserve(c, (int)nv + 1)) st = c->status;
+        if (st == PRAY_OK) {
+            start.n = (int)nv + 1;
+            memset(start.p, 0, sizeof(int) * (size_t)(nv + 1));
+        }
+        for (int pass = 0; pass < 2 && st == PRAY_OK; pass++) {
+            for (int i = 0; i < np; i++) {
+                const Box &bx = s->prims[i].box;
+                int lo[3], hi[3];
+                bool any = true;
+                for (int l = 0; l < 3 && any; l++) {
+                    double gl = ((double)bx.lo[l] - margin - (double)a->org[l]) / (double)a->h;
+                    double gh = ((double)bx.hi[l] + margin - (double)a->org[l]) / (double)a->h;
+                    lo[l] = gl < 0 ? 0 : gl >= a->n[l] ? a->n[l] : (int)floor(gl);
+                    hi[l] = gh < 0 ? -1 : gh >= a->n[l] ? a->n[l] - 1 : (int)floor(gh);
+                    any = lo[l] <= hi[l];
+                }
+                if (!any) continue;
+                for (int z = lo[2]; z <= hi[2]; z++)
+                    for (int y = lo[1]; y <= hi[1]; y++)
+                        for (int x = lo[0]; x <= hi[0]; x++) {
+                            long v = ((long)z * a->n[1] + y) * a->n[0] + x;
+                            if (pass == 0) start[(int)v + 1]++;
+                            else cand[start[(int)v]++] = i;
+                        }
+            }
+            if (pass == 0) {
+                for (long v = 0; v < nv; v++) start[(int)v + 1] += start[(int)v];
+                if (start[(int)nv] > 64 * 1048576) {
+                    st = fail(c, PRAY_ERR_LIMIT, "the grid would hold %d primitive references; lower option grid", start[(int)nv]);
+                    break;
+                }
+                if (!cand.reserve(c, start[(int)nv] + 1)) st = c->status;
+                cand.n = start[(int)nv];
+            } else {
+                for (long v = nv; v > 0; v--) start[(int)v] = start[(int)v - 1];
+                start[0] = 0;
+            }
+        }
+        // one list per voxel
+        for (int z = 0; z < a->n[2] && st == PRAY_OK; z++)
+            for (int y = 0; y < a->n[1] && st == PRAY_OK; y++)
+                for (int x = 0; x < a->n[0] && st == PRAY_OK; x++) {
+                    long v = ((long)z * a->n[1] + y) * a->n[0] + x;
+                    int k0 = start[(int)v], k1 = start[(int)v + 1];
+                    real lo[3], hi[3];
+                    int ix[3] = {x, y, z};
+                    for (int l = 0; l < 3; l++) {
+                        lo[l] = (real)((double)a->org[l] + ix[l] * (double)a->h - margin);
+                        hi[l] = (real)((double)a->org[l] + (ix[l] + 1) * (double)a->h + margin);
+                    }
+                    cls.n = 0;
+                    if (!cls.reserve(c, k1 - k0 + 1)) {
+                        st = c->status;
+                        break;
+                    }
+                    for (int k = k0; k < k1; k++) cls.p[cls.n++] = (unsigned char)classify_prim(s->prims[cand[k]], lo, hi);
+                    int L = lb_list(b, cand.p + k0, cls.p, k1 - k0);
+                    if (L < 0) st = c->status;
+                    else a->voxel[v] = L;
+                }
+        // areas: connected voxels with the same list (for the statistics)
+        if (st == PRAY_OK) {
+            Array<int> q;
+            q.init();
+            unsigned char *seen = (unsigned char *)mem_zalloc(c, (size_t)nv);
+            if (!seen) st = c->status;
+            for (long v0 = 0; st == PRAY_OK && v0 < nv; v0++) {
+                if (seen[v0]) continue;
+                a->areas++;
+                seen[v0] = 1;
+                q.n = 0;
+                if (!q.push(c, (int)v0)) st = c->status;
+                while (st == PRAY_OK && q.n) {
+                    long v = q[--q.n];
+                    int x = (int)(v % a->n[0]), y = (int)(v / a->n[0] % a->n[1]), z = (int)(v / a->n[0] / a->n[1]);
+                    int nb[6][3] = {{x - 1, y, z}, {x + 1, y, z}, {x, y - 1, z}, {x, y + 1, z}, {x, y, z - 1}, {x, y, z + 1}};
+                    for (int k = 0; k < 6; k++) {
+                        if (nb[k][0] < 0 || nb[k][1] < 0 || nb[k][2] < 0 || nb[k][0] >= a->n[0] ||
+                            nb[k][1] >= a->n[1] || nb[k][2] >= a->n[2])
+                            continue;
+                        long u = ((long)nb[k][2] * a->n[1] + nb[k][1]) * a->n[0] + nb[k][0];
+                        if (seen[u] || a->voxel[u] != a->voxel[v0]) continue;
+                        seen[u] = 1;
+                        if (!q.push(c, (int)u)) st = c->status;
+                    }
+                }
+            }
+            mem_free(c, seen);
+            q.release(c);
+        }
+    }
+    // the space outside the grid (or everything): primitives not inside the grid's box are active
+    if (st == PRAY_OK) {
+        cand.n = 0;
+        cls.n = 0;
+        for (int i = 0; i < np && st == PRAY_OK; i++) {
+            const Box &bx = s->prims[i].box;
+            bool inside = a->n[0] > 0;
+            for (int l = 0; l < 3 && inside; l++)
+                inside = bx.lo[l] > a->org[l] && bx.hi[l] < (real)((double)a->org[l] + a->n[l] * (double)a->h);
+            if (inside) continue;
+            if (!cand.push(c, i) || !cls.push(c, CL_BD)) st = c->status;
+        }
+        if (st == PRAY_OK) {
+            a->outer = lb_list(b, cand.p, cls.p, cand.n);
+            if (a->outer < 0) st = c->status;
+        }
+    }
+    cand.release(c);
+    start.release(c);
+    cls.release(c);
+    lb_release(b);
+    long nv = (long)a->n[0] * a->n[1] * a->n[2];
+    a->memory = (double)sizeof(Accel) + (double)nv * sizeof(int) + (double)a->data.cap * sizeof(int) +
+                (double)a->off.cap * sizeof(int);
+    c->stats.grid[0] = a->n[0];
+    c->stats.grid[1] = a->n[1];
+    c->stats.grid[2] = a->n[2];
+    c->stats.voxels = nv;
+    c->stats.lists = a->off.n - 1;
+    c->stats.areas = a->areas;
+    c->stats.memory = a->memory;
+    return st;
+}
+
+// ---- evaluation along a ray ----
+// The primitive's interval along the current ray, computed at most once per ray.
+void span_get(const Scene *s, Scratch *w, const Ray &ray, int p, int self) {
+    if (w->span_stamp[p] == w->ray) return;
+    w->span_stamp[p] = w->ray;
+    real t0 = 0, t1 = 0;
+    w->k.tests += 1;
+    w->span_kind[p] = (unsigned char)prim_span(s->prims[p], ray, p == self, &t0, &t1);
+    w->span_t0[p] = t0;
+    w->span_t1[p] = t1;
+}
+
+// Freeze the subtree of element e for this ray (3.5).
+void freeze_tree(const Scene *s, Scratch *w, int e) {
+    w->stack.n = 0;
+    int top = e;
+    for (;;) {
+        if (e_is_node(top)) {
+            int j = e_index(top);
+            if (w->nfrozen[j] != w->ray) {
+                w->nfrozen[j] = w->ray;
+                const Node &nd = s->nodes[j];
+                for (int i = 0; i < nd.n; i++) w->stack.p[w->stack.n++] = s->kids[nd.k0 + i];
+            }
+        } else
+            w->pfrozen[e_index(top)] = w->ray;
+        if (!w->stack.n) break;
+        top = w->stack.p[--w->stack.n];
+    }
+}
+
+// Element e is known to keep status st for the rest of the ray: tell its parent, which may then
+// know its own status for good and freeze its other children (3.5).
+void settle(const Scene *s, Scratch *w, int e, bool st) {
+    for (;;) {
+        int p = elem_parent(s, e);
+        if (p < 0) {
+            if (e == s->root) w->root_fixed = 1;
+            return;
+        }
+        if (w->nfrozen[p] == w->ray || w->nfixed[p] == w->ray) return;
+        const Node &nd = s->nodes[p];
+        bool first = elem_first(s, e);
+        int fix = -1;
+        switch (nd.op) {
+        case O_UNION: fix = st ? 1 : -1; break;
+        case O_INTER: fix = st ? -1 : 0; break;
+        case O_DIFF: fix = (first ? !st : st) ? 0 : -1; break;
+        default: fix = !st; break;
+        }
+        if (fix < 0) return;
+        w->nfixed[p] = w->ray;
+        w->nfixval[p] = (unsigned char)fix;
+        for (int i = 0; i < nd.n; i++)
+            if (s->kids[nd.k0 + i] != e) freeze_tree(s, w, s->kids[nd.k0 + i]);
+        e = 2 * p + 1;
+        st = fix != 0;
+    }
+}
+
+// Like propagate (section 9), but a node whose status is fixed for the ray stops the change.
+bool propagate_live(const Scene *s, Scratch *w, int e, bool st) {
+    for (;;) {
+        int p = elem_parent(s, e);
+        if (p < 0) return e == s->root;
+        if (w->nfixed[p] == w->ray) return false;
+        const Node &nd = s->nodes[p];
+        bool old = w->nstat[p] != 0;
+        if (elem_first(s, e) && nd.op == O_DIFF) w->nfirst[p] = st;
+        else w->cnt[p] += st ? 1 : -1;
+        bool now = node_status(nd, w->cnt[p], w->nfirst[p]);
+        if (now == old) return false;
+        w->nstat[p] = now;
+        st = now;
+        e = 2 * p + 1;
+    }
+}
+
+inline void bump(const Scene *s, Scratch *w, int e) {
+    int p = elem_parent(s, e);
+    if (p < 0 || w->nfixed[p] == w->ray) return;
+    if (elem_first(s, e) && s->nodes[p].op == O_DIFF) w->nfirst[p] = 1;
+    else w->cnt[p]++;
+}
+
+// Evaluate list L on the part (a, b] of the ray (and t < tmax): initialise the active part of
+// the status tree at a, then sweep the crossings inside. Returns true when `visit` stopped.
+template <class Visit>
+bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L, real a, real b, real tmax,
+               int self, Visit &visit) {
+    if (L == 0) return false;
+    const int *d = A->data.p + A->off[L];
+    int na = d[0], np = d[1];
+    const int *nodes = d + 4, *prims = d + 4 + 3 * na;
+    w->k.set_in += d[2];
+    w->k.set_out += d[3];
+    for (int i = 0; i < na; i++) {
+        int j = nodes[3 * i];
+        w->cnt[j] = nodes[3 * i + 1];
+        w->nfirst[j] = (unsigned char)nodes[3 * i + 2];
+    }
+    int nc = 0;
+    for (int i = 0; i < np; i++) {
+        int p = prims[i];
+        w->k.checks += 1;
+        if (w->pfrozen[p] == w->ray) {
+            w->k.frozen += 1;
+            continue;
+        }
+        span_get(s, w, ray, p, self);
+        int kind = w->span_kind[p];
+        real t0 = w->span_t0[p], t1 = w->span_t1[p];
+        bool in = kind == SPAN_ALL || (kind == SPAN && t0 <= a && a < t1);
+        w->pstat[p] = in;
+        if (kind != SPAN) continue;
+        if (t0 > a && t0 <= b && t0 < tmax) {
+            w->cross[nc].t = t0;
+            w->cross[nc].prim = p;
+            w->cross[nc].enter = 1;
+            nc++;
+        }
+        if (t1 > a && t1 <= b && t1 < tmax) {
+            w->cross[nc].t = t1;
+            w->cross[nc].prim = p;
+            w->cross[nc].enter = 0;
+            nc++;
+        }
+    }
+    if (A->freeze)
+        for (int i = 0; i < np; i++) {
+            int p = prims[i];
+            if (w->pfrozen[p] == w->ray) continue;
+            int kind = w->span_kind[p];
+            real t0 = w->span_t0[p], t1 = w->span_t1[p];
+            if (kind == SPAN_NONE || (kind == SPAN && t1 <= a)) settle(s, w, 2 * p, false);
+            else if (kind == SPAN_ALL || (kind == SPAN && t0 <= a && t1 >= REAL_INF)) settle(s, w, 2 * p, true);
+        }
+    for (int i = 0; i < np; i++)
+        if (w->pstat[prims[i]] && w->pfrozen[prims[i]] != w->ray) bump(s, w, 2 * prims[i]);
+    for (int i = 0; i < na; i++) {
+        int j = nodes[3 * i];
+        if (w->nfrozen[j] == w->ray) continue;
+        bool st = w->nfixed[j] == w->ray ? w->nfixval[j] != 0 : node_status(s->nodes[j], w->cnt[j], w->nfirst[j]);
+        w->nstat[j] = st;
+        if (st) bump(s, w, 2 * j + 1);
+    }
+    bool root = e_is_node(s->root) ? w->nstat[e_index(s->root)] != 0 : w->pstat[e_index(s->root)] != 0;
+    if (nc > 1) qsort(w->cross, (size_t)nc, sizeof(Cross), cross_cmp);
+    for (int i = 0; i < nc;) {
+        real t = w->cross[i].t;
+        bool before = root;
+        int last = -1;
+        for (; i < nc && w->cross[i].t == t; i++) {
+            const Cross &x = w->cross[i];
+            if (w->pfrozen[x.prim] == w->ray) continue;
+            bool st = x.enter != 0;
+            if ((w->pstat[x.prim] != 0) == st) continue;
+            w->pstat[x.prim] = st;
+            if (propagate_live(s, w, 2 * x.prim, st)) {
+                root = !root;
+                last = i;
+            }
+            if (A->freeze && (!st || w->span_t1[x.prim] >= REAL_INF)) settle(s, w, 2 * x.prim, st);
+        }
+        if (root != before && last >= 0) {
+            Hit h;
+            h.t = t;
+            h.prim = w->cross[last].prim;
+            h.prim_enter = w->cross[last].enter;
+            h.root_enter = root;
+            if (!visit(h)) return true;
+        }
+        if (w->root_fixed) return true;
+    }
+    return false;
+}
+
+// Where the ray meets the box: [*t0, *t1]; false when it misses.
+bool ray_box(const Ray &r, const real *lo, const real *hi, real *t0, real *t1) {
+    real a = -REAL_INF, b = REAL_INF;
+    for (int l = 0; l < 3; l++) {
+        real o = comp(r.o, l), dd = comp(r.d, l);
+        if (dd == 0) {
+            if (o < lo[l] || o > hi[l]) return false;
+            continue;
+        }
+        real u = (lo[l] - o) / dd, v = (hi[l] - o) / dd;
+        if (u > v) {
+            real x = u;
+            u = v;
+            v = x;
+        }
+        if (u > a) a = u;
+        if (v < b) b = v;
+    }
+    *t0 = a;
+    *t1 = b;
+    return a <= b;
+}
+
+// The accelerated counterpart of `sweep`: the same hits, in the same order.
+template <class Visit>
+void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
+    const Accel *A = s->accel;
+    if (s->root < 0) return;
+    w->ray++;
+    if (w->ray == 0) {  // the stamps wrapped around: clear them
+        memset(w->span_stamp, 0, sizeof(unsigned) * (size_t)s->prims.n);
+        memset(w->pfrozen, 0, sizeof(unsigned) * (size_t)s->prims.n);
+        memset(w->nfrozen, 0, sizeof(unsigned) * (size_t)s->nodes.n);
+        memset(w->nfixed, 0, sizeof(unsigned) * (size_t)s->nodes.n);
+        w->ray = 1;
+    }
+    w->root_fixed = 0;
+    if (A->bounds && A->n[0] == 0) {
+        // without a grid, a bounded node whose box the ray misses is outside for the whole ray
+        for (int j = s->nodes.n - 1; j >= 0; j--) {
+            const Node &nd = s->nodes[j];
+            if (w->nfrozen[j] == w->ray || w->nfixed[j] == w->ray || !box_finite(nd.box)) continue;
+            real t0, t1;
+            if (ray_box(ray, nd.box.lo, nd.box.hi, &t0, &t1) && t1 > 0 && t0 < tmax) continue;
+            w->nfixed[j] = w->ray;
+            w->nfixval[j] = 0;
+            for (int i = 0; i < nd.n; i++) freeze_tree(s, w, s->kids[nd.k0 + i]);
+            if (A->freeze) settle(s, w, 2 * j + 1, false);
+        }
+    }
+    if (A->n[0] == 0) {
+        eval_list(s, A, w, ray, A->outer, 0, tmax, tmax, self, visit);
+        return;
+    }
+    real lo[3], hi[3];
+    for (int l = 0; l < 3; l++) {
+        lo[l] = A->org[l];
+        hi[l] = (real)((double)A->org[l] + A->n[l] * (double)A->h);
+    }
+    real tin, tout;
+    if (!ray_box(ray, lo, hi, &tin, &tout) || tout <= 0 || tin >= tmax) {
+        eval_list(s, A, w, ray, A->outer, 0, tmax, tmax, self, visit);
+        return;
+    }
+    real t = tin > 0 ? tin : 0;
+    if (t > 0 && eval_list(s, A, w, ray, A->outer, 0, t, tmax, self, visit)) return;
+    real tend = tout < tmax ? tout : tmax;
+    // Leading-axis traversal (3.3): the boundaries of the three axes come at regular intervals
+    // along the ray; the next voxel is across the nearest one. Distances are kept as ray
+    // parameters (the leading-axis distance over the leading component of the direction), so a
+    // step is two comparisons and one addition.
+    R3 p = ray.o + ray.d * t;
+    int ix[3], step[3];
+    real next[3], delta[3];
+    for (int l = 0; l < 3; l++) {
+        real dd = comp(ray.d, l);
+        int i = (int)floor((double)((comp(p, l) - A->org[l]) / A->h));
+        ix[l] = i < 0 ? 0 : i >= A->n[l] ? A->n[l] - 1 : i;
+        if (dd > 0) {
+            step[l] = 1;
+            next[l] = (A->org[l] + (real)(ix[l] + 1) * A->h - comp(ray.o, l)) / dd;
+            delta[l] = A->h / dd;
+        } else if (dd < 0) {
+            step[l] = -1;
+            next[l] = (A->org[l] + (real)ix[l] * A->h - comp(ray.o, l)) / dd;
+            delta[l] = -A->h / dd;
+        } else {
+            step[l] = 0;
+            next[l] = REAL_INF;
+            delta[l] = 0;
+        }
+    }
+    int run = -1;  // the list of the area being crossed
+    real run_a = t;
+    for (;;) {
+        int L = A->voxel[((long)ix[2] * A->n[1] + ix[1]) * A->n[0] + ix[0]];
+        int ax = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
+        real exit = next[ax] < tend ? next[ax] : tend;
+        w->k.steps += 1;
+        if (L == run && A->merge) {
+            w->k.moves += 1;  // same list: a move, no evaluation
+        } else {
+            if (run >= 0 && eval_list(s, A, w, ray, run, run_a, t, tmax, self, visit)) return;
+            run = L;
+            run_a = t;
+        }
+        t = exit > t ? exit : t;
+        if (exit >= tend) break;
+        ix[ax] += step[ax];
+        if (ix[ax] < 0 || ix[ax] >= A->n[ax]) break;
+        next[ax] += delta[ax];
+    }
+    if (run >= 0 && eval_list(s, A, w, ray, run, run_a, t, tmax, self, visit)) return;
+    if (tend < tmax) eval_list(s, A, w, ray, A->outer, tend, tmax, tmax, self, visit);
+}
+
+// All hits along the ray in (0, tmax), by the reference or the accelerated path.
+template <class Visit>
+void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
+    if (s->accel) trace_accel(s, w, ray, tmax, self, visit);
+    else sweep(s, w, ray, tmax, self, visit);
+}
+
+// =============================================================================================
 // [SECTION] 10 Whitted shading and the render driver
 // =============================================================================================
 struct Tracer {
@@ -1686,7 +2531,7 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind) {
     tr.w->k.rays[kind] += 1;
     FirstHit fh;
     fh.found = false;
-    sweep(s, tr.w, ray, REAL_INF, self, fh);
+    find_hits(s, tr.w, ray, REAL_INF, self, fh);
     if (!fh.found) return tr.bg;
     const Hit &h = fh.h;
     const Prim &q = s->prims[h.prim];
@@ -1721,7 +2566,7 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind) {
             sr.o = x;
             sr.d = l;
             tr.w->k.rays[RAY_SHADOW] += 1;
-            sweep(s, tr.w, sr, dist, h.prim, sh);
+            find_hits(s, tr.w, sr, dist, h.prim, sh);
             if (czero(sh.f)) continue;
             li = cmul(li, sh.f);
         }
@@ -1778,6 +2623,8 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     s->prune = opt_int(c, OPT_BOUNDS) && !opt_int(c, OPT_BRUTE);
     s->root = flatten(c, s, root);
     if (s->root == -3 || scene_compact(c, s) || snap_coincident(c, s)) return c->status;
+    c->stats.primitives_declared = root->nprims;
+    if (!opt_int(c, OPT_BRUTE) && accel_build(c, s)) return c->status;
     for (int i = 0; lights && i < lights->n; i++) {
         const LightSrc &src = lights->src[i];
         Light L;

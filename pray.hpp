@@ -203,10 +203,17 @@ pray_status pray_background(pray_ctx *ctx, pray_rgb top, pray_rgb bottom);
 /* Statistics: totals over the renders of the current (or last) program run, or since the context
    was made for renders outside runs; primitives and nodes are those of the last render. */
 typedef struct pray_stats {
-    long primitives;                 /* primitives in the rendered object */
-    long nodes;                      /* CSG nodes after flattening */
+    long primitives_declared;        /* primitives in the object handed to the renderer */
+    long primitives;                 /* ... kept after simplification */
+    long nodes;                      /* CSG nodes after simplification */
+    int grid[3];                     /* voxels along x, y, z (0 = no grid) */
+    long voxels, lists, areas;       /* voxels; distinct action lists; areas of equal lists */
+    double memory;                   /* bytes of the acceleration structure */
     double rays_primary, rays_shadow, rays_reflected, rays_refracted;
-    double intersection_tests;       /* ray/primitive tests */
+    double voxel_steps, area_moves;  /* traversal steps; steps inside an area (no evaluation) */
+    double set_inside, set_outside, checks; /* actions executed, by kind */
+    double intersection_tests;       /* ray/primitive intersections computed */
+    double frozen_skips;             /* checks skipped because the node was frozen */
     double time_parse, time_prepare, time_render; /* seconds */
 } pray_stats;
 

@@ -1,0 +1,595 @@
+// Image files and the command line. Files written by pray are decoded by INDEPENDENT readers:
+// python3 with PIL (Debian python3-pil), libtiff's tiffinfo (libtiff-tools), and a few lines of
+// Python reading raw bytes. The command-line program ./pray is built by make before the tests
+// run; the tests run from the repository root. POSIX only (mkdtemp, popen, wait status).
+#include <doctest/doctest.h>
+
+#include "../pray.hpp"
+#include "testkit.hpp"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// A fresh temporary directory, removed with everything in it at the end of the scope.
+struct TempDir {
+    std::string path;
+    TempDir() {
+        std::string t = (fs::temp_directory_path() / "pray_test_XXXXXX").string();
+        std::vector<char> buf(t.begin(), t.end());
+        buf.push_back(0);
+        if (mkdtemp(buf.data())) path = buf.data();
+    }
+    ~TempDir() {
+        std::error_code ec;
+        if (!path.empty()) fs::remove_all(path, ec);
+    }
+    std::string operator/(const std::string &name) const { return path + "/" + name; }
+    // Names of the files in the directory, sorted, "a b c".
+    std::string listing() const {
+        std::vector<std::string> names;
+        for (const fs::directory_entry &e : fs::directory_iterator(path)) names.push_back(e.path().filename().string());
+        std::sort(names.begin(), names.end());
+        std::string s;
+        for (size_t i = 0; i < names.size(); i++) s += (i ? " " : "") + names[i];
+        return s;
+    }
+};
+
+std::string slurp(const std::string &path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+}
+
+void spit(const std::string &path, const std::string &text) {
+    std::ofstream out(path, std::ios::binary);
+    out << text;
+}
+
+bool starts(const std::string &s, const std::string &prefix) { return s.compare(0, prefix.size(), prefix) == 0; }
+
+bool exists(const std::string &path) {
+    std::error_code ec;
+    return fs::exists(path, ec);
+}
+
+// Run a shell command; returns its exit status (-1 when it did not exit normally) and, through
+// `out`, what it wrote to standard output and standard error together.
+int run_cmd(const std::string &cmd, std::string *out) {
+    std::string full = cmd + " 2>&1";
+    FILE *p = popen(full.c_str(), "r");
+    if (!p) return -1;
+    std::string s;
+    char buf[4096];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, p)) > 0) s.append(buf, n);
+    int st = pclose(p);
+    if (out) *out = s;
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+// Single-quote a string for the shell.
+std::string sq(const std::string &s) {
+    std::string r = "'";
+    for (char ch : s) r += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+    return r + "'";
+}
+
+// A python3 that has PIL: the one on PATH, else the system's.
+const std::string &python() {
+    static std::string py;
+    static bool done = false;
+    if (!done) {
+        done = true;
+        const char *cands[] = {"python3", "/usr/bin/python3"};
+        for (const char *c : cands)
+            if (run_cmd(std::string(c) + " -c 'import PIL.Image'", NULL) == 0) {
+                py = c;
+                break;
+            }
+    }
+    return py;
+}
+
+// The test image: 4 x 3 pixels with edge cases in the first row.
+const int W = 4, H = 3;
+std::vector<float> test_pixels() {
+    std::vector<float> p(W * H * 3);
+    for (int i = 0; i < W * H * 3; i++) p[i] = (float)(i / 35.0);
+    const float row0[12] = {0.5f, 0.123f, 2.0f,
+                            -1.0f, std::numeric_limits<float>::quiet_NaN(), 1.0f,
+                            0.25f, 0.75f, 1e-9f,
+                            std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(), 0.999f};
+    for (int i = 0; i < 12; i++) p[i] = row0[i];
+    return p;
+}
+
+// Quantisation as the format promises: clamp to [0, 1] (NaN to 0), round to nearest.
+unsigned q(float v, unsigned maxval) {
+    if (!(v > 0)) return 0;
+    if (v >= 1) return maxval;
+    return (unsigned)std::floor((double)v * maxval + 0.5);
+}
+
+std::string expected_list(unsigned maxval) {
+    std::vector<float> p = test_pixels();
+    std::string s;
+    for (int i = 0; i < W * H; i++) {
+        char b[64];
+        snprintf(b, sizeof b, "%s(%u, %u, %u)", i ? ", " : "", q(p[3 * i], maxval), q(p[3 * i + 1], maxval),
+                 q(p[3 * i + 2], maxval));
+        s += b;
+    }
+    return "[" + s + "]";
+}
+
+pray_status write_test_image(const std::string &path, int bits, pray_ctx **keep = NULL) {
+    std::vector<float> p = test_pixels();
+    pray_image img;
+    img.width = W;
+    img.height = H;
+    img.pixels = p.data();
+    pray_ctx *c = pray_new();
+    pray_status st = pray_write_image(c, &img, path.c_str(), bits);
+    if (keep) *keep = c;
+    else pray_free(c);
+    return st;
+}
+
+unsigned le16(const std::string &s, size_t at) {
+    return (unsigned char)s[at] | (unsigned)(unsigned char)s[at + 1] << 8;
+}
+unsigned long le32(const std::string &s, size_t at) { return le16(s, at) | (unsigned long)le16(s, at + 2) << 16; }
+
+const char *PIL_DUMP = "import sys\nfrom PIL import Image\nim = Image.open(sys.argv[1])\n"
+                       "a = im.tile[0][3] if im.tile else ''\n"
+                       "print(im.format, im.size, im.mode, a if isinstance(a, str) else a[0])\n"
+                       "print(list(im.convert('RGB').getdata()))\n";
+
+std::string pil_dump(const std::string &path) {
+    REQUIRE_MESSAGE(!python().empty(), "no python3 with PIL (Debian: python3-pil)");
+    std::string out;
+    int rc = run_cmd(python() + " -c " + sq(PIL_DUMP) + " " + sq(path), &out);
+    CHECK_MESSAGE(rc == 0, out);
+    return out;
+}
+
+} // namespace
+
+// =============================================================================================
+// Files decoded by independent readers
+// =============================================================================================
+TEST_CASE("TIFF 8 bit: PIL reads it back, tiffinfo accepts it without warnings") {
+    TempDir d;
+    REQUIRE(!d.path.empty());
+    std::string f = d / "a.tif";
+    REQUIRE(write_test_image(f, 8) == PRAY_OK);
+    std::string out = pil_dump(f);
+    CHECK(out == "TIFF (4, 3) RGB RGB\n" + expected_list(255) + "\n");
+    // the quantisation: 0.5 -> 128, > 1 -> 255, negative and NaN -> 0
+    CHECK(out.find("[(128, 31, 255), (0, 0, 255), (64, 191, 0), (255, 0, 255)") != std::string::npos);
+    std::string info;
+    int rc = run_cmd("tiffinfo -D " + sq(f), &info);
+    CHECK(rc == 0);
+    INFO(info);
+    CHECK(info.find("arning") == std::string::npos);
+    CHECK(info.find("rror") == std::string::npos);
+    CHECK(info.find("Image Width: 4 Image Length: 3") != std::string::npos);
+    CHECK(info.find("Bits/Sample: 8") != std::string::npos);
+    CHECK(info.find("Samples/Pixel: 3") != std::string::npos);
+    CHECK(info.find("Photometric Interpretation: RGB color") != std::string::npos);
+    CHECK(info.find("Compression Scheme: None") != std::string::npos);
+    CHECK(d.listing() == "a.tif");  // no temporary file left
+}
+
+TEST_CASE("TIFF 16 bit: little-endian samples, read by PIL and decoded exactly by libtiff") {
+    TempDir d;
+    std::string f = d / "a16.tif";
+    REQUIRE(write_test_image(f, 16) == PRAY_OK);
+    std::string out = pil_dump(f);
+    CHECK(out.rfind("TIFF (4, 3) RGB RGB;16L\n", 0) == 0);  // PIL sees 16-bit little-endian RGB
+    // PIL hands out 8 bits: the high byte of every sample, within one
+    std::vector<float> p = test_pixels();
+    {
+        std::string script = std::string("import sys\nfrom PIL import Image\n") +
+                             "print(' '.join('%d %d %d' % px for px in Image.open(sys.argv[1]).convert('RGB').getdata()))\n";
+        std::string vals;
+        REQUIRE(run_cmd(python() + " -c " + sq(script) + " " + sq(f), &vals) == 0);
+        std::istringstream in(vals);
+        int bad = 0;
+        for (int i = 0; i < W * H * 3; i++) {
+            int v = -1;
+            in >> v;
+            if (std::abs(v - (int)(q(p[i], 65535) / 257.0 + 0.5)) > 1) bad++;
+        }
+        CHECK(bad == 0);
+    }
+    // libtiff's decoded strip, exactly (host byte order; this host is checked to be little-endian)
+    std::string info;
+    REQUIRE(run_cmd("tiffinfo -d " + sq(f), &info) == 0);
+    CHECK(info.find("arning") == std::string::npos);
+    CHECK(info.find("Bits/Sample: 16") != std::string::npos);
+    size_t at = info.find("Strip 0:");
+    REQUIRE(at != std::string::npos);
+    std::istringstream hex(info.substr(at + 8));
+    std::vector<unsigned> bytes;
+    std::string tok;
+    while (hex >> tok && bytes.size() < (size_t)W * H * 6) bytes.push_back((unsigned)std::stoul(tok, NULL, 16));
+    REQUIRE(bytes.size() == (size_t)W * H * 6);
+    const uint16_t probe = 1;
+    bool little = *(const unsigned char *)&probe == 1;
+    int bad = 0;
+    for (int i = 0; i < W * H * 3; i++) {
+        unsigned v = little ? bytes[2 * i] | bytes[2 * i + 1] << 8 : bytes[2 * i] << 8 | bytes[2 * i + 1];
+        if (v != q(p[i], 65535)) bad++;
+    }
+    CHECK(bad == 0);
+    CHECK(q(0.5f, 65535) == 32768);
+}
+
+TEST_CASE("TIFF: byte-exact header") {
+    TempDir d;
+    for (int bits : {8, 16}) {
+        CAPTURE(bits);
+        std::string f = d / ("h" + std::to_string(bits) + ".tif");
+        REQUIRE(write_test_image(f, bits) == PRAY_OK);
+        std::string s = slurp(f);
+        REQUIRE(s.size() > 200);
+        CHECK(starts(s, std::string("II*\0", 4)));
+        unsigned long ifd = le32(s, 4);
+        REQUIRE(ifd + 2 + 12 * 12 + 4 <= s.size());
+        CHECK(le16(s, ifd) == 12);  // 12 tags
+        unsigned prev = 0;
+        unsigned long strip = 0, count = 0;
+        std::vector<unsigned> tags;
+        for (int i = 0; i < 12; i++) {
+            size_t e = ifd + 2 + 12 * i;
+            unsigned tag = le16(s, e), type = le16(s, e + 2);
+            unsigned long n = le32(s, e + 4);
+            tags.push_back(tag);
+            CHECK(tag > prev);  // ascending, as TIFF requires
+            prev = tag;
+            unsigned long val = type == 3 && n == 1 ? le16(s, e + 8) : le32(s, e + 8);
+            if (tag == 256) CHECK(val == (unsigned long)W);
+            if (tag == 257) CHECK(val == (unsigned long)H);
+            if (tag == 259) CHECK(val == 1);  // no compression
+            if (tag == 262) CHECK(val == 2);  // RGB
+            if (tag == 277) CHECK(val == 3);
+            if (tag == 258) {
+                CHECK(n == 3);
+                for (int k = 0; k < 3; k++) CHECK(le16(s, val + 2 * k) == (unsigned)bits);
+            }
+            if (tag == 273) strip = val;
+            if (tag == 279) count = val;
+        }
+        CHECK(le32(s, ifd + 2 + 12 * 12) == 0);  // one image only
+        const unsigned want_tags[12] = {256, 257, 258, 259, 262, 273, 277, 278, 279, 282, 283, 296};
+        CHECK(tags == std::vector<unsigned>(want_tags, want_tags + 12));
+        CHECK(count == (unsigned long)W * H * 3 * (bits / 8));
+        CHECK(strip + count == s.size());
+        if (bits == 16) {
+            // 0.5 -> 32768 = 0x8000 and 0.123 -> 8061 = 0x1F7D, low byte first
+            CHECK((unsigned char)s[strip] == 0x00);
+            CHECK((unsigned char)s[strip + 1] == 0x80);
+            CHECK((unsigned char)s[strip + 2] == 0x7D);
+            CHECK((unsigned char)s[strip + 3] == 0x1F);
+        } else {
+            CHECK((unsigned char)s[strip] == 128);
+            CHECK((unsigned char)s[strip + 1] == 31);
+            CHECK((unsigned char)s[strip + 2] == 255);
+        }
+    }
+}
+
+TEST_CASE("PPM 8 and 16 bit: byte-exact header, PIL and a raw reader agree") {
+    TempDir d;
+    std::string f8 = d / "a.ppm", f16 = d / "a16.ppm";
+    REQUIRE(write_test_image(f8, 8) == PRAY_OK);
+    REQUIRE(write_test_image(f16, 16) == PRAY_OK);
+    std::string s8 = slurp(f8), s16 = slurp(f16);
+    CHECK(starts(s8, "P6\n4 3\n255\n"));
+    CHECK(s8.size() == 11 + (size_t)W * H * 3);
+    CHECK(starts(s16, "P6\n4 3\n65535\n"));
+    CHECK(s16.size() == 13 + (size_t)W * H * 6);
+    // 16-bit PPM samples are big-endian: 0.5 -> 0x80 0x00
+    REQUIRE(s16.size() > 16);
+    CHECK((unsigned char)s16[13] == 0x80);
+    CHECK((unsigned char)s16[14] == 0x00);
+    CHECK((unsigned char)s16[15] == 0x1F);
+    CHECK((unsigned char)s16[16] == 0x7D);
+
+    std::string out = pil_dump(f8);
+    CHECK(out == "PPM (4, 3) RGB RGB\n" + expected_list(255) + "\n");
+    out = pil_dump(f16);
+    CHECK(out.rfind("PPM (4, 3) RGB", 0) == 0);
+
+    // a raw reader in Python: header tokens, then big-endian 16-bit samples
+    std::string script = "import sys, struct\nb = open(sys.argv[1], 'rb').read()\n"
+                         "t = b.split(None, 4)\nw, h, m = int(t[1]), int(t[2]), int(t[3])\n"
+                         "d = t[4]\nprint(t[0].decode(), w, h, m, len(d))\n"
+                         "print(list(struct.unpack('>%dH' % (w*h*3), d)))\n";
+    std::string raw;
+    REQUIRE(run_cmd(python() + " -c " + sq(script) + " " + sq(f16), &raw) == 0);
+    std::vector<float> p = test_pixels();
+    std::string want = "P6 4 3 65535 72\n[";
+    for (int i = 0; i < W * H * 3; i++) want += (i ? ", " : "") + std::to_string(q(p[i], 65535));
+    want += "]\n";
+    CHECK(raw == want);
+    CHECK(d.listing() == "a.ppm a16.ppm");
+}
+
+TEST_CASE("PNG: PIL reads it back") {
+    pray_ctx *c = pray_new();
+    bool png = std::string(pray_features()).find("png") != std::string::npos;
+    pray_free(c);
+    TempDir d;
+    std::string f = d / "a.png";
+    if (!png) {
+        CHECK(write_test_image(f, 8) != PRAY_OK);  // no PNG in this build: an error, no file
+        CHECK(d.listing() == "");
+        return;
+    }
+    REQUIRE(write_test_image(f, 8) == PRAY_OK);
+    CHECK(pil_dump(f) == "PNG (4, 3) RGB RGB\n" + expected_list(255) + "\n");
+    CHECK(write_test_image(d / "b.png", 16) != PRAY_OK);  // PNG has 8 bits here
+    CHECK(d.listing() == "a.png");
+}
+
+TEST_CASE("writers into a byte sink give the same bytes as the files") {
+    TempDir d;
+    std::vector<float> p = test_pixels();
+    pray_image img;
+    img.width = W;
+    img.height = H;
+    img.pixels = p.data();
+    pray_ctx *c = pray_new();
+    for (int bits : {8, 16}) {
+        std::string tif, ppm;
+        CHECK(pray_write_tiff(c, &img, bits, testkit::print_sink, &tif) == PRAY_OK);
+        CHECK(pray_write_ppm(c, &img, bits, testkit::print_sink, &ppm) == PRAY_OK);
+        REQUIRE(pray_write_image(c, &img, (d / "x.tif").c_str(), bits) == PRAY_OK);
+        REQUIRE(pray_write_image(c, &img, (d / "x.ppm").c_str(), bits) == PRAY_OK);
+        CHECK(slurp(d / "x.tif") == tif);
+        CHECK(slurp(d / "x.ppm") == ppm);
+    }
+    // upper-case extensions and .tiff are TIFF too
+    CHECK(pray_write_image(c, &img, (d / "y.TIF").c_str(), 8) == PRAY_OK);
+    CHECK(pray_write_image(c, &img, (d / "y.tiff").c_str(), 8) == PRAY_OK);
+    CHECK(starts(slurp(d / "y.TIF"), std::string("II*\0", 4)));
+    CHECK(starts(slurp(d / "y.tiff"), std::string("II*\0", 4)));
+    pray_free(c);
+}
+
+// =============================================================================================
+// Failures leave nothing behind
+// =============================================================================================
+TEST_CASE("writing into a directory that does not exist fails with PRAY_ERR_IO and leaves nothing") {
+    TempDir d;
+    pray_ctx *c = NULL;
+    for (const char *name : {"nodir/x.tif", "nodir/x.ppm", "nodir/x.png"}) {
+        CAPTURE(name);
+        pray_status st = write_test_image(d / name, 8, &c);
+        if (std::string(name).find(".png") == std::string::npos || std::string(pray_features()).find("png") != std::string::npos) {
+            CHECK(st == PRAY_ERR_IO);
+            CHECK(std::string(pray_error(c)).find("nodir") != std::string::npos);
+        } else {
+            CHECK(st != PRAY_OK);
+        }
+        pray_free(c);
+    }
+    CHECK(d.listing() == "");
+}
+
+TEST_CASE("a target that cannot be replaced (a directory) fails and the temporary file is removed") {
+    TempDir d;
+    fs::create_directory(d / "x.ppm");
+    pray_ctx *c = NULL;
+    CHECK(write_test_image(d / "x.ppm", 8, &c) == PRAY_ERR_IO);
+    CHECK(std::string(pray_error(c)) != "");
+    pray_free(c);
+    CHECK(d.listing() == "x.ppm");
+    CHECK(fs::is_directory(d / "x.ppm"));
+}
+
+TEST_CASE("an unknown or missing extension is an error and writes nothing") {
+    TempDir d;
+    pray_ctx *c = NULL;
+    for (const char *name : {"x.bmp", "x", "x.tif.gz", "x.jpg"}) {
+        CAPTURE(name);
+        CHECK(write_test_image(d / name, 8, &c) != PRAY_OK);
+        CHECK(std::string(pray_error(c)) != "");
+        pray_free(c);
+    }
+    // bits other than 8 and 16
+    CHECK(write_test_image(d / "y.tif", 12, &c) != PRAY_OK);
+    pray_free(c);
+    CHECK(d.listing() == "");
+}
+
+TEST_CASE("a failed write leaves an existing file as it was") {
+    TempDir d;
+    std::string f = d / "keep.ppm";
+    spit(f, "old contents");
+    pray_ctx *c = NULL;
+    CHECK(write_test_image(f, 12, &c) != PRAY_OK);
+    pray_free(c);
+    CHECK(slurp(f) == "old contents");
+    CHECK(d.listing() == "keep.ppm");
+    // a successful write replaces it whole
+    REQUIRE(write_test_image(f, 8) == PRAY_OK);
+    CHECK(starts(slurp(f), "P6\n4 3\n255\n"));
+    CHECK(d.listing() == "keep.ppm");
+}
+
+TEST_CASE("rendertiff writes files: the output option, the default name, numbered frames") {
+    TempDir d;
+    pray_ctx *c = pray_new();
+    std::string prog = "option \"width\", 3\noption \"height\", 2\noption \"output\", \"" + (d / "f.ppm") +
+                       "\"\nrendertiff sphere(color({1}), [0, 0, 0], 1)\nrendertiff nothing\nrendertiff nothing\n";
+    REQUIRE(pray_run_string(c, "f.ray", prog.data(), prog.size()) == PRAY_OK);
+    CHECK(pray_frames(c) == 3);
+    CHECK(d.listing() == "f.ppm f_0001.ppm f_0002.ppm");
+    CHECK(starts(slurp(d / "f.ppm"), "P6\n3 2\n255\n"));
+    std::string hashes = "option \"width\", 2\noption \"height\", 2\noption \"output\", \"" + (d / "anim###.ppm") +
+                         "\"\nI = 0\nwhile I < 2\nrendertiff nothing\nI = I + 1\nendwhile\n";
+    REQUIRE(pray_run_string(c, "anim.ray", hashes.data(), hashes.size()) == PRAY_OK);
+    CHECK(exists(d / "anim000.ppm"));
+    CHECK(exists(d / "anim001.ppm"));
+    CHECK(!exists(d / "anim002.ppm"));
+    // without the output option: the program's name with .tif
+    std::string plain = "option \"width\", 2\noption \"height\", 2\nrendertiff nothing\n";
+    std::string name = d / "scene.ray";
+    REQUIRE(pray_run_string(c, name.c_str(), plain.data(), plain.size()) == PRAY_OK);
+    CHECK(exists(d / "scene.tif"));
+    CHECK(starts(slurp(d / "scene.tif"), std::string("II*\0", 4)));
+    // bits 16 through the option
+    std::string b16 = "option \"width\", 2\noption \"height\", 2\noption \"bits\", 16\noption \"output\", \"" + (d / "b.ppm") +
+                      "\"\nrendertiff nothing\n";
+    REQUIRE(pray_run_string(c, "b.ray", b16.data(), b16.size()) == PRAY_OK);
+    CHECK(starts(slurp(d / "b.ppm"), "P6\n2 2\n65535\n"));
+    pray_free(c);
+}
+
+TEST_CASE("a failed program or render writes no image") {
+    TempDir d;
+    pray_ctx *c = pray_new();
+    const std::string out = "option \"width\", 2\noption \"height\", 2\noption \"output\", \"" + (d / "x.ppm") + "\"\n";
+    const char *bad[] = {
+        "rendertiff sphere(color({1}), [0, 0, 0], 1), 5\n",        // a number where a light belongs
+        "rendertiff 5\n",                                          // not an object
+        "S = sphere(color({1}), [0, 0, 0], 1)\nrendertiff S, Lite\n",  // undefined variable
+    };
+    for (const char *b : bad) {
+        CAPTURE(b);
+        std::string prog = out + b;
+        CHECK(pray_run_string(c, "bad.ray", prog.data(), prog.size()) != PRAY_OK);
+        CHECK(std::string(pray_error(c)).find("bad.ray:") != std::string::npos);
+    }
+    // out of memory during the render
+    pray_set_memory_limit(c, 20000);
+    std::string big = "option \"width\", 200\noption \"height\", 200\noption \"output\", \"" + (d / "y.ppm") +
+                      "\"\nrendertiff sphere(color({1}), [0, 0, 0], 1)\n";
+    CHECK(pray_run_string(c, "big.ray", big.data(), big.size()) != PRAY_OK);
+    pray_free(c);
+    CHECK(d.listing() == "");
+}
+
+// =============================================================================================
+// The command line
+// =============================================================================================
+namespace {
+bool have_pray() { return exists("./pray") && exists("examples/csg.ray"); }
+const char *NO_PRAY = "./pray or examples/ missing: run the tests from the repository root after make";
+} // namespace
+
+TEST_CASE("command line: renders CSG.RAY, exit status 0") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    TempDir d;
+    std::string out;
+    int rc = run_cmd("./pray --quiet -s 32x32 -o " + sq(d / "x.ppm") + " examples/csg.ray", &out);
+    CHECK_MESSAGE(rc == 0, out);
+    std::string s = slurp(d / "x.ppm");
+    CHECK(starts(s, "P6\n32 32\n255\n"));
+    CHECK(s.size() == 13 + 32 * 32 * 3);
+    CHECK(d.listing() == "x.ppm");
+    // the same without --quiet: no terminal, so no progress bar either
+    rc = run_cmd("./pray -s 32x32 -o " + sq(d / "y.tif") + " examples/csg.ray", &out);
+    CHECK(rc == 0);
+    CHECK(out == "");
+    CHECK(starts(slurp(d / "y.tif"), std::string("II*\0", 4)));
+    // the picture: PIL sees a 32x32 image, not all one colour
+    std::string pix = pil_dump(d / "x.ppm");
+    CHECK(pix.rfind("PPM (32, 32) RGB", 0) == 0);
+    CHECK(pix.find("(0, 0, 0)") != std::string::npos);
+}
+
+TEST_CASE("command line: a program error exits with 1, names the place and writes nothing") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    TempDir d;
+    std::string out;
+    int rc = run_cmd("./pray -s 8x8 -o " + sq(d / "x.ppm") + " examples/redsphx.ray", &out);
+    CHECK(rc == 1);
+    CHECK(out.find("redsphx.ray:5:") != std::string::npos);
+    CHECK(out.find("Centre") != std::string::npos);
+    CHECK(d.listing() == "");
+    // an error in rendertiff itself, after an image name was chosen
+    spit(d / "bad.ray", "option \"width\", 4\noption \"height\", 4\nrendertiff sphere(color({1}), [0, 0, 0], 1), 5\n");
+    rc = run_cmd("./pray -o " + sq(d / "y.ppm") + " " + sq(d / "bad.ray"), &out);
+    CHECK(rc == 1);
+    CHECK(out.find("bad.ray:3:") != std::string::npos);
+    CHECK(d.listing() == "bad.ray");
+}
+
+TEST_CASE("command line: usage errors exit with 2") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    TempDir d;
+    const char *cases[] = {"--frobnicate examples/csg.ray", "-s 10 examples/csg.ray", "-s 10x examples/csg.ray",
+                           "-s x10 examples/csg.ray", "-D width examples/csg.ray", "", "-o", "examples/csg.ray examples/csg.ray"};
+    for (const char *a : cases) {
+        CAPTURE(a);
+        std::string out;
+        int rc = run_cmd("./pray -o " + sq(d / "x.ppm") + " " + a, &out);
+        CHECK(rc == 2);
+        CHECK(out != "");
+    }
+    CHECK(d.listing() == "");
+}
+
+TEST_CASE("command line: unreadable program or unwritable output exits with 3") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    TempDir d;
+    std::string out;
+    int rc = run_cmd("./pray -o " + sq(d / "x.ppm") + " " + sq(d / "missing.ray"), &out);
+    CHECK(rc == 3);
+    CHECK(out.find("missing.ray") != std::string::npos);
+    rc = run_cmd("./pray -s 8x8 -o " + sq(d / "nodir/x.ppm") + " examples/csg.ray", &out);
+    CHECK(rc == 3);
+    CHECK(out.find("nodir") != std::string::npos);
+    CHECK(d.listing() == "");
+}
+
+TEST_CASE("command line: --version and --help exit with 0") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    std::string out;
+    CHECK(run_cmd("./pray --version", &out) == 0);
+    CHECK(out.find(PRAY_VERSION_STRING) != std::string::npos);
+    CHECK(run_cmd("./pray --help", &out) == 0);
+    CHECK(out.find("usage") != std::string::npos);
+    CHECK(out.find("-D") != std::string::npos);
+}
+
+TEST_CASE("command line: -D and -s win over the program's options") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    TempDir d;
+    spit(d / "w.ray", "option \"width\", 64\noption \"height\", 8\noption \"output\", \"" + (d / "prog.ppm") +
+                          "\"\nrendertiff sphere(color({1}), [0, 0, 0], 1)\n");
+    std::string out;
+    int rc = run_cmd("./pray -D width=16 -o " + sq(d / "w.ppm") + " " + sq(d / "w.ray"), &out);
+    CHECK_MESSAGE(rc == 0, out);
+    CHECK(starts(slurp(d / "w.ppm"), "P6\n16 8\n255\n"));
+    CHECK(!exists(d / "prog.ppm"));  // -o wins over the output option
+    rc = run_cmd("./pray -s 5x6 -D bits=16 -o " + sq(d / "s.ppm") + " " + sq(d / "w.ray"), &out);
+    CHECK_MESSAGE(rc == 0, out);
+    CHECK(starts(slurp(d / "s.ppm"), "P6\n5 6\n65535\n"));
+    // without -o the program's output option holds
+    rc = run_cmd("./pray -D height=3 " + sq(d / "w.ray"), &out);
+    CHECK_MESSAGE(rc == 0, out);
+    CHECK(starts(slurp(d / "prog.ppm"), "P6\n64 3\n255\n"));
+}
