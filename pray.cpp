@@ -923,8 +923,10 @@ struct Prim {
     R3 n;               // unit outward normal of a plane, unit axis of a cylinder
     real r, r2, d;      // radius, radius squared, plane offset n.p
     const pray_model *mat;
+    int id;             // position among the declared primitives, left to right
     int parent;         // node index, -1 for the root
     unsigned char first;  // first child of a difference
+    unsigned char settles;  // 1: being outside for good decides the parent, 2: inside (3.5)
 };
 
 struct Node {
@@ -950,6 +952,7 @@ struct Scene {
     Array<int> kids;  // element codes of the nodes' children
     int root;
     int prune;        // drop parts that bounds show cannot matter
+    int leaves;       // primitives met so far while flattening
     Accel *accel;     // NULL: the brute-force reference
     Array<Light> lights;
     int parallel;
@@ -1164,6 +1167,7 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
         q.p = r3of(o->p);
         q.mat = o->mat;
         q.parent = -1;
+        q.id = s->leaves++;
         if (o->kind == O_SPHERE) {
             q.r = (real)o->r;
         } else if (o->kind == O_PLANE) {
@@ -1184,7 +1188,11 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
     kids.init();
     int op = o->kind;
     int result = -4;  // undecided
-    for (int i = 0; i < o->nkids && result == -4; i++) {
+    for (int i = 0; i < o->nkids; i++) {
+        if (result != -4) {  // decided: the rest is not needed, but keeps its primitives' numbers
+            s->leaves += (int)o->kids->k[i]->nprims;
+            continue;
+        }
         int e = flatten(c, s, o->kids->k[i]);
         if (e == -3) result = -3;
         else if (op == O_UNION) {
@@ -1380,6 +1388,11 @@ pray_status scene_compact(pray_ctx *c, Scene *s) {
         s->nodes = nodes;
         s->kids = kids;
         s->root = done[0];
+        for (int i = 0; i < prims.n; i++) {
+            const Prim &q = prims[i];
+            int op = q.parent < 0 ? O_COMPL : nodes[q.parent].op;  // the root: either decides
+            prims[i].settles = (unsigned char)(op == O_UNION ? 2 : op == O_INTER ? 1 : op == O_DIFF ? (q.first ? 1 : 2) : 3);
+        }
     } else {
         prims.release(c);
         nodes.release(c);
@@ -1499,6 +1512,12 @@ struct Counters {
 };
 enum { RAY_PRIMARY, RAY_SHADOW, RAY_REFLECT, RAY_REFRACT };
 
+struct Span {
+    real t0, t1;
+    unsigned stamp;  // the ray it belongs to
+    int kind;
+};
+
 struct Scratch {
     Cross *cross;
     unsigned char *pstat, *nstat, *nfirst;
@@ -1506,9 +1525,7 @@ struct Scratch {
     Counters k;
     // per ray, stamped with the ray number (thesis 3.5: no explicit unfreezing)
     unsigned ray;
-    unsigned *span_stamp;           // the primitive's interval along this ray is known
-    unsigned char *span_kind;
-    real *span_t0, *span_t1;
+    Span *span;                     // per primitive: its interval along the ray, once per ray
     unsigned *pfrozen, *nfrozen;    // frozen for this ray: actions do nothing
     unsigned *nfixed;               // status known for the rest of this ray ...
     unsigned char *nfixval;         // ... and its value
@@ -1524,25 +1541,18 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->nstat = (unsigned char *)mem_zalloc(c, nn);
     w->nfirst = (unsigned char *)mem_zalloc(c, nn);
     w->cnt = (int *)mem_zalloc(c, sizeof(int) * nn);
-    w->span_stamp = (unsigned *)mem_zalloc(c, sizeof(unsigned) * np);
-    w->span_kind = (unsigned char *)mem_zalloc(c, np);
-    w->span_t0 = (real *)mem_zalloc(c, sizeof(real) * np);
-    w->span_t1 = (real *)mem_zalloc(c, sizeof(real) * np);
+    w->span = (Span *)mem_zalloc(c, sizeof(Span) * np);
     w->pfrozen = (unsigned *)mem_zalloc(c, sizeof(unsigned) * np);
     w->nfrozen = (unsigned *)mem_zalloc(c, sizeof(unsigned) * nn);
     w->nfixed = (unsigned *)mem_zalloc(c, sizeof(unsigned) * nn);
     w->nfixval = (unsigned char *)mem_zalloc(c, nn);
     w->stack.init();
     if (!w->stack.reserve(c, s->prims.n + s->nodes.n + 1)) return false;
-    return w->cross && w->pstat && w->nstat && w->nfirst && w->cnt && w->span_stamp && w->span_kind &&
-           w->span_t0 && w->span_t1 && w->pfrozen && w->nfrozen && w->nfixed && w->nfixval;
+    return w->cross && w->pstat && w->nstat && w->nfirst && w->cnt && w->span && w->pfrozen && w->nfrozen && w->nfixed && w->nfixval;
 }
 
 void scratch_release(pray_ctx *c, Scratch *w) {
-    mem_free(c, w->span_stamp);
-    mem_free(c, w->span_kind);
-    mem_free(c, w->span_t0);
-    mem_free(c, w->span_t1);
+    mem_free(c, w->span);
     mem_free(c, w->pfrozen);
     mem_free(c, w->nfrozen);
     mem_free(c, w->nfixed);
@@ -1983,13 +1993,13 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
         for (int i = 0; ok && i < nodes.n; i++) {
             int p = nodes[i];
             const Node &nd = s->nodes[p];
-            bool fd = nd.op == O_DIFF || nd.op == O_COMPL;
             int cnt = nd.op == O_COMPL ? 0 : b.acc_in[p];
             int first = nd.op == O_DIFF && b.first_cls[p] == CL_IN;
-            int bd = b.acc_bd[p] + (fd && b.first_cls[p] == CL_BD);
             h[0]++;
             h[2] += cnt + first;
-            h[3] += nd.n - cnt - first - bd;
+            // children outside by default need no action in the counting representation; those
+            // the region touches and finds outside are the "set outside" actions
+            for (int k = b.head[p]; k >= 0; k = b.next[k]) h[3] += b.cls[k] == CL_OUT;
             ok = b.out.push(b.c, p) && b.out.push(b.c, cnt) && b.out.push(b.c, first);
         }
         for (int i = 0; ok && i < prims_out.n; i++) {
@@ -2218,14 +2228,14 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
 
 // ---- evaluation along a ray ----
 // The primitive's interval along the current ray, computed at most once per ray.
-void span_get(const Scene *s, Scratch *w, const Ray &ray, int p, int self) {
-    if (w->span_stamp[p] == w->ray) return;
-    w->span_stamp[p] = w->ray;
-    real t0 = 0, t1 = 0;
-    w->k.tests += 1;
-    w->span_kind[p] = (unsigned char)prim_span(s->prims[p], ray, p == self, &t0, &t1);
-    w->span_t0[p] = t0;
-    w->span_t1[p] = t1;
+inline const Span &span_get(const Scene *s, Scratch *w, const Ray &ray, int p, int self) {
+    Span &sp = w->span[p];
+    if (sp.stamp != w->ray) {
+        sp.stamp = w->ray;
+        w->k.tests += 1;
+        sp.kind = prim_span(s->prims[p], ray, p == self, &sp.t0, &sp.t1);
+    }
+    return sp;
 }
 
 // Freeze the subtree of element e for this ray (3.5).
@@ -2317,44 +2327,39 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
         w->cnt[j] = nodes[3 * i + 1];
         w->nfirst[j] = (unsigned char)nodes[3 * i + 2];
     }
+    // check actions: the primitive's status at a and its crossings in (a, b]; a primitive that
+    // keeps its status for the rest of the ray is settled (3.5), which may freeze others
     int nc = 0;
+    w->k.checks += np;
     for (int i = 0; i < np; i++) {
         int p = prims[i];
-        w->k.checks += 1;
         if (w->pfrozen[p] == w->ray) {
             w->k.frozen += 1;
             continue;
         }
-        span_get(s, w, ray, p, self);
-        int kind = w->span_kind[p];
-        real t0 = w->span_t0[p], t1 = w->span_t1[p];
+        const Span &sp = span_get(s, w, ray, p, self);
+        int kind = sp.kind;
+        real t0 = sp.t0, t1 = sp.t1;
         bool in = kind == SPAN_ALL || (kind == SPAN && t0 <= a && a < t1);
         w->pstat[p] = in;
-        if (kind != SPAN) continue;
-        if (t0 > a && t0 <= b && t0 < tmax) {
-            w->cross[nc].t = t0;
-            w->cross[nc].prim = p;
-            w->cross[nc].enter = 1;
-            nc++;
+        if (kind == SPAN) {
+            if (t0 > a && t0 <= b && t0 < tmax) {
+                w->cross[nc].t = t0;
+                w->cross[nc].prim = p;
+                w->cross[nc].enter = 1;
+                nc++;
+            }
+            if (t1 > a && t1 <= b && t1 < tmax) {
+                w->cross[nc].t = t1;
+                w->cross[nc].prim = p;
+                w->cross[nc].enter = 0;
+                nc++;
+            }
         }
-        if (t1 > a && t1 <= b && t1 < tmax) {
-            w->cross[nc].t = t1;
-            w->cross[nc].prim = p;
-            w->cross[nc].enter = 0;
-            nc++;
-        }
+        if (A->freeze && (s->prims[p].settles & (in ? 2 : 1)) && (kind != SPAN || t1 <= a || (t0 <= a && t1 >= REAL_INF)))
+            settle(s, w, 2 * p, in);
+        if (in) bump(s, w, 2 * p);
     }
-    if (A->freeze)
-        for (int i = 0; i < np; i++) {
-            int p = prims[i];
-            if (w->pfrozen[p] == w->ray) continue;
-            int kind = w->span_kind[p];
-            real t0 = w->span_t0[p], t1 = w->span_t1[p];
-            if (kind == SPAN_NONE || (kind == SPAN && t1 <= a)) settle(s, w, 2 * p, false);
-            else if (kind == SPAN_ALL || (kind == SPAN && t0 <= a && t1 >= REAL_INF)) settle(s, w, 2 * p, true);
-        }
-    for (int i = 0; i < np; i++)
-        if (w->pstat[prims[i]] && w->pfrozen[prims[i]] != w->ray) bump(s, w, 2 * prims[i]);
     for (int i = 0; i < na; i++) {
         int j = nodes[3 * i];
         if (w->nfrozen[j] == w->ray) continue;
@@ -2378,7 +2383,8 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
                 root = !root;
                 last = i;
             }
-            if (A->freeze && (!st || w->span_t1[x.prim] >= REAL_INF)) settle(s, w, 2 * x.prim, st);
+            if (A->freeze && (s->prims[x.prim].settles & (st ? 2 : 1)) && (!st || w->span[x.prim].t1 >= REAL_INF))
+                settle(s, w, 2 * x.prim, st);
         }
         if (root != before && last >= 0) {
             Hit h;
@@ -2423,7 +2429,7 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
     if (s->root < 0) return;
     w->ray++;
     if (w->ray == 0) {  // the stamps wrapped around: clear them
-        memset(w->span_stamp, 0, sizeof(unsigned) * (size_t)s->prims.n);
+        for (int i = 0; i < s->prims.n; i++) w->span[i].stamp = 0;
         memset(w->pfrozen, 0, sizeof(unsigned) * (size_t)s->prims.n);
         memset(w->nfrozen, 0, sizeof(unsigned) * (size_t)s->nodes.n);
         memset(w->nfixed, 0, sizeof(unsigned) * (size_t)s->nodes.n);
@@ -2685,6 +2691,12 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
     c->stats.rays_reflected += w.k.rays[RAY_REFLECT];
     c->stats.rays_refracted += w.k.rays[RAY_REFRACT];
     c->stats.intersection_tests += w.k.tests;
+    c->stats.voxel_steps += w.k.steps;
+    c->stats.area_moves += w.k.moves;
+    c->stats.set_inside += w.k.set_in;
+    c->stats.set_outside += w.k.set_out;
+    c->stats.checks += w.k.checks;
+    c->stats.frozen_skips += w.k.frozen;
     scratch_release(c, &w);
     return st;
 }
@@ -3242,6 +3254,70 @@ pray_status pray_render(pray_ctx *c, pray_object *root, pray_light *lights, pray
 }
 
 void pray_stats_get(const pray_ctx *c, pray_stats *out) { *out = c->stats; }
+
+struct pray_scene {
+    Scene s;
+    Scratch w;
+};
+
+pray_scene *pray_prepare(pray_ctx *c, pray_object *root) {
+    if (!c || !root) return NULL;
+    pray_scene *q = (pray_scene *)mem_zalloc(c, sizeof(pray_scene));
+    if (!q) return NULL;
+    if (scene_build(c, &q->s, root, NULL) || !scratch_init(c, &q->w, &q->s)) {
+        pray_scene_free(c, q);
+        return NULL;
+    }
+    return q;
+}
+
+namespace {
+struct CollectHits {
+    const Scene *s;
+    Ray ray;
+    pray_hit *out;
+    int max, n;
+    bool operator()(const Hit &h) {
+        if (n < max) {
+            const Prim &q = s->prims[h.prim];
+            pray_hit &o = out[n];
+            o.t = (double)h.t;
+            o.primitive = q.id;
+            o.entering = h.root_enter;
+            R3 ng = prim_normal(q, ray.o + ray.d * h.t);
+            R3 nn = h.prim_enter == h.root_enter ? ng : ng * (real)-1;
+            o.normal = vmake((double)nn.x, (double)nn.y, (double)nn.z);
+        }
+        n++;
+        return true;
+    }
+};
+} // namespace
+
+int pray_intersect(pray_ctx *c, pray_scene *q, pray_vec origin, pray_vec dir, double tmax, pray_hit *hits,
+                   int max_hits) {
+    if (!c || !q || (max_hits > 0 && !hits)) return -1;
+    if (!vfinite(origin) || !vfinite(dir) || vlen(dir) == 0 || tmax != tmax) {
+        fail(c, PRAY_ERR_ARG, "pray_intersect: the ray must have a finite origin and direction");
+        return -1;
+    }
+    CollectHits ch;
+    ch.s = &q->s;
+    ch.ray.o = r3of(origin);
+    ch.ray.d = unit(r3of(dir));
+    ch.out = hits;
+    ch.max = max_hits;
+    ch.n = 0;
+    find_hits(&q->s, &q->w, ch.ray, tmax >= HUGE_VAL ? REAL_INF : (real)tmax, -1, ch);
+    return ch.n;
+}
+
+void pray_scene_free(pray_ctx *c, pray_scene *q) {
+    if (!c || !q) return;
+    scratch_release(c, &q->w);
+    scene_release(c, &q->s);
+    mem_free(c, q);
+}
 
 void pray_image_free(pray_ctx *c, pray_image *img) {
     if (!img) return;
@@ -5292,12 +5368,17 @@ void print_stats(pray_ctx *c) {
     pray_stats s;
     pray_stats_get(c, &s);
     fprintf(stderr,
-            "primitives %ld, nodes %ld\n"
+            "primitives: %ld declared, %ld kept; nodes %ld\n"
+            "grid: %d x %d x %d = %ld voxels, %ld distinct lists, %ld areas, %.0f bytes\n"
             "rays: primary %.0f, shadow %.0f, reflected %.0f, refracted %.0f\n"
+            "traversal: %.0f voxel steps, %.0f area moves\n"
+            "actions: set inside %.0f, set outside %.0f, check %.0f (frozen skips %.0f)\n"
             "intersection tests %.0f\n"
             "time: parse %.3f s, prepare %.3f s, render %.3f s\n",
-            s.primitives, s.nodes, s.rays_primary, s.rays_shadow, s.rays_reflected, s.rays_refracted,
-            s.intersection_tests, s.time_parse, s.time_prepare, s.time_render);
+            s.primitives_declared, s.primitives, s.nodes, s.grid[0], s.grid[1], s.grid[2], s.voxels, s.lists,
+            s.areas, s.memory, s.rays_primary, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.voxel_steps,
+            s.area_moves, s.set_inside, s.set_outside, s.checks, s.frozen_skips, s.intersection_tests,
+            s.time_parse, s.time_prepare, s.time_render);
 }
 
 int run_stdin(pray_ctx *c) {

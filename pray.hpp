@@ -221,6 +221,24 @@ typedef struct pray_stats {
    options into `out` (allocated here; free with pray_image_free). */
 pray_status pray_render(pray_ctx *ctx, pray_object *root, pray_light *lights, pray_image *out);
 void pray_stats_get(const pray_ctx *ctx, pray_stats *out);
+
+/* Ray queries, for picking and for checking the renderer: prepare a solid once with the
+   context's options (grid, freeze, merge, bounds, brute), then ask for the surfaces a ray
+   crosses. The surfaces are those of the whole solid, in order along the ray. */
+typedef struct pray_scene pray_scene;
+typedef struct pray_hit {
+    double t;          /* the ray parameter: origin + t * unit(direction) */
+    int primitive;     /* which primitive: its position among the primitives of the object as
+                          declared, left to right, from 0 (the same whatever is simplified) */
+    int entering;      /* 1 where the ray enters the solid, 0 where it leaves */
+    pray_vec normal;   /* unit normal facing out of the solid */
+} pray_hit;
+pray_scene *pray_prepare(pray_ctx *ctx, pray_object *root);
+/* Up to max_hits hits with 0 < t < tmax (HUGE_VAL for all) in order; returns how many there
+   are in all (which may exceed max_hits), or -1 on error. */
+int pray_intersect(pray_ctx *ctx, pray_scene *scene, pray_vec origin, pray_vec direction, double tmax,
+                   pray_hit *hits, int max_hits);
+void pray_scene_free(pray_ctx *ctx, pray_scene *scene);
 void pray_image_free(pray_ctx *ctx, pray_image *img);
 
 /* Write an image; the format comes from the extension: .tif/.tiff (bits 8 or 16), .ppm (bits 8

@@ -24,16 +24,16 @@
 namespace {
 
 // Tolerances follow the renderer's precision: PRAY_REAL double (default) or float.
-const double REL = sizeof(real) == sizeof(double) ? 1e-9 : 1e-4;
+const double T_REL = sizeof(real) == sizeof(double) ? 1e-9 : 1e-4;
 
-pray_vec tvec(double x, double y, double z) {
+pray_vec t_vec(double x, double y, double z) {
     pray_vec v;
     v.x = x;
     v.y = y;
     v.z = z;
     return v;
 }
-pray_rgb trgb(double r, double g, double b) {
+pray_rgb t_rgb(double r, double g, double b) {
     pray_rgb c;
     c.r = r;
     c.g = g;
@@ -42,7 +42,7 @@ pray_rgb trgb(double r, double g, double b) {
 }
 
 // A ray with a unit direction (computed in double, then stored in render precision).
-Ray tray(double ox, double oy, double oz, double dx, double dy, double dz) {
+Ray t_ray(double ox, double oy, double oz, double dx, double dy, double dz) {
     double l = std::sqrt(dx * dx + dy * dy + dz * dz);
     Ray r;
     r.o = r3((real)ox, (real)oy, (real)oz);
@@ -50,10 +50,10 @@ Ray tray(double ox, double oy, double oz, double dx, double dy, double dz) {
     return r;
 }
 
-bool close_t(double got, double want) { return std::fabs(got - want) <= REL * std::max(1.0, std::fabs(want)); }
+bool t_close(double got, double want) { return std::fabs(got - want) <= T_REL * std::max(1.0, std::fabs(want)); }
 
 // Every hit the sweep visits, in order.
-struct AllHits {
+struct TAllHits {
     std::vector<Hit> v;
     bool operator()(const Hit &h) {
         v.push_back(h);
@@ -62,24 +62,24 @@ struct AllHits {
 };
 
 // A flattened scene of one object, with the scratch space of a sweep.
-struct Built {
+struct TScene {
     pray_ctx *c;
     Scene s;
     Scratch w;
     bool ok;
-    Built(pray_ctx *ctx, pray_object *o) : c(ctx), ok(false) {
+    TScene(pray_ctx *ctx, pray_object *o) : c(ctx), ok(false) {
         memset(&s, 0, sizeof s);
         memset(&w, 0, sizeof w);
         if (!o) return;
         if (scene_build(c, &s, o, NULL) != PRAY_OK) return;
         ok = scratch_init(c, &w, &s);
     }
-    ~Built() {
+    ~TScene() {
         scratch_release(c, &w);
         scene_release(c, &s);
     }
     std::vector<Hit> hits(const Ray &r, int self = -1, real tmax = REAL_INF) {
-        AllHits a;
+        TAllHits a;
         if (ok) sweep(&s, &w, r, tmax, self, a);
         return a.v;
     }
@@ -98,20 +98,20 @@ struct Built {
 };
 
 // A context with one material per call, so that hits can be told apart by material.
-struct Ctx {
+struct TCtx {
     pray_ctx *c;
-    Ctx() : c(pray_new()) {}
-    ~Ctx() { pray_free(c); }
-    pray_model *mat(double id) { return pray_color(c, trgb(id, 0, 0)); }
+    TCtx() : c(pray_new()) {}
+    ~TCtx() { pray_free(c); }
+    pray_model *mat(double id) { return pray_color(c, t_rgb(id, 0, 0)); }
 };
 
 // The span of a single primitive, as flattened for rendering.
-struct Span {
+struct TSpan {
     int kind;
     real t0, t1;
 };
-Span span_of(pray_ctx *c, pray_object *o, const Ray &r, bool self = false) {
-    Span sp;
+TSpan t_span_of(pray_ctx *c, pray_object *o, const Ray &r, bool self = false) {
+    TSpan sp;
     sp.kind = -1;
     sp.t0 = sp.t1 = 0;
     Scene s;
@@ -124,141 +124,141 @@ Span span_of(pray_ctx *c, pray_object *o, const Ray &r, bool self = false) {
 // ---------------------------------------------------------------------------------------------
 // An independent reference: the CSG tree kept as plain data, membership evaluated directly.
 // ---------------------------------------------------------------------------------------------
-typedef long double ld;
+typedef long double tld;
 
-struct RPrim {
+struct RefPrim {
     int kind;  // O_SPHERE, O_PLANE, O_CYLINDER
-    ld p[3];   // centre / point on the plane / point on the axis
-    ld n[3];   // plane normal / cylinder axis (not necessarily unit)
-    ld r;
+    tld p[3];   // centre / point on the plane / point on the axis
+    tld n[3];   // plane normal / cylinder axis (not necessarily unit)
+    tld r;
 };
 
-struct RNode {
+struct RefNode {
     int kind;  // O_SPHERE..O_CYLINDER (then `prim`), O_ONE, O_NOTHING, O_UNION, O_INTER, O_DIFF, O_COMPL
     int prim;
     std::vector<int> kids;
 };
 
-struct RTree {
-    std::vector<RPrim> prims;
-    std::vector<RNode> nodes;
+struct RefTree {
+    std::vector<RefPrim> prims;
+    std::vector<RefNode> nodes;
     int root;
 };
 
-ld ldot(const ld *a, const ld *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+tld ref_dot(const tld *a, const tld *b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 // Signed distance-like function: negative inside, zero on the surface (in length units).
-ld rprim_f(const RPrim &q, const ld *x) {
-    ld v[3] = {x[0] - q.p[0], x[1] - q.p[1], x[2] - q.p[2]};
+tld ref_prim_f(const RefPrim &q, const tld *x) {
+    tld v[3] = {x[0] - q.p[0], x[1] - q.p[1], x[2] - q.p[2]};
     switch (q.kind) {
-    case O_SPHERE: return std::sqrt(ldot(v, v)) - q.r;
-    case O_PLANE: return ldot(v, q.n) / std::sqrt(ldot(q.n, q.n));
+    case O_SPHERE: return std::sqrt(ref_dot(v, v)) - q.r;
+    case O_PLANE: return ref_dot(v, q.n) / std::sqrt(ref_dot(q.n, q.n));
     default: {
-        ld a2 = ldot(q.n, q.n), s = ldot(v, q.n) / a2;
-        ld w[3] = {v[0] - q.n[0] * s, v[1] - q.n[1] * s, v[2] - q.n[2] * s};
-        return std::sqrt(ldot(w, w)) - q.r;
+        tld a2 = ref_dot(q.n, q.n), s = ref_dot(v, q.n) / a2;
+        tld w[3] = {v[0] - q.n[0] * s, v[1] - q.n[1] * s, v[2] - q.n[2] * s};
+        return std::sqrt(ref_dot(w, w)) - q.r;
     }
     }
 }
 
 // Outward direction of the surface at x (not normalised).
-void rprim_grad(const RPrim &q, const ld *x, ld *g) {
-    ld v[3] = {x[0] - q.p[0], x[1] - q.p[1], x[2] - q.p[2]};
+void ref_prim_grad(const RefPrim &q, const tld *x, tld *g) {
+    tld v[3] = {x[0] - q.p[0], x[1] - q.p[1], x[2] - q.p[2]};
     if (q.kind == O_PLANE) {
         for (int i = 0; i < 3; i++) g[i] = q.n[i];
     } else if (q.kind == O_SPHERE) {
         for (int i = 0; i < 3; i++) g[i] = v[i];
     } else {
-        ld s = ldot(v, q.n) / ldot(q.n, q.n);
+        tld s = ref_dot(v, q.n) / ref_dot(q.n, q.n);
         for (int i = 0; i < 3; i++) g[i] = v[i] - q.n[i] * s;
     }
 }
 
-bool rprim_in(const RPrim &q, const ld *x) {
-    ld v[3] = {x[0] - q.p[0], x[1] - q.p[1], x[2] - q.p[2]};
+bool ref_prim_in(const RefPrim &q, const tld *x) {
+    tld v[3] = {x[0] - q.p[0], x[1] - q.p[1], x[2] - q.p[2]};
     switch (q.kind) {
-    case O_SPHERE: return ldot(v, v) < q.r * q.r;
-    case O_PLANE: return ldot(v, q.n) < 0;
+    case O_SPHERE: return ref_dot(v, v) < q.r * q.r;
+    case O_PLANE: return ref_dot(v, q.n) < 0;
     default: {
-        ld a2 = ldot(q.n, q.n), s = ldot(v, q.n) / a2;
-        ld w[3] = {v[0] - q.n[0] * s, v[1] - q.n[1] * s, v[2] - q.n[2] * s};
-        return ldot(w, w) < q.r * q.r;
+        tld a2 = ref_dot(q.n, q.n), s = ref_dot(v, q.n) / a2;
+        tld w[3] = {v[0] - q.n[0] * s, v[1] - q.n[1] * s, v[2] - q.n[2] * s};
+        return ref_dot(w, w) < q.r * q.r;
     }
     }
 }
 
-bool rnode_in(const RTree &T, int k, const ld *x) {
-    const RNode &nd = T.nodes[k];
+bool ref_node_in(const RefTree &T, int k, const tld *x) {
+    const RefNode &nd = T.nodes[k];
     switch (nd.kind) {
     case O_ONE: return true;
     case O_NOTHING: return false;
     case O_UNION:
         for (size_t i = 0; i < nd.kids.size(); i++)
-            if (rnode_in(T, nd.kids[i], x)) return true;
+            if (ref_node_in(T, nd.kids[i], x)) return true;
         return false;
     case O_INTER:
         for (size_t i = 0; i < nd.kids.size(); i++)
-            if (!rnode_in(T, nd.kids[i], x)) return false;
+            if (!ref_node_in(T, nd.kids[i], x)) return false;
         return true;
     case O_DIFF:
-        if (!rnode_in(T, nd.kids[0], x)) return false;
+        if (!ref_node_in(T, nd.kids[0], x)) return false;
         for (size_t i = 1; i < nd.kids.size(); i++)
-            if (rnode_in(T, nd.kids[i], x)) return false;
+            if (ref_node_in(T, nd.kids[i], x)) return false;
         return true;
-    case O_COMPL: return !rnode_in(T, nd.kids[0], x);
-    default: return rprim_in(T.prims[nd.prim], x);
+    case O_COMPL: return !ref_node_in(T, nd.kids[0], x);
+    default: return ref_prim_in(T.prims[nd.prim], x);
     }
 }
 
 // Where the ray meets the primitive's surface (all real roots, any sign), computed on its own.
-void rprim_roots(const RPrim &q, const ld *o, const ld *d, std::vector<ld> &out) {
-    ld oc[3] = {o[0] - q.p[0], o[1] - q.p[1], o[2] - q.p[2]};
-    ld a, b, c;
+void ref_prim_roots(const RefPrim &q, const tld *o, const tld *d, std::vector<tld> &out) {
+    tld oc[3] = {o[0] - q.p[0], o[1] - q.p[1], o[2] - q.p[2]};
+    tld a, b, c;
     if (q.kind == O_PLANE) {
-        ld dn = ldot(d, q.n);
-        if (dn != 0) out.push_back(-ldot(oc, q.n) / dn);
+        tld dn = ref_dot(d, q.n);
+        if (dn != 0) out.push_back(-ref_dot(oc, q.n) / dn);
         return;
     }
     if (q.kind == O_SPHERE) {
-        a = ldot(d, d);
-        b = 2 * ldot(oc, d);
-        c = ldot(oc, oc) - q.r * q.r;
+        a = ref_dot(d, d);
+        b = 2 * ref_dot(oc, d);
+        c = ref_dot(oc, oc) - q.r * q.r;
     } else {
-        ld a2 = ldot(q.n, q.n);
-        ld so = ldot(oc, q.n) / a2, sd = ldot(d, q.n) / a2;
-        ld op[3] = {oc[0] - q.n[0] * so, oc[1] - q.n[1] * so, oc[2] - q.n[2] * so};
-        ld dp[3] = {d[0] - q.n[0] * sd, d[1] - q.n[1] * sd, d[2] - q.n[2] * sd};
-        a = ldot(dp, dp);
-        b = 2 * ldot(op, dp);
-        c = ldot(op, op) - q.r * q.r;
+        tld a2 = ref_dot(q.n, q.n);
+        tld so = ref_dot(oc, q.n) / a2, sd = ref_dot(d, q.n) / a2;
+        tld op[3] = {oc[0] - q.n[0] * so, oc[1] - q.n[1] * so, oc[2] - q.n[2] * so};
+        tld dp[3] = {d[0] - q.n[0] * sd, d[1] - q.n[1] * sd, d[2] - q.n[2] * sd};
+        a = ref_dot(dp, dp);
+        b = 2 * ref_dot(op, dp);
+        c = ref_dot(op, op) - q.r * q.r;
         if (a == 0) return;
     }
-    ld disc = b * b - 4 * a * c;
+    tld disc = b * b - 4 * a * c;
     if (disc < 0) return;
-    ld h = std::sqrt(disc);
+    tld h = std::sqrt(disc);
     out.push_back((-b - h) / (2 * a));
     out.push_back((-b + h) / (2 * a));
 }
 
-struct Change {
-    ld t;
+struct RefChange {
+    tld t;
     bool enter;  // the ray enters the solid there
 };
 
 // Membership changes of the whole solid along the ray, for t > 0: membership is sampled at a
 // fine regular lattice, at the midpoints between the primitives' own surface crossings and past
 // the last of them; every change between two samples is located by bisection.
-std::vector<Change> ref_changes(const RTree &T, const ld *o, const ld *d) {
-    std::vector<ld> roots;
-    for (size_t i = 0; i < T.prims.size(); i++) rprim_roots(T.prims[i], o, d, roots);
-    std::vector<ld> pos;
+std::vector<RefChange> ref_changes(const RefTree &T, const tld *o, const tld *d) {
+    std::vector<tld> roots;
+    for (size_t i = 0; i < T.prims.size(); i++) ref_prim_roots(T.prims[i], o, d, roots);
+    std::vector<tld> pos;
     for (size_t i = 0; i < roots.size(); i++)
         if (roots[i] > 0) pos.push_back(roots[i]);
     std::sort(pos.begin(), pos.end());
-    std::vector<ld> ts;
+    std::vector<tld> ts;
     ts.push_back(0);
     const int N = 1000;
-    const ld TMAX = 12;
+    const tld TMAX = 12;
     for (int i = 1; i <= N; i++) ts.push_back(TMAX * i / N);
     if (!pos.empty()) {
         ts.push_back(pos[0] / 2);
@@ -268,24 +268,24 @@ std::vector<Change> ref_changes(const RTree &T, const ld *o, const ld *d) {
     }
     std::sort(ts.begin(), ts.end());
     ts.erase(std::unique(ts.begin(), ts.end()), ts.end());
-    std::vector<Change> out;
-    ld x[3];
+    std::vector<RefChange> out;
+    tld x[3];
     std::vector<char> in(ts.size());
     for (size_t i = 0; i < ts.size(); i++) {
         for (int k = 0; k < 3; k++) x[k] = o[k] + ts[i] * d[k];
-        in[i] = rnode_in(T, T.root, x);
+        in[i] = ref_node_in(T, T.root, x);
     }
     for (size_t i = 0; i + 1 < ts.size(); i++) {
         if (in[i] == in[i + 1]) continue;
-        ld lo = ts[i], hi = ts[i + 1];
+        tld lo = ts[i], hi = ts[i + 1];
         for (int it = 0; it < 400; it++) {
-            ld mid = (lo + hi) / 2;
+            tld mid = (lo + hi) / 2;
             if (!(mid > lo && mid < hi)) break;
             for (int k = 0; k < 3; k++) x[k] = o[k] + mid * d[k];
-            if ((char)rnode_in(T, T.root, x) == in[i]) lo = mid;
+            if ((char)ref_node_in(T, T.root, x) == in[i]) lo = mid;
             else hi = mid;
         }
-        Change ch;
+        RefChange ch;
         ch.t = (lo + hi) / 2;
         ch.enter = in[i + 1] != 0;
         out.push_back(ch);
@@ -294,9 +294,9 @@ std::vector<Change> ref_changes(const RTree &T, const ld *o, const ld *d) {
 }
 
 // Deterministic random numbers, the same on every platform (splitmix64).
-struct Rng {
+struct TRng {
     uint64_t s;
-    explicit Rng(uint64_t seed) : s(seed) {}
+    explicit TRng(uint64_t seed) : s(seed) {}
     uint64_t next() {
         uint64_t z = (s += 0x9E3779B97F4A7C15ull);
         z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
@@ -322,24 +322,24 @@ struct Rng {
 };
 
 // A random tree built twice: as reference data and through the public API.
-struct TreeGen {
-    Rng &g;
-    RTree &T;
+struct TTreeGen {
+    TRng &g;
+    RefTree &T;
     pray_ctx *c;
     std::vector<pray_model *> mats;  // material of reference primitive i
 
     int leaf(pray_object **obj) {
-        RNode nd;
+        RefNode nd;
         nd.prim = -1;
         double u = g.u01();
         if (u < 0.03) {
             nd.kind = O_ONE;
-            *obj = pray_one(c, pray_color(c, trgb(-1, 0, 0)));
+            *obj = pray_one(c, pray_color(c, t_rgb(-1, 0, 0)));
         } else if (u < 0.06) {
             nd.kind = O_NOTHING;
             *obj = pray_nothing(c);
         } else {
-            RPrim q;
+            RefPrim q;
             double p[3], n[3];
             int k = g.below(3);
             for (int i = 0; i < 3; i++) p[i] = g.uni(-1, 1);
@@ -349,19 +349,19 @@ struct TreeGen {
                 q.p[i] = p[i];
                 q.n[i] = n[i] * len;
             }
-            pray_model *m = pray_color(c, trgb((double)T.prims.size(), 0, 0));
+            pray_model *m = pray_color(c, t_rgb((double)T.prims.size(), 0, 0));
             if (k == 0) {
                 q.kind = O_SPHERE;
                 q.r = g.uni(0.3, 1.0);
-                *obj = pray_sphere(c, m, tvec(p[0], p[1], p[2]), (double)q.r);
+                *obj = pray_sphere(c, m, t_vec(p[0], p[1], p[2]), (double)q.r);
             } else if (k == 1) {
                 q.kind = O_PLANE;
                 q.r = 0;
-                *obj = pray_plane(c, m, tvec(p[0], p[1], p[2]), tvec((double)q.n[0], (double)q.n[1], (double)q.n[2]));
+                *obj = pray_plane(c, m, t_vec(p[0], p[1], p[2]), t_vec((double)q.n[0], (double)q.n[1], (double)q.n[2]));
             } else {
                 q.kind = O_CYLINDER;
                 q.r = g.uni(0.2, 0.7);
-                *obj = pray_cylinder(c, m, tvec(p[0], p[1], p[2]), tvec((double)q.n[0], (double)q.n[1], (double)q.n[2]),
+                *obj = pray_cylinder(c, m, t_vec(p[0], p[1], p[2]), t_vec((double)q.n[0], (double)q.n[1], (double)q.n[2]),
                                      (double)q.r);
             }
             nd.kind = q.kind;
@@ -376,7 +376,7 @@ struct TreeGen {
     int gen(int depth, pray_object **obj, bool top = false) {
         if (depth == 0 || (!top && g.u01() < 0.3)) return leaf(obj);
         double u = g.u01();
-        RNode nd;
+        RefNode nd;
         nd.prim = -1;
         nd.kind = u < 0.4 ? O_UNION : u < 0.6 ? O_INTER : u < 0.9 ? O_DIFF : O_COMPL;
         int nk = nd.kind == O_COMPL ? 1 : 2 + g.below(3);
@@ -396,10 +396,10 @@ struct TreeGen {
 };
 
 // Compare the sweep with the reference on one ray; returns "" when they agree.
-std::string compare_ray(Built &B, const RTree &T, const std::vector<pray_model *> &mats, const double *o,
+std::string t_compare_ray(TScene &B, const RefTree &T, const std::vector<pray_model *> &mats, const double *o,
                         const double *d, int *nhits) {
-    ld lo[3] = {o[0], o[1], o[2]}, ldd[3] = {d[0], d[1], d[2]};
-    std::vector<Change> want = ref_changes(T, lo, ldd);
+    tld lo[3] = {o[0], o[1], o[2]}, ldd[3] = {d[0], d[1], d[2]};
+    std::vector<RefChange> want = ref_changes(T, lo, ldd);
     Ray r;
     r.o = r3((real)o[0], (real)o[1], (real)o[2]);
     r.d = r3((real)d[0], (real)d[1], (real)d[2]);
@@ -418,7 +418,7 @@ std::string compare_ray(Built &B, const RTree &T, const std::vector<pray_model *
     for (size_t i = 0; i < want.size(); i++) {
         const Hit &h = got[i];
         double tw = (double)want[i].t;
-        if (!close_t((double)h.t, tw)) {
+        if (!t_close((double)h.t, tw)) {
             snprintf(buf, sizeof buf, "hit %d: t %.17g, reference %.17g", (int)i, (double)h.t, tw);
             return buf;
         }
@@ -431,16 +431,16 @@ std::string compare_ray(Built &B, const RTree &T, const std::vector<pray_model *
         for (size_t k = 0; k < mats.size(); k++)
             if (mats[k] == m) id = (int)k;
         if (id < 0) return "hit on a primitive of unknown material";
-        ld x[3];
+        tld x[3];
         for (int k = 0; k < 3; k++) x[k] = lo[k] + want[i].t * ldd[k];
-        ld f = rprim_f(T.prims[id], x);
+        tld f = ref_prim_f(T.prims[id], x);
         if (std::fabs((double)f) > 1e-7) {
             snprintf(buf, sizeof buf, "hit %d at t %g: primitive %d's surface is %g away", (int)i, tw, id, (double)f);
             return buf;
         }
-        ld gr[3];
-        rprim_grad(T.prims[id], x, gr);
-        ld dd = ldot(gr, ldd) / std::sqrt(ldot(gr, gr));
+        tld gr[3];
+        ref_prim_grad(T.prims[id], x, gr);
+        tld dd = ref_dot(gr, ldd) / std::sqrt(ref_dot(gr, gr));
         if (std::fabs((double)dd) > 1e-6 && (h.prim_enter != 0) != (dd < 0)) {
             snprintf(buf, sizeof buf, "hit %d at t %g: prim_enter %d, but the ray goes %s primitive %d", (int)i, tw,
                      h.prim_enter, dd < 0 ? "into" : "out of", id);
@@ -456,153 +456,153 @@ std::string compare_ray(Built &B, const RTree &T, const std::vector<pray_model *
 // Ray/primitive intersection
 // =============================================================================================
 TEST_CASE("prim_span: sphere, exact roots") {
-    Ctx k;
-    pray_object *s = pray_sphere(k.c, k.mat(1), tvec(0, 0, 0), 2);
-    Span sp = span_of(k.c, s, tray(-5, 0, 0, 1, 0, 0));
+    TCtx k;
+    pray_object *s = pray_sphere(k.c, k.mat(1), t_vec(0, 0, 0), 2);
+    TSpan sp = t_span_of(k.c, s, t_ray(-5, 0, 0, 1, 0, 0));
     CHECK(sp.kind == SPAN);
     CHECK(sp.t0 == 3);
     CHECK(sp.t1 == 7);
 
-    pray_object *s2 = pray_sphere(k.c, k.mat(1), tvec(1, 2, 3), 1);
-    sp = span_of(k.c, s2, tray(1, 2, -2, 0, 0, 1));
+    pray_object *s2 = pray_sphere(k.c, k.mat(1), t_vec(1, 2, 3), 1);
+    sp = t_span_of(k.c, s2, t_ray(1, 2, -2, 0, 0, 1));
     CHECK(sp.kind == SPAN);
     CHECK(sp.t0 == 4);
     CHECK(sp.t1 == 6);
     // from the inside: the near root is behind the origin
-    sp = span_of(k.c, s2, tray(1, 2, 3, 0, -1, 0));
+    sp = t_span_of(k.c, s2, t_ray(1, 2, 3, 0, -1, 0));
     CHECK(sp.kind == SPAN);
     CHECK(sp.t0 == -1);
     CHECK(sp.t1 == 1);
     // pointing away: both roots behind
-    sp = span_of(k.c, s, tray(-5, 0, 0, -1, 0, 0));
+    sp = t_span_of(k.c, s, t_ray(-5, 0, 0, -1, 0, 0));
     CHECK((sp.kind == SPAN_NONE || (sp.kind == SPAN && sp.t1 < 0)));
     // a miss
-    sp = span_of(k.c, s, tray(-5, 2.5, 0, 1, 0, 0));
+    sp = t_span_of(k.c, s, t_ray(-5, 2.5, 0, 1, 0, 0));
     CHECK(sp.kind == SPAN_NONE);
     // an oblique ray through the centre: roots at distance +-r from the centre
-    sp = span_of(k.c, s, tray(-3, -4, 0, 3, 4, 0));
+    sp = t_span_of(k.c, s, t_ray(-3, -4, 0, 3, 4, 0));
     CHECK(sp.kind == SPAN);
-    CHECK(close_t(sp.t0, 3));
-    CHECK(close_t(sp.t1, 7));
+    CHECK(t_close(sp.t0, 3));
+    CHECK(t_close(sp.t1, 7));
 }
 
 TEST_CASE("prim_span: half-space, both normal orientations and parallel rays") {
-    Ctx k;
+    TCtx k;
     // z <= 1
-    pray_object *up = pray_plane(k.c, k.mat(1), tvec(0, 0, 1), tvec(0, 0, 1));
+    pray_object *up = pray_plane(k.c, k.mat(1), t_vec(0, 0, 1), t_vec(0, 0, 1));
     // z >= 1 (outward normal -Z, given with length 3: only the direction matters)
-    pray_object *down = pray_plane(k.c, k.mat(1), tvec(7, -2, 1), tvec(0, 0, -3));
+    pray_object *down = pray_plane(k.c, k.mat(1), t_vec(7, -2, 1), t_vec(0, 0, -3));
 
-    Span sp = span_of(k.c, up, tray(0, 0, 5, 0, 0, -1));  // from outside, going in
+    TSpan sp = t_span_of(k.c, up, t_ray(0, 0, 5, 0, 0, -1));  // from outside, going in
     CHECK(sp.kind == SPAN);
     CHECK(sp.t0 == 4);
     CHECK(std::isinf((double)sp.t1));
     CHECK(sp.t1 > 0);
-    sp = span_of(k.c, up, tray(0, 0, -3, 0, 0, 1));  // from inside, going out
+    sp = t_span_of(k.c, up, t_ray(0, 0, -3, 0, 0, 1));  // from inside, going out
     CHECK(sp.kind == SPAN);
     CHECK(sp.t1 == 4);
     CHECK(std::isinf((double)sp.t0));
     CHECK(sp.t0 < 0);
 
-    sp = span_of(k.c, down, tray(0, 0, 5, 0, 0, -1));  // from inside z >= 1, going out at z = 1
+    sp = t_span_of(k.c, down, t_ray(0, 0, 5, 0, 0, -1));  // from inside z >= 1, going out at z = 1
     CHECK(sp.kind == SPAN);
     CHECK(sp.t1 == 4);
     CHECK(sp.t0 < 0);
-    sp = span_of(k.c, down, tray(3, 3, -3, 0, 0, 1));  // from outside, going in
+    sp = t_span_of(k.c, down, t_ray(3, 3, -3, 0, 0, 1));  // from outside, going in
     CHECK(sp.kind == SPAN);
     CHECK(sp.t0 == 4);
     CHECK(sp.t1 > 1e300);
 
     // parallel to the plane: inside is all of the ray, outside none of it
-    sp = span_of(k.c, up, tray(0, 0, 0, 1, 0, 0));
+    sp = t_span_of(k.c, up, t_ray(0, 0, 0, 1, 0, 0));
     CHECK(sp.kind == SPAN_ALL);
-    sp = span_of(k.c, up, tray(0, 0, 2, 0, 1, 0));
+    sp = t_span_of(k.c, up, t_ray(0, 0, 2, 0, 1, 0));
     CHECK(sp.kind == SPAN_NONE);
-    sp = span_of(k.c, down, tray(0, 0, 0, 1, 0, 0));
+    sp = t_span_of(k.c, down, t_ray(0, 0, 0, 1, 0, 0));
     CHECK(sp.kind == SPAN_NONE);
-    sp = span_of(k.c, down, tray(0, 0, 2, 0, 1, 0));
+    sp = t_span_of(k.c, down, t_ray(0, 0, 2, 0, 1, 0));
     CHECK(sp.kind == SPAN_ALL);
 
     // oblique: x + y <= 1, ray along X from the origin meets it at t = 1
-    pray_object *ob = pray_plane(k.c, k.mat(1), tvec(1, 0, 0), tvec(1, 1, 0));
-    sp = span_of(k.c, ob, tray(0, 0, 0, 1, 0, 0));
+    pray_object *ob = pray_plane(k.c, k.mat(1), t_vec(1, 0, 0), t_vec(1, 1, 0));
+    sp = t_span_of(k.c, ob, t_ray(0, 0, 0, 1, 0, 0));
     CHECK(sp.kind == SPAN);
-    CHECK(close_t(sp.t1, 1));
+    CHECK(t_close(sp.t1, 1));
     CHECK(sp.t0 < 0);
 }
 
 TEST_CASE("prim_span: infinite cylinder") {
-    Ctx k;
+    TCtx k;
     // axis Z through the origin, radius 1; axis given with length 2
-    pray_object *cy = pray_cylinder(k.c, k.mat(1), tvec(0, 0, 0), tvec(0, 0, 2), 1);
-    Span sp = span_of(k.c, cy, tray(-3, 0, 5, 1, 0, 0));
+    pray_object *cy = pray_cylinder(k.c, k.mat(1), t_vec(0, 0, 0), t_vec(0, 0, 2), 1);
+    TSpan sp = t_span_of(k.c, cy, t_ray(-3, 0, 5, 1, 0, 0));
     CHECK(sp.kind == SPAN);
     CHECK(sp.t0 == 2);
     CHECK(sp.t1 == 4);
     // parallel to the axis: inside all of it, outside none of it
-    sp = span_of(k.c, cy, tray(0.5, 0.25, -7, 0, 0, 1));
+    sp = t_span_of(k.c, cy, t_ray(0.5, 0.25, -7, 0, 0, 1));
     CHECK(sp.kind == SPAN_ALL);
-    sp = span_of(k.c, cy, tray(0.5, 0.25, -7, 0, 0, -1));
+    sp = t_span_of(k.c, cy, t_ray(0.5, 0.25, -7, 0, 0, -1));
     CHECK(sp.kind == SPAN_ALL);
-    sp = span_of(k.c, cy, tray(2, 0, 0, 0, 0, 1));
+    sp = t_span_of(k.c, cy, t_ray(2, 0, 0, 0, 0, 1));
     CHECK(sp.kind == SPAN_NONE);
     // oblique, at 45 degrees to the axis: the chord is sqrt(2) times longer
-    sp = span_of(k.c, cy, tray(-3, 0, 0, 1, 0, 1));
+    sp = t_span_of(k.c, cy, t_ray(-3, 0, 0, 1, 0, 1));
     CHECK(sp.kind == SPAN);
-    CHECK(close_t(sp.t0, 2 * std::sqrt(2.0)));
-    CHECK(close_t(sp.t1, 4 * std::sqrt(2.0)));
+    CHECK(t_close(sp.t0, 2 * std::sqrt(2.0)));
+    CHECK(t_close(sp.t1, 4 * std::sqrt(2.0)));
     // an oblique miss
-    sp = span_of(k.c, cy, tray(-3, 1.5, 0, 1, 0, 1));
+    sp = t_span_of(k.c, cy, t_ray(-3, 1.5, 0, 1, 0, 1));
     CHECK(sp.kind == SPAN_NONE);
     // a cylinder with a slanted axis through (1, 2, 3): a ray perpendicular to the axis through it
-    pray_object *sl = pray_cylinder(k.c, k.mat(1), tvec(1, 2, 3), tvec(1, 1, 0), 0.5);
-    sp = span_of(k.c, sl, tray(1 - 5, 2 + 5, 3, 1, -1, 0));
+    pray_object *sl = pray_cylinder(k.c, k.mat(1), t_vec(1, 2, 3), t_vec(1, 1, 0), 0.5);
+    sp = t_span_of(k.c, sl, t_ray(1 - 5, 2 + 5, 3, 1, -1, 0));
     CHECK(sp.kind == SPAN);
-    CHECK(close_t(sp.t0, 5 * std::sqrt(2.0) - 0.5));
-    CHECK(close_t(sp.t1, 5 * std::sqrt(2.0) + 0.5));
+    CHECK(t_close(sp.t0, 5 * std::sqrt(2.0) - 0.5));
+    CHECK(t_close(sp.t1, 5 * std::sqrt(2.0) + 0.5));
 }
 
 TEST_CASE("prim_span: the self-primitive rule") {
-    Ctx k;
-    pray_object *s = pray_sphere(k.c, k.mat(1), tvec(0, 0, 0), 1);
+    TCtx k;
+    pray_object *s = pray_sphere(k.c, k.mat(1), t_vec(0, 0, 0), 1);
     // starting on the surface, going in: [0, far root]
-    Span sp = span_of(k.c, s, tray(1, 0, 0, -1, 0, 0), true);
+    TSpan sp = t_span_of(k.c, s, t_ray(1, 0, 0, -1, 0, 0), true);
     CHECK(sp.kind == SPAN);
     CHECK(sp.t0 == 0);
     CHECK(sp.t1 == 2);
     // going out: nothing
-    sp = span_of(k.c, s, tray(1, 0, 0, 1, 0, 0), true);
+    sp = t_span_of(k.c, s, t_ray(1, 0, 0, 1, 0, 0), true);
     CHECK(sp.kind == SPAN_NONE);
-    sp = span_of(k.c, s, tray(0, 0, 1, 0.6, 0, 0.8), true);
+    sp = t_span_of(k.c, s, t_ray(0, 0, 1, 0.6, 0, 0.8), true);
     CHECK(sp.kind == SPAN_NONE);
 
-    pray_object *pl = pray_plane(k.c, k.mat(1), tvec(0, 0, 0), tvec(0, 0, 1));
-    sp = span_of(k.c, pl, tray(0.3, 0.1, 0, 0, 0.6, -0.8), true);
+    pray_object *pl = pray_plane(k.c, k.mat(1), t_vec(0, 0, 0), t_vec(0, 0, 1));
+    sp = t_span_of(k.c, pl, t_ray(0.3, 0.1, 0, 0, 0.6, -0.8), true);
     CHECK(sp.kind == SPAN);
     CHECK(sp.t0 == 0);
     CHECK(sp.t1 > 1e300);
-    sp = span_of(k.c, pl, tray(0.3, 0.1, 0, 0, 0.6, 0.8), true);
+    sp = t_span_of(k.c, pl, t_ray(0.3, 0.1, 0, 0, 0.6, 0.8), true);
     CHECK(sp.kind == SPAN_NONE);
 
-    pray_object *cy = pray_cylinder(k.c, k.mat(1), tvec(0, 0, 0), tvec(0, 0, 1), 1);
-    sp = span_of(k.c, cy, tray(-1, 0, 4, 1, 0, 0), true);
+    pray_object *cy = pray_cylinder(k.c, k.mat(1), t_vec(0, 0, 0), t_vec(0, 0, 1), 1);
+    sp = t_span_of(k.c, cy, t_ray(-1, 0, 4, 1, 0, 0), true);
     CHECK(sp.kind == SPAN);
     CHECK(sp.t0 == 0);
     CHECK(sp.t1 == 2);
-    sp = span_of(k.c, cy, tray(-1, 0, 4, -1, 0, 0), true);
+    sp = t_span_of(k.c, cy, t_ray(-1, 0, 4, -1, 0, 0), true);
     CHECK(sp.kind == SPAN_NONE);
 }
 
 TEST_CASE("sweep: rays leaving a sphere's surface (self) on random points, also where rounding misplaces them") {
-    Ctx k;
+    TCtx k;
     const double C[3] = {0.3, 0.7, -0.2}, R = 0.9;
-    pray_object *s = pray_sphere(k.c, k.mat(1), tvec(C[0], C[1], C[2]), R);
-    pray_object *other = pray_sphere(k.c, k.mat(2), tvec(5, 5, 5), 0.5);  // far away, never hit
-    Built B(k.c, pray_csg(k.c, PRAY_UNION, s, other));
+    pray_object *s = pray_sphere(k.c, k.mat(1), t_vec(C[0], C[1], C[2]), R);
+    pray_object *other = pray_sphere(k.c, k.mat(2), t_vec(5, 5, 5), 0.5);  // far away, never hit
+    TScene B(k.c, pray_csg(k.c, PRAY_UNION, s, other));
     REQUIRE(B.ok);
     int self = B.prim_of(s->mat);
     REQUIRE(self >= 0);
-    Rng g(7);
+    TRng g(7);
     int bad_in = 0, bad_out = 0;
     for (int i = 0; i < 300; i++) {
         double n[3], d[3];
@@ -611,11 +611,11 @@ TEST_CASE("sweep: rays leaving a sphere's surface (self) on random points, also 
         g.dir(d);
         double dn = d[0] * n[0] + d[1] * n[1] + d[2] * n[2];
         if (std::fabs(dn) < 0.05) continue;
-        Ray r = tray(o[0], o[1], o[2], d[0], d[1], d[2]);
+        Ray r = t_ray(o[0], o[1], o[2], d[0], d[1], d[2]);
         std::vector<Hit> h = B.hits(r, self);
         if (dn < 0) {
             // inward: exactly one hit, leaving the sphere at the far root, chord 2 R |d.n|
-            if (h.size() != 1 || !close_t((double)h[0].t, -2 * R * dn) || h[0].root_enter || h[0].prim != self) bad_in++;
+            if (h.size() != 1 || !t_close((double)h[0].t, -2 * R * dn) || h[0].root_enter || h[0].prim != self) bad_in++;
         } else if (!h.empty()) {
             bad_out++;  // outward: nothing at all
         }
@@ -625,10 +625,10 @@ TEST_CASE("sweep: rays leaving a sphere's surface (self) on random points, also 
 }
 
 TEST_CASE("sweep: tmax bounds the hits (shadow rays)") {
-    Ctx k;
-    Built B(k.c, pray_sphere(k.c, k.mat(1), tvec(0, 0, 0), 2));
+    TCtx k;
+    TScene B(k.c, pray_sphere(k.c, k.mat(1), t_vec(0, 0, 0), 2));
     REQUIRE(B.ok);
-    Ray r = tray(-5, 0, 0, 1, 0, 0);
+    Ray r = t_ray(-5, 0, 0, 1, 0, 0);
     CHECK(B.hits(r, -1, 2).empty());
     std::vector<Hit> h = B.hits(r, -1, 5);
     REQUIRE(h.size() == 1);
@@ -647,17 +647,17 @@ TEST_CASE("sweep: tmax bounds the hits (shadow rays)") {
 // CSG semantics of the status-tree sweep
 // =============================================================================================
 TEST_CASE("sweep agrees with direct set membership on random CSG trees (fixed seeds)") {
-    Ctx k;
+    TCtx k;
     int rays = 0, rays_with_hits = 0, total_hits = 0, failures = 0, trees_with_nodes = 0;
     std::string first_failure;
     for (uint64_t seed = 1; seed <= 100; seed++) {
-        Rng g(seed * 1000003ull);
-        RTree T;
-        TreeGen gen = {g, T, k.c, std::vector<pray_model *>()};
+        TRng g(seed * 1000003ull);
+        RefTree T;
+        TTreeGen gen = {g, T, k.c, std::vector<pray_model *>()};
         pray_object *obj = NULL;
         T.root = gen.gen(3, &obj, true);
         REQUIRE(obj != NULL);
-        Built B(k.c, obj);
+        TScene B(k.c, obj);
         REQUIRE(B.ok);
         if (B.s.nodes.n > 0) trees_with_nodes++;
         if (getenv("PRAY_TEST_VERBOSE")) printf("seed %d: root %d, %d prims, %d nodes\n", (int)seed, B.s.root, B.s.prims.n, B.s.nodes.n);
@@ -680,7 +680,7 @@ TEST_CASE("sweep agrees with direct set membership on random CSG trees (fixed se
                 g.dir(d);
             }
             int nh = 0;
-            std::string why = compare_ray(B, T, gen.mats, o, d, &nh);
+            std::string why = t_compare_ray(B, T, gen.mats, o, d, &nh);
             rays++;
             total_hits += nh;
             if (nh > 0) rays_with_hits++;
@@ -700,44 +700,44 @@ TEST_CASE("sweep agrees with direct set membership on random CSG trees (fixed se
 
 // Cube [-1, 1]^3 minus the box [0, 1] x [-0.5, 0.5]^2: the box's face x = 1 lies in the cube's
 // face x = 1; the two planes are given by different points of that plane.
-struct Notch {
+struct TNotch {
     pray_model *cm, *inner, *shared, *bm;
     pray_object *obj;
-    Notch(Ctx &k, pray_vec cube_pt, pray_vec box_pt) {
+    TNotch(TCtx &k, pray_vec cube_pt, pray_vec box_pt) {
         cm = k.mat(1);
         inner = k.mat(2);
         shared = k.mat(3);
         bm = k.mat(4);
         pray_ctx *c = k.c;
-        pray_object *cube = pray_plane(c, cm, cube_pt, tvec(1, 0, 0));
-        cube = pray_csg(c, PRAY_INTERSECTION, cube, pray_plane(c, cm, tvec(-1, 0, 0), tvec(-1, 0, 0)));
-        cube = pray_csg(c, PRAY_INTERSECTION, cube, pray_plane(c, cm, tvec(0, 1, 0), tvec(0, 1, 0)));
-        cube = pray_csg(c, PRAY_INTERSECTION, cube, pray_plane(c, cm, tvec(0, -1, 0), tvec(0, -1, 0)));
-        cube = pray_csg(c, PRAY_INTERSECTION, cube, pray_plane(c, cm, tvec(0, 0, 1), tvec(0, 0, 1)));
-        cube = pray_csg(c, PRAY_INTERSECTION, cube, pray_plane(c, cm, tvec(0, 0, -1), tvec(0, 0, -1)));
-        pray_object *box = pray_plane(c, shared, box_pt, tvec(1, 0, 0));
-        box = pray_csg(c, PRAY_INTERSECTION, box, pray_plane(c, inner, tvec(0, 0, 0), tvec(-1, 0, 0)));
-        box = pray_csg(c, PRAY_INTERSECTION, box, pray_plane(c, bm, tvec(0, 0.5, 0), tvec(0, 1, 0)));
-        box = pray_csg(c, PRAY_INTERSECTION, box, pray_plane(c, bm, tvec(0, -0.5, 0), tvec(0, -1, 0)));
-        box = pray_csg(c, PRAY_INTERSECTION, box, pray_plane(c, bm, tvec(0, 0, 0.5), tvec(0, 0, 1)));
-        box = pray_csg(c, PRAY_INTERSECTION, box, pray_plane(c, bm, tvec(0, 0, -0.5), tvec(0, 0, -1)));
+        pray_object *cube = pray_plane(c, cm, cube_pt, t_vec(1, 0, 0));
+        cube = pray_csg(c, PRAY_INTERSECTION, cube, pray_plane(c, cm, t_vec(-1, 0, 0), t_vec(-1, 0, 0)));
+        cube = pray_csg(c, PRAY_INTERSECTION, cube, pray_plane(c, cm, t_vec(0, 1, 0), t_vec(0, 1, 0)));
+        cube = pray_csg(c, PRAY_INTERSECTION, cube, pray_plane(c, cm, t_vec(0, -1, 0), t_vec(0, -1, 0)));
+        cube = pray_csg(c, PRAY_INTERSECTION, cube, pray_plane(c, cm, t_vec(0, 0, 1), t_vec(0, 0, 1)));
+        cube = pray_csg(c, PRAY_INTERSECTION, cube, pray_plane(c, cm, t_vec(0, 0, -1), t_vec(0, 0, -1)));
+        pray_object *box = pray_plane(c, shared, box_pt, t_vec(1, 0, 0));
+        box = pray_csg(c, PRAY_INTERSECTION, box, pray_plane(c, inner, t_vec(0, 0, 0), t_vec(-1, 0, 0)));
+        box = pray_csg(c, PRAY_INTERSECTION, box, pray_plane(c, bm, t_vec(0, 0.5, 0), t_vec(0, 1, 0)));
+        box = pray_csg(c, PRAY_INTERSECTION, box, pray_plane(c, bm, t_vec(0, -0.5, 0), t_vec(0, -1, 0)));
+        box = pray_csg(c, PRAY_INTERSECTION, box, pray_plane(c, bm, t_vec(0, 0, 0.5), t_vec(0, 0, 1)));
+        box = pray_csg(c, PRAY_INTERSECTION, box, pray_plane(c, bm, t_vec(0, 0, -0.5), t_vec(0, 0, -1)));
         obj = pray_csg(c, PRAY_DIFFERENCE, cube, box);
     }
 };
 
 TEST_CASE("difference: a face shared with the subtracted box is not visible") {
-    Ctx k;
+    TCtx k;
     SUBCASE("axis-aligned") {
-        Notch N(k, tvec(1, 0, 0), tvec(1, 0.3, -0.2));
-        Built B(k.c, N.obj);
+        TNotch N(k, t_vec(1, 0, 0), t_vec(1, 0.3, -0.2));
+        TScene B(k.c, N.obj);
         REQUIRE(B.ok);
-        Rng g(11);
+        TRng g(11);
         int wrong = 0;
         for (int i = 0; i < 200; i++) {
             double y = g.uni(-0.45, 0.45), z = g.uni(-0.45, 0.45);
             double dy = g.uni(-0.05, 0.05), dz = g.uni(-0.05, 0.05);
             // from x = 5 towards -X, passing x = 1 within the box's face
-            Ray r = tray(5, y - 4 * dy, z - 4 * dz, -1, dy, dz);
+            Ray r = t_ray(5, y - 4 * dy, z - 4 * dz, -1, dy, dz);
             FirstHit f = B.first(r);
             if (!f.found || B.s.prims[f.h.prim].mat != N.inner || !f.h.root_enter) wrong++;
             else {
@@ -747,7 +747,7 @@ TEST_CASE("difference: a face shared with the subtracted box is not visible") {
         }
         CHECK(wrong == 0);
         // straight along -X: the first visible surface is the box's inner face at t = 5
-        FirstHit f = B.first(tray(5, 0.1, 0.2, -1, 0, 0));
+        FirstHit f = B.first(t_ray(5, 0.1, 0.2, -1, 0, 0));
         REQUIRE(f.found);
         CHECK(f.h.t == 5);
         CHECK(B.s.prims[f.h.prim].mat == N.inner);
@@ -759,20 +759,20 @@ TEST_CASE("difference: a face shared with the subtracted box is not visible") {
         int shared_hits = 0, wrong = 0, rays = 0;
         for (int swap = 0; swap < 2; swap++)
             for (int ri = 0; ri < 4; ri++) {
-                pray_vec p1 = tvec(1, 0, 0), p2 = tvec(1, 0.3, -0.2);
-                Notch N(k, swap ? p2 : p1, swap ? p1 : p2);
-                pray_vec rot = tvec(rots[ri][0], rots[ri][1], rots[ri][2]);
-                pray_vec mv = tvec(0.3, -1.7, 2.9);
-                Built B(k.c, pray_translate(k.c, pray_rotate(k.c, N.obj, rot), mv));
+                pray_vec p1 = t_vec(1, 0, 0), p2 = t_vec(1, 0.3, -0.2);
+                TNotch N(k, swap ? p2 : p1, swap ? p1 : p2);
+                pray_vec rot = t_vec(rots[ri][0], rots[ri][1], rots[ri][2]);
+                pray_vec mv = t_vec(0.3, -1.7, 2.9);
+                TScene B(k.c, pray_translate(k.c, pray_rotate(k.c, N.obj, rot), mv));
                 REQUIRE(B.ok);
                 Xform f = xf_rotate(rot);
-                Rng g(12 + ri);
+                TRng g(12 + ri);
                 for (int i = 0; i < 100; i++) {
                     double y = g.uni(-0.45, 0.45), z = g.uni(-0.45, 0.45);
                     double dy = g.uni(-0.05, 0.05), dz = g.uni(-0.05, 0.05);
-                    pray_vec o = vadd(xf_point(f, tvec(5, y - 4 * dy, z - 4 * dz)), mv);
-                    pray_vec d = xf_dir(f, tvec(-1, dy, dz));
-                    Ray r = tray(o.x, o.y, o.z, d.x, d.y, d.z);
+                    pray_vec o = vadd(xf_point(f, t_vec(5, y - 4 * dy, z - 4 * dz)), mv);
+                    pray_vec d = xf_dir(f, t_vec(-1, dy, dz));
+                    Ray r = t_ray(o.x, o.y, o.z, d.x, d.y, d.z);
                     FirstHit fh = B.first(r);
                     rays++;
                     if (!fh.found) wrong++;
@@ -788,28 +788,28 @@ TEST_CASE("difference: a face shared with the subtracted box is not visible") {
 }
 
 TEST_CASE("difference: a solid minus itself is empty") {
-    Ctx k;
-    pray_object *s = pray_sphere(k.c, k.mat(1), tvec(0.1, 0.2, 0.3), 1);
-    Built B(k.c, pray_csg(k.c, PRAY_DIFFERENCE, s, s));
+    TCtx k;
+    pray_object *s = pray_sphere(k.c, k.mat(1), t_vec(0.1, 0.2, 0.3), 1);
+    TScene B(k.c, pray_csg(k.c, PRAY_DIFFERENCE, s, s));
     REQUIRE(B.ok);
-    Rng g(3);
+    TRng g(3);
     int hits = 0;
     for (int i = 0; i < 100; i++) {
         double d[3];
         g.dir(d);
-        hits += (int)B.hits(tray(-3 * d[0], -3 * d[1], -3 * d[2], d[0], d[1], d[2])).size();
+        hits += (int)B.hits(t_ray(-3 * d[0], -3 * d[1], -3 * d[2], d[0], d[1], d[2])).size();
     }
     CHECK(hits == 0);
 }
 
 TEST_CASE("complement: seen from outside the sphere and from inside it") {
-    Ctx k;
+    TCtx k;
     pray_model *m = k.mat(1);
-    pray_object *s = pray_sphere(k.c, m, tvec(0, 0, 0), 1);
-    Built B(k.c, pray_complement(k.c, s));
+    pray_object *s = pray_sphere(k.c, m, t_vec(0, 0, 0), 1);
+    TScene B(k.c, pray_complement(k.c, s));
     REQUIRE(B.ok);
     // the camera is in the complement: nothing until the sphere, where the ray leaves the solid
-    std::vector<Hit> h = B.hits(tray(0, -4, 0, 0, 1, 0));
+    std::vector<Hit> h = B.hits(t_ray(0, -4, 0, 0, 1, 0));
     REQUIRE(h.size() == 2);
     CHECK(h[0].t == 3);
     CHECK(h[0].root_enter == 0);
@@ -818,21 +818,21 @@ TEST_CASE("complement: seen from outside the sphere and from inside it") {
     CHECK(h[1].t == 5);
     CHECK(h[1].root_enter == 1);
     // from inside the sphere (outside the complement): the ray enters the complement at t = 1
-    FirstHit f = B.first(tray(0, 0, 0, 0.6, 0, 0.8));
+    FirstHit f = B.first(t_ray(0, 0, 0, 0.6, 0, 0.8));
     REQUIRE(f.found);
-    CHECK(close_t((double)f.h.t, 1));
+    CHECK(t_close((double)f.h.t, 1));
     CHECK(f.h.root_enter == 1);
     // a ray that misses the sphere stays inside the complement: no surface at all
-    CHECK(B.hits(tray(0, -4, 1.5, 0, 1, 0)).empty());
+    CHECK(B.hits(t_ray(0, -4, 1.5, 0, 1, 0)).empty());
     // --S is S
-    Built B2(k.c, pray_complement(k.c, pray_complement(k.c, s)));
-    h = B2.hits(tray(0, -4, 0, 0, 1, 0));
+    TScene B2(k.c, pray_complement(k.c, pray_complement(k.c, s)));
+    h = B2.hits(t_ray(0, -4, 0, 0, 1, 0));
     REQUIRE(h.size() == 2);
     CHECK(h[0].root_enter == 1);
     // A & -B is A - B
-    pray_object *a = pray_sphere(k.c, k.mat(2), tvec(-0.5, 0, 0), 1);
-    Built B3(k.c, pray_csg(k.c, PRAY_INTERSECTION, a, pray_complement(k.c, s)));
-    h = B3.hits(tray(-5, 0, 0, 1, 0, 0));
+    pray_object *a = pray_sphere(k.c, k.mat(2), t_vec(-0.5, 0, 0), 1);
+    TScene B3(k.c, pray_csg(k.c, PRAY_INTERSECTION, a, pray_complement(k.c, s)));
+    h = B3.hits(t_ray(-5, 0, 0, 1, 0, 0));
     REQUIRE(h.size() == 2);
     CHECK(h[0].t == 3.5);
     CHECK(h[1].t == 4);
@@ -841,20 +841,20 @@ TEST_CASE("complement: seen from outside the sphere and from inside it") {
 }
 
 TEST_CASE("n-ary difference chains") {
-    Ctx k;
+    TCtx k;
     pray_model *big = k.mat(1), *h1 = k.mat(2), *h2 = k.mat(3), *h3 = k.mat(4);
-    pray_object *A = pray_sphere(k.c, big, tvec(0, 0, 0), 2);
-    pray_object *B1 = pray_sphere(k.c, h1, tvec(-1, 0, 0), 0.25);
-    pray_object *B2 = pray_sphere(k.c, h2, tvec(0, 0, 0), 0.5);
-    pray_object *B3 = pray_sphere(k.c, h3, tvec(1, 0, 0), 0.25);
+    pray_object *A = pray_sphere(k.c, big, t_vec(0, 0, 0), 2);
+    pray_object *B1 = pray_sphere(k.c, h1, t_vec(-1, 0, 0), 0.25);
+    pray_object *B2 = pray_sphere(k.c, h2, t_vec(0, 0, 0), 0.5);
+    pray_object *B3 = pray_sphere(k.c, h3, t_vec(1, 0, 0), 0.25);
     pray_object *chain = pray_csg(k.c, PRAY_DIFFERENCE, pray_csg(k.c, PRAY_DIFFERENCE, pray_csg(k.c, PRAY_DIFFERENCE, A, B1), B2), B3);
-    Built B(k.c, chain);
+    TScene B(k.c, chain);
     REQUIRE(B.ok);
     // one node with four children: ((A \ B1) \ B2) \ B3
     CHECK(B.s.nodes.n == 1);
     CHECK(B.s.nodes[0].op == O_DIFF);
     CHECK(B.s.nodes[0].n == 4);
-    std::vector<Hit> h = B.hits(tray(-5, 0, 0, 1, 0, 0));
+    std::vector<Hit> h = B.hits(t_ray(-5, 0, 0, 1, 0, 0));
     const double want_t[] = {3, 3.75, 4.25, 4.5, 5.5, 5.75, 6.25, 7};
     const pray_model *want_m[] = {big, h1, h1, h2, h2, h3, h3, big};
     REQUIRE(h.size() == 8);
@@ -865,20 +865,20 @@ TEST_CASE("n-ary difference chains") {
         CHECK(B.s.prims[h[i].prim].mat == want_m[i]);
     }
     // A \ (B2 \ B') is not ((A \ B2) \ B'): the inner difference gives back the core of B2
-    pray_object *core = pray_sphere(k.c, k.mat(5), tvec(0, 0, 0), 0.25);
-    Built N(k.c, pray_csg(k.c, PRAY_DIFFERENCE, A, pray_csg(k.c, PRAY_DIFFERENCE, B2, core)));
+    pray_object *core = pray_sphere(k.c, k.mat(5), t_vec(0, 0, 0), 0.25);
+    TScene N(k.c, pray_csg(k.c, PRAY_DIFFERENCE, A, pray_csg(k.c, PRAY_DIFFERENCE, B2, core)));
     REQUIRE(N.ok);
-    h = N.hits(tray(-5, 0, 0, 1, 0, 0));
+    h = N.hits(t_ray(-5, 0, 0, 1, 0, 0));
     const double want_n[] = {3, 4.5, 4.75, 5.25, 5.5, 7};
     REQUIRE(h.size() == 6);
     for (int i = 0; i < 6; i++) CHECK(h[i].t == want_n[i]);
 }
 
 TEST_CASE("a union grown in a loop is one node") {
-    Ctx k;
+    TCtx k;
     pray_object *all = pray_nothing(k.c);
     for (int i = 0; i < 1024; i++) {
-        pray_object *s = pray_sphere(k.c, k.mat(i), tvec(i, 0, 0), 0.25);
+        pray_object *s = pray_sphere(k.c, k.mat(i), t_vec(i, 0, 0), 0.25);
         pray_object *n = pray_csg(k.c, PRAY_UNION, all, s);
         pray_release(k.c, all);
         pray_release(k.c, s);
@@ -886,54 +886,54 @@ TEST_CASE("a union grown in a loop is one node") {
     }
     REQUIRE(all != NULL);
     CHECK(pray_object_primitives(all) == 1024);
-    Built B(k.c, all);
+    TScene B(k.c, all);
     REQUIRE(B.ok);
     CHECK(B.s.nodes.n == 1);
     CHECK(B.s.nodes[0].n == 1024);
     CHECK(B.s.prims.n == 1024);
-    std::vector<Hit> h = B.hits(tray(-1, 0, 0, 1, 0, 0));
+    std::vector<Hit> h = B.hits(t_ray(-1, 0, 0, 1, 0, 0));
     CHECK(h.size() == 2048);
 }
 
 TEST_CASE("tangent rays produce no hit") {
-    Ctx k;
+    TCtx k;
     SUBCASE("sphere") {
-        Built B(k.c, pray_sphere(k.c, k.mat(1), tvec(0, 0, 0), 1));
-        CHECK(B.hits(tray(-5, 1, 0, 1, 0, 0)).empty());
-        CHECK(B.hits(tray(-5, 0, -1, 1, 0, 0)).empty());
+        TScene B(k.c, pray_sphere(k.c, k.mat(1), t_vec(0, 0, 0), 1));
+        CHECK(B.hits(t_ray(-5, 1, 0, 1, 0, 0)).empty());
+        CHECK(B.hits(t_ray(-5, 0, -1, 1, 0, 0)).empty());
     }
     SUBCASE("cylinder") {
-        Built B(k.c, pray_cylinder(k.c, k.mat(1), tvec(0, 0, 0), tvec(0, 0, 1), 1));
-        CHECK(B.hits(tray(-5, 1, 3, 1, 0, 0)).empty());
-        CHECK(B.hits(tray(-5, -1, 3, 1, 0, 0)).empty());
+        TScene B(k.c, pray_cylinder(k.c, k.mat(1), t_vec(0, 0, 0), t_vec(0, 0, 1), 1));
+        CHECK(B.hits(t_ray(-5, 1, 3, 1, 0, 0)).empty());
+        CHECK(B.hits(t_ray(-5, -1, 3, 1, 0, 0)).empty());
     }
     SUBCASE("a ray lying in a half-space's boundary plane") {
-        Built B(k.c, pray_plane(k.c, k.mat(1), tvec(0, 0, 1), tvec(0, 0, 1)));
-        CHECK(B.hits(tray(-5, 0, 1, 1, 0.5, 0)).empty());
+        TScene B(k.c, pray_plane(k.c, k.mat(1), t_vec(0, 0, 1), t_vec(0, 0, 1)));
+        CHECK(B.hits(t_ray(-5, 0, 1, 1, 0.5, 0)).empty());
     }
     SUBCASE("a ray gliding along a face and along an edge of a cube") {
         pray_model *m = k.mat(1);
-        pray_object *c = pray_plane(k.c, m, tvec(1, 0, 0), tvec(1, 0, 0));
-        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, tvec(-1, 0, 0), tvec(-1, 0, 0)));
-        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, tvec(0, 1, 0), tvec(0, 1, 0)));
-        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, tvec(0, -1, 0), tvec(0, -1, 0)));
-        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, tvec(0, 0, 1), tvec(0, 0, 1)));
-        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, tvec(0, 0, -1), tvec(0, 0, -1)));
-        Built B(k.c, c);
-        CHECK(B.hits(tray(-5, 0.2, 1, 1, 0, 0)).empty());  // in the face z = 1
-        CHECK(B.hits(tray(-5, 1, 1, 1, 0, 0)).empty());    // along the edge y = z = 1
-        CHECK(B.hits(tray(-5, 0.2, 0.5, 1, 0, 0)).size() == 2);
+        pray_object *c = pray_plane(k.c, m, t_vec(1, 0, 0), t_vec(1, 0, 0));
+        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, t_vec(-1, 0, 0), t_vec(-1, 0, 0)));
+        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, t_vec(0, 1, 0), t_vec(0, 1, 0)));
+        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, t_vec(0, -1, 0), t_vec(0, -1, 0)));
+        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, t_vec(0, 0, 1), t_vec(0, 0, 1)));
+        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, t_vec(0, 0, -1), t_vec(0, 0, -1)));
+        TScene B(k.c, c);
+        CHECK(B.hits(t_ray(-5, 0.2, 1, 1, 0, 0)).empty());  // in the face z = 1
+        CHECK(B.hits(t_ray(-5, 1, 1, 1, 0, 0)).empty());    // along the edge y = z = 1
+        CHECK(B.hits(t_ray(-5, 0.2, 0.5, 1, 0, 0)).size() == 2);
     }
     SUBCASE("touching a hole inside a solid adds nothing") {
         pray_model *m = k.mat(1), *hm = k.mat(2);
-        pray_object *c = pray_plane(k.c, m, tvec(1, 0, 0), tvec(1, 0, 0));
-        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, tvec(-1, 0, 0), tvec(-1, 0, 0)));
-        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, tvec(0, 1, 0), tvec(0, 1, 0)));
-        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, tvec(0, -1, 0), tvec(0, -1, 0)));
-        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, tvec(0, 0, 1), tvec(0, 0, 1)));
-        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, tvec(0, 0, -1), tvec(0, 0, -1)));
-        Built B(k.c, pray_csg(k.c, PRAY_DIFFERENCE, c, pray_sphere(k.c, hm, tvec(0, 0, 0), 0.5)));
-        std::vector<Hit> h = B.hits(tray(-5, 0.5, 0, 1, 0, 0));
+        pray_object *c = pray_plane(k.c, m, t_vec(1, 0, 0), t_vec(1, 0, 0));
+        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, t_vec(-1, 0, 0), t_vec(-1, 0, 0)));
+        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, t_vec(0, 1, 0), t_vec(0, 1, 0)));
+        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, t_vec(0, -1, 0), t_vec(0, -1, 0)));
+        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, t_vec(0, 0, 1), t_vec(0, 0, 1)));
+        c = pray_csg(k.c, PRAY_INTERSECTION, c, pray_plane(k.c, m, t_vec(0, 0, -1), t_vec(0, 0, -1)));
+        TScene B(k.c, pray_csg(k.c, PRAY_DIFFERENCE, c, pray_sphere(k.c, hm, t_vec(0, 0, 0), 0.5)));
+        std::vector<Hit> h = B.hits(t_ray(-5, 0.5, 0, 1, 0, 0));
         REQUIRE(h.size() == 2);
         CHECK(h[0].t == 4);
         CHECK(h[1].t == 6);
@@ -941,32 +941,32 @@ TEST_CASE("tangent rays produce no hit") {
 }
 
 TEST_CASE("folding of nothing and one") {
-    Ctx k;
+    TCtx k;
     pray_model *m = k.mat(1);
-    pray_object *s = pray_sphere(k.c, m, tvec(0, 0, 0), 1);
-    pray_object *s2 = pray_sphere(k.c, k.mat(2), tvec(0.5, 0, 0), 1);
+    pray_object *s = pray_sphere(k.c, m, t_vec(0, 0, 0), 1);
+    pray_object *s2 = pray_sphere(k.c, k.mat(2), t_vec(0.5, 0, 0), 1);
     pray_object *one = pray_one(k.c, k.mat(9));
     pray_object *none = pray_nothing(k.c);
-    Ray r = tray(-5, 0, 0, 1, 0, 0);
+    Ray r = t_ray(-5, 0, 0, 1, 0, 0);
     SUBCASE("union with one is all of space: no surface anywhere") {
-        Built B(k.c, pray_csg(k.c, PRAY_UNION, s, one));
+        TScene B(k.c, pray_csg(k.c, PRAY_UNION, s, one));
         CHECK(B.s.root == E_ALL);
         CHECK(B.hits(r).empty());
-        CHECK(B.hits(tray(0, 0, 0, 0, 0, 1)).empty());
-        Built B2(k.c, pray_csg(k.c, PRAY_UNION, pray_csg(k.c, PRAY_INTERSECTION, s, s2), one));
+        CHECK(B.hits(t_ray(0, 0, 0, 0, 0, 1)).empty());
+        TScene B2(k.c, pray_csg(k.c, PRAY_UNION, pray_csg(k.c, PRAY_INTERSECTION, s, s2), one));
         CHECK(B2.hits(r).empty());
     }
     SUBCASE("nothing, and everything intersected with nothing") {
-        Built B(k.c, none);
+        TScene B(k.c, none);
         CHECK(B.hits(r).empty());
-        Built B2(k.c, pray_csg(k.c, PRAY_INTERSECTION, s, none));
+        TScene B2(k.c, pray_csg(k.c, PRAY_INTERSECTION, s, none));
         CHECK(B2.s.root == E_NONE);
         CHECK(B2.hits(r).empty());
-        Built B3(k.c, pray_csg(k.c, PRAY_DIFFERENCE, s, one));
+        TScene B3(k.c, pray_csg(k.c, PRAY_DIFFERENCE, s, one));
         CHECK(B3.hits(r).empty());
-        Built B4(k.c, pray_csg(k.c, PRAY_DIFFERENCE, none, s));
+        TScene B4(k.c, pray_csg(k.c, PRAY_DIFFERENCE, none, s));
         CHECK(B4.hits(r).empty());
-        Built B5(k.c, pray_complement(k.c, one));
+        TScene B5(k.c, pray_complement(k.c, one));
         CHECK(B5.hits(r).empty());
     }
     SUBCASE("neutral elements leave the other operand as it is") {
@@ -977,7 +977,7 @@ TEST_CASE("folding of nothing and one") {
                                       pray_csg(k.c, PRAY_INTERSECTION, s, pray_complement(k.c, none))};
         for (int i = 0; i < 7; i++) {
             CAPTURE(i);
-            Built B(k.c, (pray_object *)forms[i]);
+            TScene B(k.c, (pray_object *)forms[i]);
             std::vector<Hit> h = B.hits(r);
             REQUIRE(h.size() == 2);
             CHECK(h[0].t == 4);
@@ -986,7 +986,7 @@ TEST_CASE("folding of nothing and one") {
         }
     }
     SUBCASE("one minus others is the complement of their union") {
-        Built B(k.c, pray_csg(k.c, PRAY_DIFFERENCE, pray_csg(k.c, PRAY_DIFFERENCE, one, s), s2));
+        TScene B(k.c, pray_csg(k.c, PRAY_DIFFERENCE, pray_csg(k.c, PRAY_DIFFERENCE, one, s), s2));
         REQUIRE(B.ok);
         std::vector<Hit> h = B.hits(r);
         REQUIRE(h.size() == 2);
@@ -994,7 +994,7 @@ TEST_CASE("folding of nothing and one") {
         CHECK(h[0].root_enter == 0);
         CHECK(h[1].t == 6.5);
         CHECK(h[1].root_enter == 1);
-        Built B2(k.c, pray_complement(k.c, none));
+        TScene B2(k.c, pray_complement(k.c, none));
         CHECK(B2.s.root == E_ALL);
         CHECK(B2.hits(r).empty());
     }

@@ -182,6 +182,9 @@ TEST_CASE("shadows: an occluder between the plane and the light leaves the ambie
     check_near(f, 0, 0, lit, lit, lit);
     f = frame_of(std::string(ONE) + "rendertiff " + P + " | " + occ + ", " + L + "\n", {"shadows=0"});
     check_near(f, 0, 0, lit, lit, lit);
+    // a directional light is shadowed by an occluder however far along it
+    f = frame_of(std::string(ONE) + "rendertiff " + P + " | sphere(phong({0.3}, {0}, 1), [0, -1000, 1000], 10), " + L + "\n");
+    check_exact(f, 0, 0, 0.125, 0.125, 0.125);
     // a point light in front of the occluder is not shadowed by it
     f = frame_of(std::string(ONE) + "rendertiff " + P + " | " + occ + ", pointlight({1}, [0, -0.5, 0.5])\n");
     check_near(f, 0, 0, lit, lit, lit);
@@ -629,4 +632,54 @@ TEST_CASE("memory limits from tiny to enough: every run ends in OK or NOMEM and 
     CHECK(no_message == 0);
     CHECK(nomem > 0);
     CHECK(ok > 0);
+}
+
+// =============================================================================================
+// More of the specification
+// =============================================================================================
+TEST_CASE("complement: the camera inside -S sees the sphere's surface, in the sphere's material") {
+    Frame f = frame_of("option \"width\", 3\noption \"height\", 3\nbackground {0.9}\n"
+                       "rendertiff -sphere(color({0.25, 0.5, 0.75}), [0, 0, 0], 0.5)\n");
+    check_exact(f, 1, 1, 0.25, 0.5, 0.75);
+    check_exact(f, 0, 0, 0.9, 0.9, 0.9);  // a ray that misses the sphere meets no surface
+    // A & -B: the bite shows B's material
+    f = frame_of(std::string(ONE) + "background {0.9}\n"
+                                    "rendertiff sphere(color({1, 0, 0}), [0, 0, 0], 1) & -sphere(color({0, 0, 1}), [0, -1, 0], 0.5)\n");
+    check_exact(f, 0, 0, 0, 0, 1);
+}
+
+TEST_CASE("antialias: A x A samples per pixel, at the centres of the sub-pixels, averaged") {
+    // 1x1 image, antialias 2: the four samples pass through (+-0.5, 0, -+0.5); one small sphere
+    // sits on the top-left sample's ray, one on the bottom-right's
+    Frame f = frame_of(std::string(ONE) + "option \"antialias\", 2\nbackground {0}\n"
+                                          "rendertiff sphere(color({1, 0, 0}), [-0.5, 0, 0.5], 0.1) | sphere(color({0, 0.5, 0}), [0.5, 0, -0.5], 0.1)\n");
+    check_exact(f, 0, 0, 0.25, 0.125, 0);
+    // antialias over a uniform colour changes nothing
+    f = frame_of(std::string(ONE) + "option \"antialias\", 3\nrendertiff sphere(color({0.25, 0.5, 0.75}), [0, 0, 0], 3)\n");
+    check_exact(f, 0, 0, 0.25, 0.5, 0.75);
+}
+
+TEST_CASE("accelerated renders give the images of the brute-force reference") {
+    const char *files[] = {"examples/csg.ray", "examples/holes.ray", "examples/glass.ray", "examples/parallel.ray"};
+    const char *const modes[][2] = {{"grid=0", "bounds=1"}, {"freeze=0", "merge=0"}, {"bounds=0", "grid=8"},
+                                    {"grid=32", "freeze=1"}, {"merge=1", "bounds=1"}};
+    for (const char *file : files) {
+        CAPTURE(file);
+        std::string prog = read_file(file);
+        REQUIRE(!prog.empty());
+        Result ref = testkit::run(prog, {"width=48", "height=36", "brute=1"});
+        REQUIRE(ref.status == PRAY_OK);
+        REQUIRE(ref.frames.size() == 1);
+        for (const auto &m : modes) {
+            CAPTURE(m[0]);
+            CAPTURE(m[1]);
+            Result r = testkit::run(prog, {"width=48", "height=36", m[0], m[1]});
+            REQUIRE(r.status == PRAY_OK);
+            REQUIRE(r.frames.size() == 1);
+            int differ = 0;
+            for (size_t i = 0; i < r.frames[0].pixels.size(); i++)
+                if (std::fabs(r.frames[0].pixels[i] - ref.frames[0].pixels[i]) > 1e-5f) differ++;
+            CHECK(differ == 0);
+        }
+    }
 }

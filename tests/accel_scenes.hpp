@@ -1,0 +1,450 @@
+// Random CSG scenes for the acceleration tests (test_accel.cpp), built through the public API
+// only, together with a record of their geometry from which adversarial rays are made: rays
+// along the (predicted) faces, edges and corners of the grid's voxels, through the corners of
+// primitives' boxes, tangent to spheres and cylinders, lying in the faces of boxes, starting
+// inside solids and on box boundaries. Everything is driven by a fixed-seed generator, so a
+// failing case can be reproduced from its seed alone.
+#ifndef PRAY_ACCEL_SCENES_HPP
+#define PRAY_ACCEL_SCENES_HPP
+
+#include "../pray.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+namespace accel_scenes {
+
+// ---- small vector helpers ----
+inline pray_vec V(double x, double y, double z) {
+    pray_vec v;
+    v.x = x;
+    v.y = y;
+    v.z = z;
+    return v;
+}
+inline pray_vec add(pray_vec a, pray_vec b) { return V(a.x + b.x, a.y + b.y, a.z + b.z); }
+inline pray_vec sub(pray_vec a, pray_vec b) { return V(a.x - b.x, a.y - b.y, a.z - b.z); }
+inline pray_vec mul(pray_vec a, double s) { return V(a.x * s, a.y * s, a.z * s); }
+inline double dot(pray_vec a, pray_vec b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline pray_vec cross(pray_vec a, pray_vec b) {
+    return V(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+}
+inline double len(pray_vec a) { return std::sqrt(dot(a, a)); }
+inline pray_vec unit(pray_vec a) { return mul(a, 1.0 / len(a)); }
+inline double comp(pray_vec a, int i) { return i == 0 ? a.x : i == 1 ? a.y : a.z; }
+inline void set_comp(pray_vec &a, int i, double v) { (i == 0 ? a.x : i == 1 ? a.y : a.z) = v; }
+inline pray_vec axis_vec(int i, double s = 1) { return V(i == 0 ? s : 0, i == 1 ? s : 0, i == 2 ? s : 0); }
+
+// ---- deterministic random numbers (splitmix64: the same sequence on every platform) ----
+struct Rng {
+    uint64_t s;
+    explicit Rng(uint64_t seed) : s(seed * 0x9E3779B97F4A7C15ull + 0x1234567ull) {}
+    uint64_t next() {
+        uint64_t z = (s += 0x9E3779B97F4A7C15ull);
+        z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+        z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+        return z ^ (z >> 31);
+    }
+    double uni() { return (double)(next() >> 11) * (1.0 / 9007199254740992.0); }  // [0, 1)
+    double range(double a, double b) { return a + (b - a) * uni(); }
+    int below(int n) { return (int)(next() % (uint64_t)n); }
+    bool chance(double p) { return uni() < p; }
+    double sign() { return chance(0.5) ? 1.0 : -1.0; }
+    pray_vec in_box(pray_vec lo, pray_vec hi) {
+        return V(range(lo.x, hi.x), range(lo.y, hi.y), range(lo.z, hi.z));
+    }
+    pray_vec dir() {  // a random unit vector
+        for (;;) {
+            pray_vec v = V(range(-1, 1), range(-1, 1), range(-1, 1));
+            double l = len(v);
+            if (l > 0.1 && l <= 1) return mul(v, 1 / l);
+        }
+    }
+};
+
+// ---- the record of a scene's geometry ----
+struct Sphere {
+    pray_vec c;
+    double r;
+};
+struct Cylinder {
+    pray_vec p, a;  // a point of the axis, the unit axis
+    double r;
+};
+struct Plane {
+    pray_vec p, n;  // a point of the boundary, the unit outward normal
+};
+struct BoxRec {           // a box made of six half-spaces (axis-aligned or tilted)
+    pray_vec c, u[3];     // centre, unit edge directions
+    double h[3];          // half sizes
+    pray_vec corner(int k) const {
+        pray_vec x = c;
+        for (int i = 0; i < 3; i++) x = add(x, mul(u[i], (k >> i & 1) ? h[i] : -h[i]));
+        return x;
+    }
+};
+
+struct Scene {
+    std::string label;  // what it is and its seed
+    pray_object *root = nullptr;
+    std::vector<Sphere> spheres;
+    std::vector<Cylinder> cylinders;
+    std::vector<Plane> planes;
+    std::vector<BoxRec> boxes;
+    int nprims = 0;
+    double scale = 1;         // the scene's unit (1, or far from 1 for the scaled scenes)
+    pray_vec offset{0, 0, 0};  // ... and its placement
+    // where rays are aimed: the part of space the scene's finite parts occupy
+    pray_vec lo{-1, -1, -1}, hi{1, 1, 1};
+};
+
+// The box around the primitives whose own boxes are finite (spheres: the renderer's grid is
+// sized from these): false when there is none.
+inline bool finite_region(const Scene &s, pray_vec *lo, pray_vec *hi) {
+    if (s.spheres.empty()) return false;
+    *lo = V(HUGE_VAL, HUGE_VAL, HUGE_VAL);
+    *hi = V(-HUGE_VAL, -HUGE_VAL, -HUGE_VAL);
+    for (const Sphere &q : s.spheres)
+        for (int l = 0; l < 3; l++) {
+            set_comp(*lo, l, std::min(comp(*lo, l), comp(q.c, l) - q.r));
+            set_comp(*hi, l, std::max(comp(*hi, l), comp(q.c, l) + q.r));
+        }
+    return true;
+}
+
+// The planes of a grid of N voxels along the longest side of the region, placed as the renderer
+// places it (centred on the region, cubical voxels, one voxel more where the side is an exact
+// multiple). Only a guess used to aim rays: the tests never depend on it being right.
+struct GridGuess {
+    int n[3];
+    double org[3], h;
+    double face(int axis, int k) const { return org[axis] + k * h; }
+};
+inline bool guess_grid(pray_vec lo, pray_vec hi, int N, GridGuess *g) {
+    double ext = 0;
+    for (int l = 0; l < 3; l++) ext = std::max(ext, comp(hi, l) - comp(lo, l));
+    if (!(ext > 0) || N <= 0) return false;
+    g->h = ext / N;
+    double margin = g->h * 1e-6;
+    for (int l = 0; l < 3; l++) {
+        double L = comp(hi, l) - comp(lo, l) + 2 * margin;
+        g->n[l] = std::max(1, (int)std::ceil(L / g->h));
+        g->org[l] = (comp(lo, l) + comp(hi, l)) / 2 - g->n[l] * g->h / 2;
+    }
+    return true;
+}
+inline int guess_auto_grid(int bounded) {
+    if (bounded < 8) return 0;
+    int n = (int)std::ceil(2.0 * std::cbrt((double)bounded));
+    return n < 4 ? 4 : n > 160 ? 160 : n;
+}
+
+// ---- the generator ----
+class Gen {
+public:
+    Gen(pray_ctx *c, uint64_t seed) : c_(c), rng(seed) {
+        pray_rgb d = {0.7, 0.5, 0.3}, s = {0.2, 0.2, 0.2}, a = {0, 0, 0};
+        m_ = pray_phong(c, d, s, a, 10);
+    }
+    Rng rng;
+    Scene sc;
+
+    // Scene coordinates of a point / a length given in unit coordinates.
+    pray_vec P(pray_vec u) const { return add(mul(u, sc.scale), sc.offset); }
+    double L(double u) const { return u * sc.scale; }
+
+    // A coordinate in [a, b], half of the time on a multiple of 1/8 or 1/16.
+    double coord(double a, double b) {
+        double x = rng.range(a, b);
+        int k = rng.below(4);
+        if (k == 0) return std::round(x * 8) / 8;
+        if (k == 1) return std::round(x * 16) / 16;
+        return x;
+    }
+    pray_vec point(double a, double b) { return V(coord(a, b), coord(a, b), coord(a, b)); }
+    double radius(double a, double b) {
+        double r = rng.range(a, b);
+        if (rng.chance(0.5)) r = std::max(1.0 / 16, std::round(r * 16) / 16);
+        return r;
+    }
+
+    // Primitives, in unit coordinates.
+    pray_object *sphere(pray_vec c, double r) {
+        Sphere q = {P(c), L(r)};
+        sc.spheres.push_back(q);
+        sc.nprims++;
+        if (rng.chance(0.1) && sc.scale == 1) {  // built at the origin and moved there by '.'
+            pray_object *o = pray_sphere(c_, m_, V(0, 0, 0), r);
+            return pray_translate(c_, o, c);
+        }
+        return pray_sphere(c_, m_, q.c, q.r);
+    }
+    pray_object *plane(pray_vec p, pray_vec n) {
+        Plane q = {P(p), unit(n)};
+        sc.planes.push_back(q);
+        sc.nprims++;
+        return pray_plane(c_, m_, q.p, n);
+    }
+    pray_object *cylinder(pray_vec p, pray_vec a, double r) {
+        Cylinder q = {P(p), unit(a), L(r)};
+        sc.cylinders.push_back(q);
+        sc.nprims++;
+        return pray_cylinder(c_, m_, q.p, a, q.r);
+    }
+    // A box of six half-spaces: centre c, unit edge directions u (orthonormal), half sizes h.
+    pray_object *box(pray_vec c, const pray_vec u[3], const double h[3]) {
+        BoxRec b;
+        b.c = P(c);
+        for (int i = 0; i < 3; i++) {
+            b.u[i] = u[i];
+            b.h[i] = L(h[i]);
+        }
+        sc.boxes.push_back(b);
+        int order[6] = {0, 1, 2, 3, 4, 5};
+        for (int i = 5; i > 0; i--) std::swap(order[i], order[rng.below(i + 1)]);
+        pray_object *acc = nullptr;
+        for (int k = 0; k < 6; k++) {
+            int i = order[k] / 2;
+            double s = order[k] % 2 ? 1.0 : -1.0;
+            pray_object *pl = plane(add(c, mul(u[i], s * h[i])), mul(u[i], s));
+            acc = acc ? pray_csg(c_, PRAY_INTERSECTION, acc, pl) : pl;
+        }
+        return acc;
+    }
+    pray_object *axis_box(pray_vec lo, pray_vec hi) {
+        pray_vec u[3] = {V(1, 0, 0), V(0, 1, 0), V(0, 0, 1)};
+        double h[3] = {(hi.x - lo.x) / 2, (hi.y - lo.y) / 2, (hi.z - lo.z) / 2};
+        return box(mul(add(lo, hi), 0.5), u, h);
+    }
+    // An orthonormal frame in a random orientation.
+    void frame(pray_vec u[3]) {
+        u[0] = rng.dir();
+        pray_vec t = rng.dir();
+        u[1] = unit(sub(t, mul(u[0], dot(t, u[0]))));
+        u[2] = cross(u[0], u[1]);
+    }
+
+    // A random leaf: one primitive or a small solid made of several.
+    pray_object *leaf() {
+        int k = rng.below(16);
+        if (k < 5) return sphere(point(-1, 1), radius(0.1, 0.7));
+        if (k < 7) {  // axis-aligned cube or box
+            pray_vec lo = point(-1, 0.6), hi = add(lo, V(radius(0.15, 0.9), radius(0.15, 0.9), radius(0.15, 0.9)));
+            if (rng.chance(0.3)) hi = add(lo, V(0.5, 0.5, 0.5));
+            return axis_box(lo, hi);
+        }
+        if (k < 9) {  // tilted box
+            pray_vec u[3];
+            frame(u);
+            double h[3] = {radius(0.1, 0.5), radius(0.1, 0.5), radius(0.1, 0.5)};
+            return box(point(-0.8, 0.8), u, h);
+        }
+        if (k < 12) {  // cylinder: axis-aligned or oblique, infinite or capped
+            bool aligned = rng.chance(0.6);
+            int ax = rng.below(3);
+            pray_vec a = aligned ? axis_vec(ax, rng.sign()) : rng.dir();
+            pray_vec p = point(-0.8, 0.8);
+            double r = radius(0.08, 0.5);
+            pray_object *cyl = cylinder(p, a, r);
+            if (rng.chance(0.5)) return cyl;
+            double h = radius(0.1, 0.8);
+            pray_object *cap1 = plane(add(p, mul(a, h)), a);
+            pray_object *cap2 = plane(sub(p, mul(a, h)), mul(a, -1));
+            return pray_csg(c_, PRAY_INTERSECTION, pray_csg(c_, PRAY_INTERSECTION, cyl, cap1), cap2);
+        }
+        if (k < 14) {  // a half-space, axis-aligned or in any orientation
+            pray_vec n = rng.chance(0.5) ? axis_vec(rng.below(3), rng.sign()) : rng.dir();
+            return plane(point(-0.8, 0.8), n);
+        }
+        if (k == 14) {  // a slab between two parallel planes
+            pray_vec n = rng.chance(0.5) ? axis_vec(rng.below(3), 1) : rng.dir();
+            pray_vec p = point(-0.5, 0.5);
+            double h = radius(0.1, 0.4);
+            return pray_csg(c_, PRAY_INTERSECTION, plane(add(p, mul(n, h)), n), plane(sub(p, mul(n, h)), mul(n, -1)));
+        }
+        // a sphere with a cylindrical hole
+        pray_vec cc = point(-0.8, 0.8);
+        double r = radius(0.2, 0.6);
+        pray_object *s = sphere(cc, r);
+        pray_vec a = rng.chance(0.5) ? axis_vec(rng.below(3), 1) : rng.dir();
+        return pray_csg(c_, PRAY_DIFFERENCE, s, cylinder(cc, a, r * rng.range(0.2, 0.7)));
+    }
+
+    // A random tree: n-ary unions, intersections and differences (chains of pray_csg),
+    // complements, nested `depth` levels deep; sometimes `nothing` and `one` to be folded.
+    pray_object *tree(int depth) {
+        if (depth <= 0 || rng.chance(0.25)) {
+            pray_object *o = leaf();
+            if (rng.chance(0.1)) o = pray_complement(c_, o);
+            return o;
+        }
+        int op = rng.below(3);
+        int n = 2 + rng.below(3);
+        pray_object *acc = tree(depth - 1);
+        for (int i = 1; i < n; i++) {
+            pray_object *k = tree(depth - 1);
+            if (op == PRAY_DIFFERENCE && rng.chance(0.3)) {
+                // (a - b) - c chains; also a - (b - c) nesting
+                acc = pray_csg(c_, PRAY_DIFFERENCE, acc, k);
+            } else {
+                acc = pray_csg(c_, (pray_op)op, acc, k);
+            }
+        }
+        if (rng.chance(0.04)) acc = pray_csg(c_, PRAY_UNION, acc, pray_nothing(c_));
+        if (rng.chance(0.04)) acc = pray_csg(c_, PRAY_INTERSECTION, acc, pray_one(c_, m_));
+        if (rng.chance(0.12)) acc = pray_complement(c_, acc);
+        return acc;
+    }
+
+    pray_ctx *c_;
+    pray_model *m_;
+};
+
+// Where rays are aimed: the box of the finite parts recorded (spheres, boxes' corners, points on
+// cylinders' axes and on planes), padded; in scene coordinates.
+inline void aim_region(Scene &s) {
+    pray_vec lo = V(HUGE_VAL, HUGE_VAL, HUGE_VAL), hi = V(-HUGE_VAL, -HUGE_VAL, -HUGE_VAL);
+    auto grow = [&](pray_vec p, double r) {
+        for (int l = 0; l < 3; l++) {
+            set_comp(lo, l, std::min(comp(lo, l), comp(p, l) - r));
+            set_comp(hi, l, std::max(comp(hi, l), comp(p, l) + r));
+        }
+    };
+    for (const Sphere &q : s.spheres) grow(q.c, q.r);
+    for (const BoxRec &b : s.boxes)
+        for (int k = 0; k < 8; k++) grow(b.corner(k), 0);
+    for (const Cylinder &q : s.cylinders) grow(q.p, q.r);
+    for (const Plane &q : s.planes) grow(q.p, 0);
+    if (!(lo.x <= hi.x)) {
+        lo = s.offset;
+        hi = s.offset;
+    }
+    double pad = 0.05 * s.scale;
+    s.lo = sub(lo, V(pad, pad, pad));
+    s.hi = add(hi, V(pad, pad, pad));
+}
+
+// The kinds of generated scenes.
+enum Kind {
+    K_RANDOM,       // a random tree, 2 to 4 levels
+    K_MANY,         // a union of 100 to 400 small spheres minus a few solids
+    K_LATTICE,      // spheres on a lattice, touching their neighbours, minus a box
+    K_BLOCKS,       // axis-aligned unit-fraction cubes sharing faces, with differences
+    K_FLOOR,        // an unbounded floor with spheres and boxes on it (lists outside the grid)
+    K_SCALED        // a random tree scaled far from 1 and moved far from the origin
+};
+
+inline const char *kind_name(int k) {
+    static const char *names[] = {"random", "many", "lattice", "blocks", "floor", "scaled"};
+    return names[k];
+}
+
+// Build scene `seed` of kind `kind` in context c.
+inline Scene make_scene(pray_ctx *c, int kind, uint64_t seed) {
+    Gen g(c, seed * 7919 + (uint64_t)kind);
+    Rng &r = g.rng;
+    pray_object *root = nullptr;
+    switch (kind) {
+    case K_RANDOM:
+    default: {
+        int depth = 2 + r.below(3);
+        root = g.tree(depth);
+        // make sure some spheres exist sometimes, so the grid has a finite region to cover
+        if (r.chance(0.5)) root = pray_csg(c, PRAY_UNION, root, g.sphere(g.point(-1, 1), g.radius(0.1, 0.4)));
+        break;
+    }
+    case K_MANY: {
+        int n = 100 + r.below(301);
+        double rmax = n > 250 ? 0.08 : 0.12;
+        for (int i = 0; i < n; i++) {
+            pray_object *s = g.sphere(g.point(-1, 1), g.radius(0.02, rmax));
+            root = root ? pray_csg(c, PRAY_UNION, root, s) : s;
+        }
+        int m = 1 + r.below(4);
+        for (int i = 0; i < m; i++) {
+            pray_object *k = r.chance(0.5) ? g.sphere(g.point(-0.7, 0.7), g.radius(0.2, 0.5)) : g.leaf();
+            root = pray_csg(c, PRAY_DIFFERENCE, root, k);
+        }
+        if (r.chance(0.3)) root = pray_csg(c, PRAY_INTERSECTION, root, g.plane(g.point(-0.3, 0.3), r.dir()));
+        break;
+    }
+    case K_LATTICE: {
+        int n = 3 + r.below(4);
+        double step = 2.0 / n, rad = step / 2;  // touching spheres
+        if (r.chance(0.3)) rad = step / 4;
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++)
+                for (int k = 0; k < n; k++) {
+                    if (r.chance(0.2)) continue;
+                    pray_vec cc = V(-1 + step * (i + 0.5), -1 + step * (j + 0.5), -1 + step * (k + 0.5));
+                    pray_object *s = g.sphere(cc, rad);
+                    root = root ? pray_csg(c, PRAY_UNION, root, s) : s;
+                }
+        if (!root) root = g.sphere(V(0, 0, 0), 0.5);
+        if (r.chance(0.7)) root = pray_csg(c, PRAY_DIFFERENCE, root, g.axis_box(V(-0.5, -0.5, -0.5), V(0.5, 0.5, 1.5)));
+        if (r.chance(0.5)) root = pray_csg(c, PRAY_INTERSECTION, root, g.cylinder(V(0, 0, 0), V(0, 0, 1), 0.9));
+        break;
+    }
+    case K_BLOCKS: {
+        int n = 4 + r.below(10);
+        for (int i = 0; i < n; i++) {
+            pray_vec lo = V(std::floor(r.range(-4, 3)) / 4, std::floor(r.range(-4, 3)) / 4, std::floor(r.range(-4, 3)) / 4);
+            pray_vec hi = add(lo, V(0.25 * (1 + r.below(3)), 0.25 * (1 + r.below(3)), 0.25 * (1 + r.below(3))));
+            pray_object *b = g.axis_box(lo, hi);
+            if (!root) root = b;
+            else root = pray_csg(c, r.chance(0.3) ? PRAY_DIFFERENCE : PRAY_UNION, root, b);
+        }
+        // spheres centred on block corners, so the grid has a finite region of simple fractions
+        for (int i = 0; i < 3; i++) {
+            pray_object *s = g.sphere(V(std::floor(r.range(-4, 4)) / 4, std::floor(r.range(-4, 4)) / 4,
+                                        std::floor(r.range(-4, 4)) / 4),
+                                      0.25);
+            root = pray_csg(c, r.chance(0.5) ? PRAY_UNION : PRAY_DIFFERENCE, root, s);
+        }
+        break;
+    }
+    case K_FLOOR: {
+        root = g.plane(V(0, 0, -1), V(0, 0, 1));
+        int n = 3 + r.below(20);
+        for (int i = 0; i < n; i++) {
+            pray_object *o = r.chance(0.6) ? g.sphere(g.point(-1, 1), g.radius(0.05, 0.4)) : g.leaf();
+            root = pray_csg(c, PRAY_UNION, root, o);
+        }
+        if (r.chance(0.5)) root = pray_csg(c, PRAY_DIFFERENCE, root, g.sphere(g.point(-1, 1), 0.5));
+        break;
+    }
+    case K_SCALED: {
+        static const double scales[] = {1e-3, 1e-2, 1e3, 1e4, 1e6};
+        static const double offs[] = {0, 1, 1e3, 1e5};
+        g.sc.scale = scales[r.below(5)];
+        double o = offs[r.below(4)] * (g.sc.scale < 1 ? 1 : g.sc.scale);
+        g.sc.offset = V(o, -o / 2, o / 4);
+        // scaled scenes are built of the primitives that the generator scales itself
+        int n = 3 + r.below(30);
+        for (int i = 0; i < n; i++) {
+            pray_object *s;
+            int k = r.below(4);
+            if (k < 2) s = g.sphere(g.point(-1, 1), g.radius(0.05, 0.5));
+            else if (k == 2) s = g.cylinder(g.point(-1, 1), r.chance(0.5) ? axis_vec(r.below(3), 1) : r.dir(), g.radius(0.05, 0.3));
+            else s = g.plane(g.point(-1, 1), r.dir());
+            if (!root) root = s;
+            else root = pray_csg(c, (pray_op)r.below(3), root, s);
+        }
+        break;
+    }
+    }
+    g.sc.root = root;
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%s scene, seed %llu", kind_name(kind), (unsigned long long)seed);
+    g.sc.label = buf;
+    aim_region(g.sc);
+    return g.sc;
+}
+
+} // namespace accel_scenes
+
+#endif
