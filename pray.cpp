@@ -2042,20 +2042,37 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
     }
     pray_status st = PRAY_OK;
     int np = s->prims.n;
-    // The grid's box: around the primitives with finite boxes, and with bounds, no larger than
-    // the root's box.
+    // The grid's box: with bounds, the finite boxes of the scene's parts (a union of a floor and
+    // furniture: the furniture's); otherwise, or when that finds nothing, the finite boxes of the
+    // primitives.
     Box region;
-    int bounded = 0;
     for (int l = 0; l < 3; l++) {
         region.lo[l] = REAL_BIG;
         region.hi[l] = -REAL_BIG;
     }
-    for (int i = 0; i < np; i++)
-        if (box_finite(s->prims[i].box)) {
-            box_hull(&region, s->prims[i].box);
-            bounded++;
+    if (a->bounds && s->root >= 0) {
+        Array<int> &stk = b.touched;
+        stk.n = 0;
+        if (!stk.push(c, s->root)) st = c->status;
+        while (st == PRAY_OK && stk.n) {
+            int e = stk[--stk.n];
+            const Box &bx = elem_box(s, e);
+            if (box_finite(bx)) box_hull(&region, bx);
+            else if (e_is_node(e) && s->nodes[e_index(e)].op == O_UNION) {
+                const Node &nd = s->nodes[e_index(e)];
+                for (int i = 0; i < nd.n && st == PRAY_OK; i++)
+                    if (!stk.push(c, s->kids[nd.k0 + i])) st = c->status;
+            } else if (e_is_node(e) && s->nodes[e_index(e)].op == O_DIFF) {
+                if (!stk.push(c, s->kids[s->nodes[e_index(e)].k0])) st = c->status;
+            }
         }
+    }
+    if (box_empty(region))
+        for (int i = 0; i < np; i++)
+            if (box_finite(s->prims[i].box)) box_hull(&region, s->prims[i].box);
     if (a->bounds && s->root >= 0) box_clip(&region, elem_box(s, s->root));
+    int bounded = 0;  // primitives that reach into the grid's box
+    for (int i = 0; i < np && !box_empty(region); i++) bounded += box_overlap(s->prims[i].box, region);
     int want = opt_int(c, OPT_GRID);
     if (want < 0) want = auto_grid(bounded);
     if (box_empty(region) || bounded == 0 || s->root < 0) want = 0;
@@ -2079,6 +2096,25 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
             if (vox * sizeof(int) * 2 <= budget || want <= 1) break;
             want = (int)(want * 0.8);
         }
+    }
+    // With bounds, a primitive matters only where all its ancestors' boxes reach: outside a
+    // node's box the node is outside, and so is what its primitives alone would make of it
+    // (a box smaller than all of space implies that). So each primitive is placed in the grid
+    // by the intersection of the boxes from it up to the root.
+    Box *eff = (Box *)mem_alloc(c, sizeof(Box) * (size_t)(np + 1));
+    if (!eff) st = c->status;
+    if (st == PRAY_OK) {
+        Box *neff = (Box *)mem_alloc(c, sizeof(Box) * (size_t)(s->nodes.n + 1));
+        if (!neff) st = c->status;
+        for (int j = s->nodes.n - 1; neff && j >= 0; j--) {  // parents before children
+            neff[j] = s->nodes[j].box;
+            if (s->nodes[j].parent >= 0) box_clip(&neff[j], neff[s->nodes[j].parent]);
+        }
+        for (int i = 0; neff && i < np; i++) {
+            eff[i] = s->prims[i].box;
+            if (a->bounds && s->prims[i].parent >= 0) box_clip(&eff[i], neff[s->prims[i].parent]);
+        }
+        mem_free(c, neff);
     }
     Array<int> cand, start;
     Array<unsigned char> cls;
@@ -2107,7 +2143,7 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
         }
         for (int pass = 0; pass < 2 && st == PRAY_OK; pass++) {
             for (int i = 0; i < np; i++) {
-                const Box &bx = s->prims[i].box;
+                const Box &bx = eff[i];
                 int lo[3], hi[3];
                 bool any = true;
                 for (int l = 0; l < 3 && any; l++) {
@@ -2197,7 +2233,8 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
         cand.n = 0;
         cls.n = 0;
         for (int i = 0; i < np && st == PRAY_OK; i++) {
-            const Box &bx = s->prims[i].box;
+            const Box &bx = eff[i];
+            if (box_empty(bx)) continue;
             bool inside = a->n[0] > 0;
             for (int l = 0; l < 3 && inside; l++)
                 inside = bx.lo[l] > a->org[l] && bx.hi[l] < (real)((double)a->org[l] + a->n[l] * (double)a->h);
@@ -2212,6 +2249,7 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
     cand.release(c);
     start.release(c);
     cls.release(c);
+    mem_free(c, eff);
     lb_release(b);
     long nv = (long)a->n[0] * a->n[1] * a->n[2];
     a->memory = (double)sizeof(Accel) + (double)nv * sizeof(int) + (double)a->data.cap * sizeof(int) +
