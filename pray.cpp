@@ -2317,6 +2317,10 @@ void settle(const Scene *s, Scratch *w, int e, bool st) {
         if (fix < 0) return;
         w->nfixed[p] = w->ray;
         w->nfixval[p] = (unsigned char)fix;
+        if (2 * p + 1 == s->root) {  // nothing more can be seen on this ray: no need to freeze
+            w->root_fixed = 1;
+            return;
+        }
         for (int i = 0; i < nd.n; i++)
             if (s->kids[nd.k0 + i] != e) freeze_tree(s, w, s->kids[nd.k0 + i]);
         e = 2 * p + 1;
@@ -2398,6 +2402,7 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
             settle(s, w, 2 * p, in);
         if (in) bump(s, w, 2 * p);
     }
+    if (w->root_fixed) return true;  // the root keeps its status from a on
     for (int i = 0; i < na; i++) {
         int j = nodes[3 * i];
         if (w->nfrozen[j] == w->ray) continue;
