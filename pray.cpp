@@ -2014,12 +2014,16 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
     return lb_store(b);
 }
 
-// Side of the grid's voxels: about cbrt(primitives) of them per axis times a factor found by
-// measurement (see docs/benchmarks.md), no grid for a handful of primitives.
-int auto_grid(int bounded) {
+// Voxels along the longest axis when the grid option is automatic. Measured on the benchmark
+// scenes (docs/benchmarks.md): about 4 voxels per primitive plus a floor of 4096 voxels is near
+// the best for CSG scenes of 200 to 1000 primitives; the building cost grows with the voxels, so
+// they are capped by half the primary rays. A handful of primitives is fastest without a grid.
+int auto_grid(int bounded, double rays) {
     if (bounded < 8) return 0;
-    int n = (int)ceil(2.0 * cbrt_pos((double)bounded));
-    return n < 4 ? 4 : n > 160 ? 160 : n;
+    double v = 4.0 * bounded + 4096;
+    if (v > rays / 2) v = rays / 2;
+    int n = (int)ceil(cbrt_pos(v));
+    return n < 4 ? 4 : n;
 }
 
 // Build the acceleration structure: the lists of the grid's voxels and of the space around it.
@@ -2074,7 +2078,7 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
     int bounded = 0;  // primitives that reach into the grid's box
     for (int i = 0; i < np && !box_empty(region); i++) bounded += box_overlap(s->prims[i].box, region);
     int want = opt_int(c, OPT_GRID);
-    if (want < 0) want = auto_grid(bounded);
+    if (want < 0) want = auto_grid(bounded, (double)opt_int(c, OPT_WIDTH) * opt_int(c, OPT_HEIGHT) * opt_int(c, OPT_ANTIALIAS) * opt_int(c, OPT_ANTIALIAS));
     if (box_empty(region) || bounded == 0 || s->root < 0) want = 0;
     double ext = 0;
     for (int l = 0; want > 0 && l < 3; l++)

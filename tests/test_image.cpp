@@ -72,8 +72,8 @@ bool exists(const std::string &path) {
 
 // Run a shell command; returns its exit status (-1 when it did not exit normally) and, through
 // `out`, what it wrote to standard output and standard error together.
-int run_cmd(const std::string &cmd, std::string *out) {
-    std::string full = cmd + " 2>&1";
+int run_cmd(const std::string &cmd, std::string *out, bool with_stderr = true) {
+    std::string full = cmd + (with_stderr ? " 2>&1" : "");
     FILE *p = popen(full.c_str(), "r");
     if (!p) return -1;
     std::string s;
@@ -529,6 +529,20 @@ TEST_CASE("command line: a program error exits with 1, names the place and write
     CHECK(out.find("redsphx.ray:5:") != std::string::npos);
     CHECK(out.find("Centre") != std::string::npos);
     CHECK(d.listing() == "");
+    // the message is "file:line:col: error: ..." on standard error; nothing on standard output
+    std::string only_out;
+    CHECK(run_cmd("./pray -s 8x8 -o " + sq(d / "x.ppm") + " examples/redsphx.ray 2>/dev/null", &only_out, false) == 1);
+    CHECK(only_out == "");
+    std::string only_err;
+    CHECK(run_cmd("./pray -s 8x8 -o " + sq(d / "x.ppm") + " examples/redsphx.ray 2>&1 >/dev/null", &only_err, false) == 1);
+    size_t at = only_err.find("redsphx.ray:5:");
+    REQUIRE(at != std::string::npos);
+    size_t col_end = only_err.find(':', at + 14);
+    REQUIRE(col_end != std::string::npos);
+    std::string col = only_err.substr(at + 14, col_end - at - 14);
+    CHECK(!col.empty());
+    CHECK(col.find_first_not_of("0123456789") == std::string::npos);
+    CHECK(only_err.compare(col_end, 9, ": error: ") == 0);
     // an error in rendertiff itself, after an image name was chosen
     spit(d / "bad.ray", "option \"width\", 4\noption \"height\", 4\nrendertiff sphere(color({1}), [0, 0, 0], 1), 5\n");
     rc = run_cmd("./pray -o " + sq(d / "y.ppm") + " " + sq(d / "bad.ray"), &out);
@@ -541,7 +555,8 @@ TEST_CASE("command line: usage errors exit with 2") {
     REQUIRE_MESSAGE(have_pray(), NO_PRAY);
     TempDir d;
     const char *cases[] = {"--frobnicate examples/csg.ray", "-s 10 examples/csg.ray", "-s 10x examples/csg.ray",
-                           "-s x10 examples/csg.ray", "-D width examples/csg.ray", "", "-o", "examples/csg.ray examples/csg.ray"};
+                           "-s x10 examples/csg.ray", "-D width examples/csg.ray", "", "-o", "examples/csg.ray examples/csg.ray",
+                           "-D width=abc examples/csg.ray", "-D nosuch=1 examples/csg.ray", "--threads x examples/csg.ray"};
     for (const char *a : cases) {
         CAPTURE(a);
         std::string out;

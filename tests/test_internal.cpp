@@ -78,15 +78,20 @@ struct TScene {
         scratch_release(c, &w);
         scene_release(c, &s);
     }
+    // Hits by the status-tree sweep over all primitives (the brute-force reference), or, with
+    // `accelerated`, by the path the renderer takes (grid, action lists, freezing, merging).
+    bool accelerated = false;
     std::vector<Hit> hits(const Ray &r, int self = -1, real tmax = REAL_INF) {
         TAllHits a;
-        if (ok) sweep(&s, &w, r, tmax, self, a);
+        if (ok && accelerated) find_hits(&s, &w, r, tmax, self, a);
+        else if (ok) sweep(&s, &w, r, tmax, self, a);
         return a.v;
     }
     FirstHit first(const Ray &r, int self = -1, real tmax = REAL_INF) {
         FirstHit f;
         f.found = false;
-        if (ok) sweep(&s, &w, r, tmax, self, f);
+        if (ok && accelerated) find_hits(&s, &w, r, tmax, self, f);
+        else if (ok) sweep(&s, &w, r, tmax, self, f);
         return f;
     }
     // The primitive index whose material is m (primitives get distinct materials in tests).
@@ -646,11 +651,20 @@ TEST_CASE("sweep: tmax bounds the hits (shadow rays)") {
 // =============================================================================================
 // CSG semantics of the status-tree sweep
 // =============================================================================================
-TEST_CASE("sweep agrees with direct set membership on random CSG trees (fixed seeds)") {
-    TCtx k;
-    int rays = 0, rays_with_hits = 0, total_hits = 0, failures = 0, trees_with_nodes = 0;
+// Random trees and rays against the reference; options are "name=value" render options.
+struct RandomRun {
+    int rays = 0, rays_with_hits = 0, total_hits = 0, failures = 0, trees_with_nodes = 0, accelerated = 0;
     std::string first_failure;
-    for (uint64_t seed = 1; seed <= 100; seed++) {
+};
+
+RandomRun random_trees(const std::vector<std::string> &options, bool accelerated, int trees) {
+    RandomRun R;
+    TCtx k;
+    for (size_t i = 0; i < options.size(); i++) {
+        size_t eq = options[i].find('=');
+        CHECK(pray_option(k.c, options[i].substr(0, eq).c_str(), atof(options[i].c_str() + eq + 1)) == PRAY_OK);
+    }
+    for (uint64_t seed = 1; seed <= (uint64_t)trees; seed++) {
         TRng g(seed * 1000003ull);
         RefTree T;
         TTreeGen gen = {g, T, k.c, std::vector<pray_model *>()};
@@ -659,8 +673,9 @@ TEST_CASE("sweep agrees with direct set membership on random CSG trees (fixed se
         REQUIRE(obj != NULL);
         TScene B(k.c, obj);
         REQUIRE(B.ok);
-        if (B.s.nodes.n > 0) trees_with_nodes++;
-        if (getenv("PRAY_TEST_VERBOSE")) printf("seed %d: root %d, %d prims, %d nodes\n", (int)seed, B.s.root, B.s.prims.n, B.s.nodes.n);
+        B.accelerated = accelerated;
+        if (B.s.nodes.n > 0) R.trees_with_nodes++;
+        if (B.s.accel) R.accelerated++;
         for (int i = 0; i < 8; i++) {
             double o[3], d[3];
             if (i % 2 == 0) {  // from outside, aimed into the busy region
@@ -681,21 +696,41 @@ TEST_CASE("sweep agrees with direct set membership on random CSG trees (fixed se
             }
             int nh = 0;
             std::string why = t_compare_ray(B, T, gen.mats, o, d, &nh);
-            rays++;
-            total_hits += nh;
-            if (nh > 0) rays_with_hits++;
+            R.rays++;
+            R.total_hits += nh;
+            if (nh > 0) R.rays_with_hits++;
             if (!why.empty()) {
-                failures++;
-                if (first_failure.empty()) first_failure = "seed " + std::to_string(seed) + ": " + why;
+                R.failures++;
+                if (R.first_failure.empty()) R.first_failure = "seed " + std::to_string(seed) + ": " + why;
             }
         }
     }
-    CHECK_MESSAGE(failures == 0, first_failure);
+    return R;
+}
+
+TEST_CASE("sweep agrees with direct set membership on random CSG trees (fixed seeds)") {
+    RandomRun R = random_trees({}, false, 100);
+    CHECK_MESSAGE(R.failures == 0, R.first_failure);
     // the test means something only when the trees are varied and the rays meet them
-    CHECK(rays == 800);
-    CHECK(rays_with_hits >= 200);
-    CHECK(total_hits >= 350);
-    CHECK(trees_with_nodes >= 30);
+    CHECK(R.rays == 800);
+    CHECK(R.rays_with_hits >= 200);
+    CHECK(R.total_hits >= 350);
+    CHECK(R.trees_with_nodes >= 30);
+    // the same without pruning and compaction of the flattened tree
+    R = random_trees({"brute=1"}, false, 100);
+    CHECK_MESSAGE(R.failures == 0, R.first_failure);
+}
+
+TEST_CASE("the accelerated path agrees with direct set membership on random CSG trees") {
+    const std::vector<std::vector<std::string> > sets = {
+        {}, {"grid=1"}, {"grid=4", "freeze=0"}, {"grid=7", "merge=0"}, {"grid=3", "bounds=0"}, {"grid=16"}};
+    for (size_t i = 0; i < sets.size(); i++) {
+        CAPTURE(i);
+        RandomRun R = random_trees(sets[i], true, 40);
+        CHECK_MESSAGE(R.failures == 0, R.first_failure);
+        CHECK(R.rays == 320);
+        if (!sets[i].empty()) CHECK(R.accelerated >= 30);  // a grid was built
+    }
 }
 
 // Cube [-1, 1]^3 minus the box [0, 1] x [-0.5, 0.5]^2: the box's face x = 1 lies in the cube's
