@@ -2558,7 +2558,9 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
         if (ix[ax] < 0 || ix[ax] >= A->n[ax]) break;
         next[ax] += delta[ax];
     }
-    if (run >= 0 && eval_list(s, A, w, ray, run, run_a, t, tmax, self, visit)) return;
+    // the last stretch ends where the ray leaves the grid's box, whatever rounding the stepping
+    // gathered, so that it meets the stretch after the grid without a gap
+    if (run >= 0 && eval_list(s, A, w, ray, run, run_a, tend, tmax, self, visit)) return;
     if (tend < tmax) eval_list(s, A, w, ray, A->outer, tend, tmax, tmax, self, visit);
 }
 

@@ -102,18 +102,25 @@ struct Scene {
     pray_vec lo{-1, -1, -1}, hi{1, 1, 1};
 };
 
-// The box around the primitives whose own boxes are finite (spheres: the renderer's grid is
-// sized from these): false when there is none.
-inline bool finite_region(const Scene &s, pray_vec *lo, pray_vec *hi) {
-    if (s.spheres.empty()) return false;
+// Guesses of the box the renderer's grid covers: around the primitives whose own boxes are
+// finite (spheres), or (with_boxes) also around the boxes made of half-spaces (with bounds, the
+// finite boxes of the scene's parts). False when there is nothing finite.
+inline bool finite_region(const Scene &s, pray_vec *lo, pray_vec *hi, bool with_boxes = false) {
     *lo = V(HUGE_VAL, HUGE_VAL, HUGE_VAL);
     *hi = V(-HUGE_VAL, -HUGE_VAL, -HUGE_VAL);
-    for (const Sphere &q : s.spheres)
+    bool any = false;
+    auto grow = [&](pray_vec p, double r) {
+        any = true;
         for (int l = 0; l < 3; l++) {
-            set_comp(*lo, l, std::min(comp(*lo, l), comp(q.c, l) - q.r));
-            set_comp(*hi, l, std::max(comp(*hi, l), comp(q.c, l) + q.r));
+            set_comp(*lo, l, std::min(comp(*lo, l), comp(p, l) - r));
+            set_comp(*hi, l, std::max(comp(*hi, l), comp(p, l) + r));
         }
-    return true;
+    };
+    for (const Sphere &q : s.spheres) grow(q.c, q.r);
+    if (with_boxes)
+        for (const BoxRec &b : s.boxes)
+            for (int k = 0; k < 8; k++) grow(b.corner(k), 0);
+    return any;
 }
 
 // The planes of a grid of N voxels along the longest side of the region, placed as the renderer
@@ -146,7 +153,7 @@ inline int guess_auto_grid(int bounded) {
 // ---- the generator ----
 class Gen {
 public:
-    Gen(pray_ctx *c, uint64_t seed) : c_(c), rng(seed) {
+    Gen(pray_ctx *c, uint64_t seed) : rng(seed), c_(c) {
         pray_rgb d = {0.7, 0.5, 0.3}, s = {0.2, 0.2, 0.2}, a = {0, 0, 0};
         m_ = pray_phong(c, d, s, a, 10);
     }
@@ -165,7 +172,6 @@ public:
         if (k == 1) return std::round(x * 16) / 16;
         return x;
     }
-    pray_vec point(double a, double b) { return V(coord(a, b), coord(a, b), coord(a, b)); }
     double radius(double a, double b) {
         double r = rng.range(a, b);
         if (rng.chance(0.5)) r = std::max(1.0 / 16, std::round(r * 16) / 16);
@@ -228,7 +234,13 @@ public:
         u[2] = cross(u[0], u[1]);
     }
 
-    // A random leaf: one primitive or a small solid made of several.
+    // A random leaf: one primitive or a small solid made of several, near the focus point.
+    pray_vec focus{0, 0, 0};
+    double spread = 1;
+    pray_vec point(double a, double b) {  // a point near the focus: a, b scaled by the spread
+        return V(coord(focus.x + a * spread, focus.x + b * spread), coord(focus.y + a * spread, focus.y + b * spread),
+                 coord(focus.z + a * spread, focus.z + b * spread));
+    }
     pray_object *leaf() {
         int k = rng.below(16);
         if (k < 5) return sphere(point(-1, 1), radius(0.1, 0.7));
@@ -276,14 +288,22 @@ public:
 
     // A random tree: n-ary unions, intersections and differences (chains of pray_csg),
     // complements, nested `depth` levels deep; sometimes `nothing` and `one` to be folded.
+    // Subtrees are placed around a focus point that moves less and less deep down, so that the
+    // parts of intersections and differences overlap often. At most max_prims primitives.
+    int max_prims = 1 << 30;
     pray_object *tree(int depth) {
-        if (depth <= 0 || rng.chance(0.25)) {
+        if (depth <= 0 || rng.chance(0.25) || sc.nprims >= max_prims) {
             pray_object *o = leaf();
             if (rng.chance(0.1)) o = pray_complement(c_, o);
             return o;
         }
-        int op = rng.below(3);
+        double w = rng.uni();
+        int op = w < 0.45 ? PRAY_UNION : w < 0.75 ? PRAY_DIFFERENCE : PRAY_INTERSECTION;
         int n = 2 + rng.below(3);
+        pray_vec f0 = focus;
+        double s0 = spread;
+        focus = add(f0, mul(V(rng.range(-1, 1), rng.range(-1, 1), rng.range(-1, 1)), 0.5 * s0));
+        spread = s0 * 0.6;
         pray_object *acc = tree(depth - 1);
         for (int i = 1; i < n; i++) {
             pray_object *k = tree(depth - 1);
@@ -297,6 +317,8 @@ public:
         if (rng.chance(0.04)) acc = pray_csg(c_, PRAY_UNION, acc, pray_nothing(c_));
         if (rng.chance(0.04)) acc = pray_csg(c_, PRAY_INTERSECTION, acc, pray_one(c_, m_));
         if (rng.chance(0.12)) acc = pray_complement(c_, acc);
+        focus = f0;
+        spread = s0;
         return acc;
     }
 
@@ -352,6 +374,7 @@ inline Scene make_scene(pray_ctx *c, int kind, uint64_t seed) {
     case K_RANDOM:
     default: {
         int depth = 2 + r.below(3);
+        g.max_prims = 40;
         root = g.tree(depth);
         // make sure some spheres exist sometimes, so the grid has a finite region to cover
         if (r.chance(0.5)) root = pray_csg(c, PRAY_UNION, root, g.sphere(g.point(-1, 1), g.radius(0.1, 0.4)));
@@ -432,7 +455,7 @@ inline Scene make_scene(pray_ctx *c, int kind, uint64_t seed) {
             else if (k == 2) s = g.cylinder(g.point(-1, 1), r.chance(0.5) ? axis_vec(r.below(3), 1) : r.dir(), g.radius(0.05, 0.3));
             else s = g.plane(g.point(-1, 1), r.dir());
             if (!root) root = s;
-            else root = pray_csg(c, (pray_op)r.below(3), root, s);
+            else root = pray_csg(c, r.chance(0.5) ? PRAY_UNION : r.chance(0.6) ? PRAY_DIFFERENCE : PRAY_INTERSECTION, root, s);
         }
         break;
     }

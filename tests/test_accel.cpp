@@ -1,0 +1,889 @@
+// The acceleration (thesis 3.3-3.6: uniform grid, per-voxel action lists, freezing, merging of
+// voxels into areas, bounding boxes) against the brute-force reference, through the public API
+// only (pray.hpp):
+//   - the same hits (primitive, t, entering, number of hits) for every combination of the
+//     switches grid x freeze x merge x bounds, on a few hundred random CSG scenes with fixed seeds,
+//     each probed with adversarial rays (accel_scenes.hpp: voxel faces, edges and corners, box
+//     corners, tangents, rays in faces, starting inside the grid, on box boundaries and inside
+//     solids, with tmax limits);
+//   - the same images, float for float, on every example program and on random scenes;
+//   - freezing never increases the number of intersection tests;
+//   - the statistics of the grid are plausible.
+// A mismatch is a bug in the renderer: the failure message lists the first ones in full (scene
+// and seed, options, ray, expected and actual hits), enough to reproduce each one.
+#include <doctest/doctest.h>
+
+#include "accel_scenes.hpp"
+#include "testkit.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace {
+
+using namespace accel_scenes;
+
+// ---- option combinations ----
+const int GRIDS[] = {0, 1, 2, 3, 5, 8, 16, -1};
+const int NGRIDS = sizeof GRIDS / sizeof GRIDS[0];
+
+struct Opts {
+    int brute, grid, freeze, merge, bounds;
+    std::string text() const {
+        char b[96];
+        if (brute) return "brute=1";
+        std::snprintf(b, sizeof b, "grid=%d freeze=%d merge=%d bounds=%d", grid, freeze, merge, bounds);
+        return b;
+    }
+    // as fixed options of a program run
+    std::vector<std::string> fixed() const {
+        std::vector<std::string> v;
+        v.push_back("brute=" + std::to_string(brute));
+        v.push_back("grid=" + std::to_string(grid));
+        v.push_back("freeze=" + std::to_string(freeze));
+        v.push_back("merge=" + std::to_string(merge));
+        v.push_back("bounds=" + std::to_string(bounds));
+        return v;
+    }
+};
+
+Opts reference() { return Opts{1, -1, 1, 1, 1}; }
+
+std::vector<Opts> all_combinations() {
+    std::vector<Opts> v;
+    for (int g = 0; g < NGRIDS; g++)
+        for (int f = 0; f < 2; f++)
+            for (int m = 0; m < 2; m++)
+                for (int b = 0; b < 2; b++) v.push_back(Opts{0, GRIDS[g], f, m, b});
+    return v;
+}
+
+// All five, every time: options set on a context persist.
+bool apply(pray_ctx *c, const Opts &o) {
+    return pray_option(c, "brute", o.brute) == PRAY_OK && pray_option(c, "grid", o.grid) == PRAY_OK &&
+           pray_option(c, "freeze", o.freeze) == PRAY_OK && pray_option(c, "merge", o.merge) == PRAY_OK &&
+           pray_option(c, "bounds", o.bounds) == PRAY_OK;
+}
+
+// ---- rays ----
+enum RayKind {
+    R_RANDOM, R_AXIS, R_GRID_EDGE, R_GRID_FACE, R_GRID_CORNER, R_GRID_SLOPE, R_FRACTION, R_BOX_CORNER,
+    R_IN_GRID, R_ON_BOX, R_IN_SOLID, R_TANGENT_SPHERE, R_TANGENT_CYL, R_ALONG_CYL, R_IN_FACE, R_TMAX,
+    R_TMAX_HIT, R_NKINDS
+};
+const char *ray_kind_name(int k) {
+    static const char *n[] = {"random", "axis-parallel", "along grid edge", "in grid face", "grid corner diagonal",
+                              "grid corner slope", "on 1/8,1/16 fractions", "through box corner",
+                              "starting inside grid", "starting on box boundary", "starting inside solid",
+                              "tangent to sphere", "tangent to cylinder", "along cylinder surface",
+                              "in a plane face", "tmax limit", "tmax at a hit"};
+    return n[k];
+}
+
+struct RayCase {
+    pray_vec o, d;
+    double tmax;
+    int kind;
+};
+
+std::string fmt_vec(pray_vec v) {
+    char b[128];
+    std::snprintf(b, sizeof b, "(%.17g, %.17g, %.17g)", v.x, v.y, v.z);
+    return b;
+}
+
+std::string fmt_ray(const RayCase &r) {
+    std::string s = std::string(ray_kind_name(r.kind)) + " ray o=" + fmt_vec(r.o) + " d=" + fmt_vec(r.d);
+    char b[64];
+    if (r.tmax < HUGE_VAL) {
+        std::snprintf(b, sizeof b, " tmax=%.17g", r.tmax);
+        s += b;
+    }
+    return s;
+}
+
+// Adversarial rays for a scene.
+std::vector<RayCase> make_rays(const Scene &s, Rng &rng) {
+    std::vector<RayCase> v;
+    pray_vec lo = s.lo, hi = s.hi, C = mul(add(lo, hi), 0.5);
+    double ext = std::max(hi.x - lo.x, std::max(hi.y - lo.y, hi.z - lo.z));
+    double far = 3 * ext;
+    auto push = [&](pray_vec o, pray_vec d, int kind, double tmax = HUGE_VAL) {
+        if (len(d) == 0) return;
+        RayCase r = {o, d, tmax, kind};
+        v.push_back(r);
+    };
+    auto axis_dir = [&]() { return axis_vec(rng.below(3), rng.sign()); };
+    auto diag_dir = [&]() {  // (+-1, +-1, +-1) or (+-1, +-1, 0) in some order
+        pray_vec d = V(rng.sign(), rng.sign(), rng.sign());
+        if (rng.chance(0.4)) set_comp(d, rng.below(3), 0);
+        return d;
+    };
+    auto fraction = [&](int l) {  // a coordinate on a multiple of 1/8 or 1/16 of the extent
+        int den = rng.chance(0.5) ? 8 : 16;
+        return comp(lo, l) + ext * rng.below(den + 1) / den;
+    };
+
+    // random rays from outside, aimed into the scene's box or at the centre of a part
+    for (int i = 0; i < 16; i++) {
+        pray_vec o = add(C, mul(rng.dir(), far));
+        pray_vec t = rng.in_box(lo, hi);
+        if (i % 2 && !s.spheres.empty()) t = s.spheres[rng.below((int)s.spheres.size())].c;
+        if (i % 4 == 3 && !s.boxes.empty()) t = s.boxes[rng.below((int)s.boxes.size())].c;
+        push(o, sub(t, o), R_RANDOM);
+    }
+    // axis-parallel rays, from outside and from inside
+    for (int i = 0; i < 16; i++) {
+        int a = rng.below(3);
+        pray_vec o = rng.in_box(lo, hi);
+        for (int l = 0; l < 3; l++)
+            if (rng.chance(0.5)) set_comp(o, l, fraction(l));
+        double sg = rng.sign();
+        if (rng.chance(0.5)) set_comp(o, a, comp(C, a) - sg * far);
+        push(o, axis_vec(a, sg), R_AXIS);
+    }
+    // on the guessed planes of the grid's voxels, for every grid size tested
+    pray_vec glo = lo, ghi = hi, blo, bhi;
+    bool have_grid = finite_region(s, &glo, &ghi);
+    if (!have_grid) glo = lo, ghi = hi;
+    std::vector<std::pair<pray_vec, pray_vec>> regions;
+    if (have_grid) regions.push_back(std::make_pair(glo, ghi));
+    if (finite_region(s, &blo, &bhi, true) && (!have_grid || len(sub(blo, glo)) + len(sub(bhi, ghi)) > 0))
+        regions.push_back(std::make_pair(blo, bhi));
+    for (size_t ri = 0; ri < regions.size(); ri++) {
+        int sizes[] = {1, 2, 3, 5, 8, 16, guess_auto_grid((int)(s.spheres.size() + 6 * s.boxes.size()))};
+        for (int N : sizes) {
+            GridGuess g;
+            if (!guess_grid(regions[ri].first, regions[ri].second, N, &g)) continue;
+            bool half = regions.size() > 1 && rng.chance(0.5);  // two guesses: half the rays each
+            auto face = [&](int l) { return g.face(l, rng.below(g.n[l] + 1)); };
+            auto corner = [&]() { return V(face(0), face(1), face(2)); };
+            // along an edge: two coordinates on faces, parallel to the third axis
+            for (int i = half; i < 2; i++) {
+                int a = rng.below(3);
+                pray_vec o = corner();
+                double sg = rng.sign();
+                if (rng.chance(0.5)) set_comp(o, a, comp(o, a) - sg * (g.n[a] + 1) * g.h);  // from outside
+                push(o, axis_vec(a, sg), R_GRID_EDGE);
+            }
+            // in a face: one coordinate on a face, the direction in that plane
+            for (int i = half; i < 2; i++) {
+                int b = rng.below(3);
+                pray_vec o = rng.in_box(V(g.org[0], g.org[1], g.org[2]),
+                                        V(g.face(0, g.n[0]), g.face(1, g.n[1]), g.face(2, g.n[2])));
+                set_comp(o, b, face(b));
+                pray_vec d = rng.dir();
+                set_comp(d, b, 0);
+                if (rng.chance(0.5)) d = diag_dir(), set_comp(d, b, 0);
+                if (rng.chance(0.5)) o = sub(o, mul(unit(d), far));
+                push(o, d, R_GRID_FACE);
+            }
+            // diagonals of the cubical voxels: through a corner of every voxel they cross
+            for (int i = half; i < 2; i++) {
+                pray_vec P = corner();
+                pray_vec d = diag_dir();
+                int m = rng.below(4);
+                double back = m == 3 ? (g.n[0] + g.n[1] + g.n[2] + 1) * g.h : m * g.h;
+                push(sub(P, mul(d, back)), d, R_GRID_CORNER);
+            }
+            // small integer slopes through a corner: through corners and edges periodically
+            {
+                pray_vec P = corner();
+                pray_vec d = V(rng.sign() * (1 + rng.below(3)), rng.sign() * (1 + rng.below(3)), rng.sign() * rng.below(3));
+                int p[3] = {0, 1, 2};
+                for (int k = 2; k > 0; k--) std::swap(p[k], p[rng.below(k + 1)]);
+                d = V(comp(d, p[0]), comp(d, p[1]), comp(d, p[2]));
+                push(rng.chance(0.5) ? P : sub(P, mul(d, 2 * far / len(d))), d, R_GRID_SLOPE);
+            }
+        }
+    }
+    // on simple fractions of the scene's extent
+    for (int i = 0; i < 14; i++) {
+        pray_vec o = V(fraction(0), fraction(1), fraction(2));
+        pray_vec d = rng.chance(0.5) ? axis_dir() : diag_dir();
+        if (rng.chance(0.5)) o = sub(o, mul(unit(d), far));
+        push(o, d, R_FRACTION);
+    }
+    // through the corners of primitives' boxes (boxes of six half-spaces, spheres' boxes)
+    std::vector<pray_vec> corners;
+    for (const BoxRec &b : s.boxes)
+        for (int k = 0; k < 8; k++) corners.push_back(b.corner(k));
+    for (const Sphere &q : s.spheres)
+        if (corners.size() < 4000)
+            for (int k = 0; k < 8; k++)
+                corners.push_back(V(q.c.x + (k & 1 ? q.r : -q.r), q.c.y + (k & 2 ? q.r : -q.r), q.c.z + (k & 4 ? q.r : -q.r)));
+    for (int i = 0; i < 14 && !corners.empty(); i++) {
+        pray_vec P = corners[rng.below((int)corners.size())];
+        int m = rng.below(3);
+        pray_vec d = m == 0 ? rng.dir() : m == 1 ? axis_dir() : diag_dir();
+        push(rng.chance(0.3) ? P : sub(P, mul(unit(d), far)), d, R_BOX_CORNER);
+    }
+    // starting inside the grid's region
+    for (int i = 0; i < 8; i++) {
+        pray_vec o = rng.in_box(glo, ghi);
+        push(o, rng.chance(0.3) ? axis_dir() : rng.dir(), R_IN_GRID);
+    }
+    // starting exactly on a primitive's box boundary
+    for (int i = 0; i < 8 && !s.spheres.empty(); i++) {
+        const Sphere &q = s.spheres[rng.below((int)s.spheres.size())];
+        pray_vec o = add(q.c, V(rng.range(-q.r, q.r), rng.range(-q.r, q.r), rng.range(-q.r, q.r)));
+        int l = rng.below(3);
+        set_comp(o, l, comp(q.c, l) + rng.sign() * q.r);
+        push(o, rng.chance(0.3) ? axis_dir() : rng.dir(), R_ON_BOX);
+    }
+    for (int i = 0; i < 4 && !s.boxes.empty(); i++) {
+        const BoxRec &b = s.boxes[rng.below((int)s.boxes.size())];
+        pray_vec o = b.c;
+        for (int k = 0; k < 3; k++) o = add(o, mul(b.u[k], rng.range(-b.h[k], b.h[k])));
+        int k = rng.below(3);
+        o = add(o, mul(b.u[k], rng.sign() * b.h[k] - dot(sub(o, b.c), b.u[k])));
+        push(o, rng.chance(0.3) ? axis_dir() : rng.dir(), R_ON_BOX);
+    }
+    // starting inside solids
+    for (int i = 0; i < 8; i++) {
+        int w = rng.below(3);
+        pray_vec o;
+        if (w == 0 && !s.spheres.empty()) o = s.spheres[rng.below((int)s.spheres.size())].c;
+        else if (w == 1 && !s.boxes.empty()) o = s.boxes[rng.below((int)s.boxes.size())].c;
+        else if (!s.cylinders.empty()) {
+            const Cylinder &q = s.cylinders[rng.below((int)s.cylinders.size())];
+            o = add(q.p, mul(q.a, rng.range(-0.5, 0.5) * s.scale));
+        } else
+            o = rng.in_box(lo, hi);
+        push(o, rng.chance(0.3) ? axis_dir() : rng.dir(), R_IN_SOLID);
+    }
+    // tangent to spheres: the line passes at exactly the radius from the centre
+    for (int i = 0; i < 12 && !s.spheres.empty(); i++) {
+        const Sphere &q = s.spheres[rng.below((int)s.spheres.size())];
+        pray_vec d, u;
+        if (rng.chance(0.5)) {  // axis-aligned: exact in floating point
+            int a = rng.below(3), b = (a + 1 + rng.below(2)) % 3;
+            d = axis_vec(a, rng.sign());
+            u = axis_vec(b, rng.sign());
+        } else {
+            d = rng.dir();
+            u = unit(cross(d, rng.dir()));
+        }
+        pray_vec o = add(q.c, mul(u, q.r));
+        if (rng.chance(0.7)) o = sub(o, mul(d, far));
+        push(o, d, R_TANGENT_SPHERE);
+    }
+    // tangent to cylinders, and lying on a cylinder's surface (parallel to the axis)
+    for (int i = 0; i < 10 && !s.cylinders.empty(); i++) {
+        const Cylinder &q = s.cylinders[rng.below((int)s.cylinders.size())];
+        pray_vec t = rng.dir();
+        pray_vec u = unit(cross(q.a, t));             // perpendicular to the axis
+        pray_vec w = cross(q.a, u);                   // the third direction
+        if (i % 3 == 2) {
+            pray_vec o = add(add(q.p, mul(u, q.r)), mul(q.a, rng.range(-1, 1) * s.scale));
+            push(o, mul(q.a, rng.sign()), R_ALONG_CYL);
+            continue;
+        }
+        // axis-aligned cylinders with axis-aligned tangents: exact
+        int ax = -1;
+        for (int l = 0; l < 3; l++)
+            if (std::fabs(comp(q.a, l)) == 1) ax = l;
+        if (ax >= 0 && rng.chance(0.6)) {
+            int b = (ax + 1 + rng.below(2)) % 3, c2 = 3 - ax - b;
+            u = axis_vec(b, rng.sign());
+            w = axis_vec(c2, 1);
+        }
+        double ang = rng.chance(0.5) ? 0 : rng.range(-1.2, 1.2);
+        pray_vec d = add(mul(w, std::cos(ang)), mul(q.a, std::sin(ang)));
+        pray_vec o = add(q.p, mul(u, q.r));
+        if (rng.chance(0.7)) o = sub(o, mul(d, far));
+        push(o, d, R_TANGENT_CYL);
+    }
+    // lying in a face of a box, or in a plane
+    for (int i = 0; i < 8 && (!s.boxes.empty() || !s.planes.empty()); i++) {
+        if (!s.boxes.empty() && rng.chance(0.7)) {
+            const BoxRec &b = s.boxes[rng.below((int)s.boxes.size())];
+            int k = rng.below(3), k1 = (k + 1) % 3, k2 = (k + 2) % 3;
+            pray_vec o = add(b.c, mul(b.u[k], rng.sign() * b.h[k]));
+            o = add(o, mul(b.u[k1], rng.range(-1.5, 1.5) * b.h[k1]));
+            pray_vec d = rng.chance(0.5) ? b.u[k2] : add(mul(b.u[k1], rng.range(-1, 1)), mul(b.u[k2], rng.range(-1, 1)));
+            if (rng.chance(0.5)) o = sub(o, mul(unit(d), far));
+            push(o, d, R_IN_FACE);
+        } else if (!s.planes.empty()) {
+            const Plane &q = s.planes[rng.below((int)s.planes.size())];
+            pray_vec d = unit(cross(q.n, rng.dir()));
+            push(sub(q.p, mul(d, far)), d, R_IN_FACE);
+        }
+    }
+    // tmax limits (shadow-like)
+    size_t n0 = v.size();
+    for (int i = 0; i < 14 && n0; i++) {
+        RayCase r = v[rng.below((int)n0)];
+        r.tmax = rng.range(0, 2 * far);
+        r.kind = R_TMAX;
+        v.push_back(r);
+    }
+    return v;
+}
+
+// ---- hits ----
+const int MAXH = 64;
+
+struct Hits {
+    int n = 0;
+    std::vector<pray_hit> h;
+};
+
+Hits intersect(pray_ctx *c, pray_scene *q, const RayCase &r) {
+    Hits out;
+    out.h.resize(MAXH);
+    out.n = pray_intersect(c, q, r.o, r.d, r.tmax, out.h.data(), MAXH);
+    out.h.resize(out.n < 0 ? 0 : std::min(out.n, MAXH));
+    return out;
+}
+
+bool same_t(double a, double b) { return std::fabs(a - b) <= 1e-9 * (1 + std::fabs(a)); }
+
+bool same_hits(const Hits &a, const Hits &b) {
+    if (a.n != b.n) return false;
+    for (size_t i = 0; i < a.h.size(); i++)
+        if (a.h[i].primitive != b.h[i].primitive || a.h[i].entering != b.h[i].entering || !same_t(a.h[i].t, b.h[i].t))
+            return false;
+    return true;
+}
+
+std::string fmt_hits(const Hits &a) {
+    std::ostringstream s;
+    s << a.n << " hit" << (a.n == 1 ? "" : "s");
+    size_t shown = std::min<size_t>(a.h.size(), 12);
+    for (size_t i = 0; i < shown; i++) {
+        char b[96];
+        std::snprintf(b, sizeof b, " [t=%.17g prim %d %s]", a.h[i].t, a.h[i].primitive, a.h[i].entering ? "in" : "out");
+        s << b;
+    }
+    if (a.h.size() > shown) s << " ...";
+    return s.str();
+}
+
+// ---- the collection of mismatches ----
+struct Report {
+    long scenes = 0, rays = 0, rays_hitting = 0, hits = 0, comparisons = 0, mismatches = 0, failed_prepares = 0;
+    std::vector<std::string> first;  // in full
+    std::map<std::string, long> by_options, by_ray, by_scene;
+    void add(const std::string &scene, const std::string &kind_of_scene, const Opts &o, const RayCase &r,
+             const Hits &want, const Hits &got) {
+        mismatches++;
+        by_options[o.text()]++;
+        by_ray[ray_kind_name(r.kind)]++;
+        by_scene[kind_of_scene]++;
+        if (first.size() < 25)
+            first.push_back(scene + ", " + o.text() + ", " + fmt_ray(r) + "\n      expected " + fmt_hits(want) +
+                            "\n      actual   " + fmt_hits(got));
+    }
+    std::string text() const {
+        std::ostringstream s;
+        s << scenes << " scenes, " << rays << " rays (" << rays_hitting << " with hits, " << hits << " hits), " << comparisons << " comparisons, " << mismatches
+          << " mismatches, " << failed_prepares << " failed prepares\n";
+        if (!mismatches) return s.str();
+        s << "mismatches by scene kind:";
+        for (auto &kv : by_scene) s << " " << kv.first << "=" << kv.second;
+        s << "\nmismatches by ray kind:";
+        for (auto &kv : by_ray) s << " [" << kv.first << "]=" << kv.second;
+        s << "\nmismatches by options:";
+        for (auto &kv : by_options) s << "\n    " << kv.first << ": " << kv.second;
+        s << "\nfirst mismatches:\n";
+        for (auto &m : first) s << "  - " << m << "\n";
+        return s.str();
+    }
+};
+
+// Compare every switch combination with the reference on one scene.
+void check_scene(int kind, uint64_t seed, Report &rep) {
+    pray_ctx *c = pray_new();
+    REQUIRE(c);
+    Scene s = make_scene(c, kind, seed);
+    INFO(s.label);
+    CHECK_MESSAGE(s.root != nullptr, pray_error(c));
+    if (!s.root) {
+        pray_free(c);
+        return;
+    }
+    Rng rng(seed * 31 + 7 + (uint64_t)kind * 1000003);
+    std::vector<RayCase> rays = make_rays(s, rng);
+    // the reference
+    REQUIRE(apply(c, reference()));
+    pray_scene *ref = pray_prepare(c, s.root);
+    CHECK_MESSAGE(ref != nullptr, pray_error(c));
+    if (!ref) {
+        rep.failed_prepares++;
+        pray_free(c);
+        return;
+    }
+    std::vector<Hits> want;
+    for (const RayCase &r : rays) want.push_back(intersect(c, ref, r));
+    // shadow-like rays ending exactly at a surface (the hit at tmax is not counted)
+    size_t nbase = rays.size();
+    for (size_t i = 0, added = 0; i < nbase && added < 16; i++) {
+        if (want[i].h.empty() || rng.chance(0.6)) continue;
+        RayCase r = rays[i];
+        r.kind = R_TMAX_HIT;
+        r.tmax = want[i].h[rng.below((int)want[i].h.size())].t;
+        rays.push_back(r);
+        want.push_back(intersect(c, ref, r));
+        added++;
+    }
+    for (size_t i = 0; i < rays.size(); i++)
+        if (want[i].n < 0) {
+            FAIL_CHECK("the reference failed on " << fmt_ray(rays[i]) << ": " << pray_error(c));
+            want[i].n = 0;
+        }
+    pray_scene_free(c, ref);
+    for (const Hits &h : want) {
+        rep.rays_hitting += h.n > 0;
+        rep.hits += h.n;
+    }
+    rep.scenes++;
+    rep.rays += (long)rays.size();
+    for (const Opts &o : all_combinations()) {
+        REQUIRE(apply(c, o));
+        pray_scene *q = pray_prepare(c, s.root);
+        if (!q) {
+            rep.failed_prepares++;
+            FAIL_CHECK(s.label << ", " << o.text() << ": pray_prepare failed: " << pray_error(c));
+            continue;
+        }
+        for (size_t i = 0; i < rays.size(); i++) {
+            Hits got = intersect(c, q, rays[i]);
+            rep.comparisons++;
+            if (!same_hits(want[i], got)) rep.add(s.label, kind_name(kind), o, rays[i], want[i], got);
+        }
+        pray_scene_free(c, q);
+    }
+    pray_free(c);
+}
+
+void run_kind(int kind, int first_seed, int count, Report &total) {
+    Report rep;
+    auto t0 = std::chrono::steady_clock::now();
+    for (int i = 0; i < count; i++) check_scene(kind, (uint64_t)(first_seed + i), rep);
+    double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    MESSAGE(std::string(kind_name(kind)) << " scenes: " << rep.text() << secs << " s");
+    CHECK_MESSAGE(rep.mismatches == 0, rep.text());
+    CHECK(rep.failed_prepares == 0);
+    total.scenes += rep.scenes;
+    total.rays += rep.rays;
+    total.rays_hitting += rep.rays_hitting;
+    total.hits += rep.hits;
+    total.comparisons += rep.comparisons;
+    total.mismatches += rep.mismatches;
+}
+
+Report g_total;
+
+} // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Identical hits: reference vs every combination of grid x freeze x merge x bounds.
+// ---------------------------------------------------------------------------------------------
+TEST_CASE("accel hits: random CSG trees of spheres, half-spaces, boxes, cylinders (140 seeds)") {
+    run_kind(K_RANDOM, 1, 140, g_total);
+}
+TEST_CASE("accel hits: many small spheres in a union minus a few solids (12 seeds)") {
+    run_kind(K_MANY, 1, 12, g_total);
+}
+TEST_CASE("accel hits: lattices of touching spheres (15 seeds)") { run_kind(K_LATTICE, 1, 15, g_total); }
+TEST_CASE("accel hits: blocks sharing faces, on quarter units (20 seeds)") { run_kind(K_BLOCKS, 1, 20, g_total); }
+TEST_CASE("accel hits: an unbounded floor with solids on it (15 seeds)") { run_kind(K_FLOOR, 1, 15, g_total); }
+TEST_CASE("accel hits: scenes scaled from 1e-3 to 1e6 and moved far from the origin (20 seeds)") {
+    run_kind(K_SCALED, 1, 20, g_total);
+    MESSAGE("all scene kinds so far: " << g_total.text());
+}
+
+// ---------------------------------------------------------------------------------------------
+// Identical images and fewer intersection tests with freezing: the example programs.
+// ---------------------------------------------------------------------------------------------
+namespace {
+
+// A program run with fixed options, its frames and statistics.
+struct Run {
+    pray_status status = PRAY_OK;
+    std::string error;
+    std::vector<testkit::Frame> frames;
+    pray_stats stats;
+};
+
+Run run_program(const std::string &name, const std::string &text, const std::vector<std::string> &options) {
+    Run r;
+    std::memset(&r.stats, 0, sizeof r.stats);
+    pray_ctx *c = pray_new();
+    REQUIRE(c);
+    pray_set_print(c, nullptr, nullptr);
+    pray_set_frame(c, testkit::frame_sink, &r.frames);
+    for (const std::string &o : options) {
+        size_t eq = o.find('=');
+        pray_status st = pray_option_fix(c, o.substr(0, eq).c_str(), o.substr(eq + 1).c_str());
+        CHECK_MESSAGE(st == PRAY_OK, o << ": " << pray_error(c));
+    }
+    r.status = pray_run_string(c, name.c_str(), text.data(), text.size());
+    if (r.status != PRAY_OK) r.error = pray_error(c);
+    pray_stats_get(c, &r.stats);
+    pray_free(c);
+    return r;
+}
+
+bool read_file(const std::string &path, std::string *out) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) return false;
+    std::ostringstream s;
+    s << f.rdbuf();
+    *out = s.str();
+    return true;
+}
+
+// The example programs (all but redsphx.ray, which is an error on purpose), read from
+// examples/ next to the tests' working directory.
+std::vector<std::pair<std::string, std::string>> example_programs() {
+    static const char *names[] = {"anim.ray", "csg.ray", "glass.ray", "holes.ray", "loop.ray",
+                                  "mirror.ray", "models.ray", "parallel.ray", "redsph.ray"};
+    std::vector<std::pair<std::string, std::string>> v;
+    for (const char *n : names) {
+        std::string text;
+        bool ok = false;
+        for (const char *dir : {"examples/", "../examples/", "../../examples/"})
+            if (read_file(std::string(dir) + n, &text)) {
+                ok = true;
+                break;
+            }
+        CHECK_MESSAGE(ok, "cannot read examples/" << n << " (run the tests from the repository's top directory)");
+        if (ok) v.push_back(std::make_pair(std::string(n), text));
+    }
+    return v;
+}
+
+// "" when the frames are identical, float for float; else what differs.
+std::string frame_difference(const std::vector<testkit::Frame> &want, const std::vector<testkit::Frame> &got) {
+    std::ostringstream s;
+    if (want.size() != got.size()) {
+        s << want.size() << " frames expected, " << got.size() << " rendered";
+        return s.str();
+    }
+    for (size_t k = 0; k < want.size(); k++) {
+        const testkit::Frame &a = want[k], &b = got[k];
+        if (a.width != b.width || a.height != b.height) {
+            s << "frame " << k << ": " << a.width << "x" << a.height << " expected, " << b.width << "x" << b.height;
+            return s.str();
+        }
+        long diff = 0;
+        std::ostringstream first;
+        for (int y = 0; y < a.height; y++)
+            for (int x = 0; x < a.width; x++)
+                for (int ch = 0; ch < 3; ch++) {
+                    float u = a.at(x, y, ch), v = b.at(x, y, ch);
+                    if (std::memcmp(&u, &v, sizeof u) == 0) continue;
+                    if (diff++ < 4) {
+                        char buf[160];
+                        std::snprintf(buf, sizeof buf, " (%d,%d) channel %d: %.9g expected, %.9g", x, y, ch, u, v);
+                        first << buf;
+                    }
+                }
+        if (diff) {
+            s << "frame " << k << ": " << diff << " samples differ;" << first.str();
+            return s.str();
+        }
+    }
+    return "";
+}
+
+} // namespace
+
+TEST_CASE("accel images: every example, every switch combination, the same floats as --brute; freezing never "
+          "adds intersection tests") {
+    auto t0 = std::chrono::steady_clock::now();
+    long runs = 0, image_mismatches = 0, freeze_violations = 0;
+    std::vector<std::string> problems;
+    for (auto &ex : example_programs()) {
+        CAPTURE(ex.first);
+        std::vector<std::string> size = {"width=48", "height=48"};
+        std::vector<std::string> ropts = size;
+        for (auto &o : reference().fixed()) ropts.push_back(o);
+        Run ref = run_program(ex.first, ex.second, ropts);
+        REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
+        REQUIRE(!ref.frames.empty());
+        CHECK(ref.frames[0].width == 48);
+        CHECK(ref.frames[0].height == 48);
+        CHECK(ref.frames.size() == (ex.first == "anim.ray" ? 3u : 1u));
+        runs++;
+        // tests[grid][merge][bounds][freeze]
+        double tests[NGRIDS][2][2][2];
+        for (const Opts &o : all_combinations()) {
+            std::vector<std::string> opts = size;
+            for (auto &x : o.fixed()) opts.push_back(x);
+            Run r = run_program(ex.first, ex.second, opts);
+            runs++;
+            CHECK_MESSAGE(r.status == PRAY_OK, ex.first << ", " << o.text() << ": " << r.error);
+            std::string d = frame_difference(ref.frames, r.frames);
+            if (!d.empty()) {
+                image_mismatches++;
+                if (problems.size() < 20) problems.push_back(ex.first + ", " + o.text() + ": " + d);
+            }
+            int g = (int)(std::find(GRIDS, GRIDS + NGRIDS, o.grid) - GRIDS);
+            tests[g][o.merge][o.bounds][o.freeze] = r.stats.intersection_tests;
+        }
+        for (int g = 0; g < NGRIDS; g++)
+            for (int m = 0; m < 2; m++)
+                for (int b = 0; b < 2; b++)
+                    if (tests[g][m][b][1] > tests[g][m][b][0]) {
+                        freeze_violations++;
+                        char buf[200];
+                        std::snprintf(buf, sizeof buf, "%s, grid=%d merge=%d bounds=%d: %.0f intersection tests with freeze=1, %.0f with freeze=0",
+                                      ex.first.c_str(), GRIDS[g], m, b, tests[g][m][b][1], tests[g][m][b][0]);
+                        if (problems.size() < 40) problems.push_back(buf);
+                    }
+    }
+    double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::string all;
+    for (auto &p : problems) all += "\n  - " + p;
+    MESSAGE(runs << " program runs, " << image_mismatches << " differing images, " << freeze_violations
+                 << " freeze violations, " << secs << " s");
+    CHECK_MESSAGE(image_mismatches == 0, image_mismatches << " runs whose frames differ from brute=1:" << all);
+    CHECK_MESSAGE(freeze_violations == 0, freeze_violations << " cases where freezing added intersection tests:" << all);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Random scenes rendered through pray_render: the same images, fewer tests with freezing.
+// ---------------------------------------------------------------------------------------------
+namespace {
+
+struct Render {
+    pray_status status = PRAY_OK;
+    std::string error;
+    std::vector<testkit::Frame> frames;  // one
+    pray_stats stats;                    // of this render alone (differences of the totals)
+};
+
+Render render(pray_ctx *c, pray_object *root, pray_light *lights, const Opts &o, int size) {
+    Render r;
+    REQUIRE(apply(c, o));
+    REQUIRE(pray_option(c, "width", size) == PRAY_OK);
+    REQUIRE(pray_option(c, "height", size) == PRAY_OK);
+    pray_stats before, after;
+    pray_stats_get(c, &before);
+    pray_image img;
+    r.status = pray_render(c, root, lights, &img);
+    pray_stats_get(c, &after);
+    r.stats = after;
+    r.stats.intersection_tests = after.intersection_tests - before.intersection_tests;
+    r.stats.voxel_steps = after.voxel_steps - before.voxel_steps;
+    r.stats.area_moves = after.area_moves - before.area_moves;
+    r.stats.checks = after.checks - before.checks;
+    r.stats.rays_primary = after.rays_primary - before.rays_primary;
+    r.stats.rays_shadow = after.rays_shadow - before.rays_shadow;
+    if (r.status != PRAY_OK) {
+        r.error = pray_error(c);
+        return r;
+    }
+    testkit::frame_sink(&r.frames, &img, "render");
+    pray_image_free(c, &img);
+    return r;
+}
+
+pray_light *some_lights(pray_ctx *c) {
+    pray_rgb w = {0.7, 0.7, 0.7}, w2 = {0.4, 0.4, 0.4};
+    return pray_light_add(c, pray_dirlight(c, w, V(1, 2, -3)), pray_pointlight(c, w2, V(-2, -3, 2)));
+}
+
+} // namespace
+
+TEST_CASE("accel images: random scenes rendered with every switch combination equal the reference; freezing "
+          "never adds intersection tests") {
+    struct Pick {
+        int kind, seed;
+    };
+    const Pick picks[] = {{K_RANDOM, 3}, {K_RANDOM, 17}, {K_RANDOM, 42}, {K_RANDOM, 77}, {K_RANDOM, 101},
+                          {K_MANY, 2},   {K_MANY, 5},    {K_LATTICE, 1}, {K_LATTICE, 4}, {K_BLOCKS, 3},
+                          {K_BLOCKS, 12}, {K_FLOOR, 2},  {K_FLOOR, 9}};
+    auto t0 = std::chrono::steady_clock::now();
+    long renders = 0, image_mismatches = 0, freeze_violations = 0;
+    std::vector<std::string> problems;
+    for (const Pick &pk : picks) {
+        pray_ctx *c = pray_new();
+        REQUIRE(c);
+        Scene s = make_scene(c, pk.kind, (uint64_t)pk.seed);
+        CAPTURE(s.label);
+        REQUIRE_MESSAGE(s.root, pray_error(c));
+        pray_light *lights = some_lights(c);
+        REQUIRE(lights);
+        Render ref = render(c, s.root, lights, reference(), 40);
+        REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
+        renders++;
+        double tests[NGRIDS][2][2][2];
+        for (const Opts &o : all_combinations()) {
+            Render r = render(c, s.root, lights, o, 40);
+            renders++;
+            CHECK_MESSAGE(r.status == PRAY_OK, s.label << ", " << o.text() << ": " << r.error);
+            std::string d = frame_difference(ref.frames, r.frames);
+            if (!d.empty()) {
+                image_mismatches++;
+                if (problems.size() < 20) problems.push_back(s.label + ", " + o.text() + ": " + d);
+            }
+            int g = (int)(std::find(GRIDS, GRIDS + NGRIDS, o.grid) - GRIDS);
+            tests[g][o.merge][o.bounds][o.freeze] = r.stats.intersection_tests;
+        }
+        for (int g = 0; g < NGRIDS; g++)
+            for (int m = 0; m < 2; m++)
+                for (int b = 0; b < 2; b++)
+                    if (tests[g][m][b][1] > tests[g][m][b][0]) {
+                        freeze_violations++;
+                        char buf[200];
+                        std::snprintf(buf, sizeof buf, "%s, grid=%d merge=%d bounds=%d: %.0f intersection tests with freeze=1, %.0f with freeze=0",
+                                      s.label.c_str(), GRIDS[g], m, b, tests[g][m][b][1], tests[g][m][b][0]);
+                        if (problems.size() < 40) problems.push_back(buf);
+                    }
+        pray_free(c);
+    }
+    double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::string all;
+    for (auto &p : problems) all += "\n  - " + p;
+    MESSAGE(renders << " renders of random scenes, " << image_mismatches << " differing images, " << freeze_violations
+                    << " freeze violations, " << secs << " s");
+    CHECK_MESSAGE(image_mismatches == 0, image_mismatches << " renders differ from brute=1:" << all);
+    CHECK_MESSAGE(freeze_violations == 0, freeze_violations << " cases where freezing added intersection tests:" << all);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Statistics.
+// ---------------------------------------------------------------------------------------------
+namespace {
+
+// 300 small spheres crowded into one corner and one sphere in the opposite corner: the grid
+// between them is empty space, crossed by many rays.
+pray_object *corner_cluster(pray_ctx *c, int *declared) {
+    pray_rgb d = {0.6, 0.6, 0.6}, z = {0, 0, 0};
+    pray_model *m = pray_phong(c, d, z, z, 1);
+    Rng rng(2024);
+    pray_object *root = nullptr;
+    for (int i = 0; i < 300; i++) {
+        pray_object *s = pray_sphere(c, m, V(rng.range(-1, -0.5), rng.range(-1, -0.5), rng.range(-1, -0.5)), rng.range(0.02, 0.06));
+        root = root ? pray_csg(c, PRAY_UNION, root, s) : s;
+    }
+    root = pray_csg(c, PRAY_UNION, root, pray_sphere(c, m, V(0.8, 0.8, 0.8), 0.15));
+    *declared = 301;
+    return root;
+}
+
+std::string stats_text(const pray_stats &s) {
+    char b[512];
+    std::snprintf(b, sizeof b,
+                  "primitives %ld declared %ld kept, nodes %ld, grid %d x %d x %d = %ld voxels, %ld lists, %ld areas, "
+                  "memory %.0f, rays %.0f/%.0f, steps %.0f, moves %.0f, checks %.0f, tests %.0f, frozen %.0f",
+                  s.primitives_declared, s.primitives, s.nodes, s.grid[0], s.grid[1], s.grid[2], s.voxels, s.lists,
+                  s.areas, s.memory, s.rays_primary, s.rays_shadow, s.voxel_steps, s.area_moves, s.checks,
+                  s.intersection_tests, s.frozen_skips);
+    return b;
+}
+
+} // namespace
+
+TEST_CASE("accel stats: a grid has voxels, lists and areas; merging moves through empty space; no grid has none") {
+    pray_ctx *c = pray_new();
+    REQUIRE(c);
+    int declared = 0;
+    pray_object *root = corner_cluster(c, &declared);
+    REQUIRE(root);
+    pray_light *lights = some_lights(c);
+    for (int g : {16, 5, -1}) {
+        for (int merge = 0; merge < 2; merge++) {
+            Opts o{0, g, 1, merge, 1};
+            Render r = render(c, root, lights, o, 32);
+            const pray_stats &s = r.stats;
+            INFO(o.text(), ": ", stats_text(s));
+            REQUIRE(r.status == PRAY_OK);
+            CHECK(s.grid[0] > 0);
+            CHECK(s.grid[1] > 0);
+            CHECK(s.grid[2] > 0);
+            if (g > 0) CHECK(std::max(s.grid[0], std::max(s.grid[1], s.grid[2])) >= g);
+            CHECK(s.voxels == (long)s.grid[0] * s.grid[1] * s.grid[2]);
+            CHECK(s.lists >= 1);
+            CHECK(s.areas >= 1);
+            CHECK(s.areas <= s.voxels);
+            CHECK(s.memory > 0);
+            CHECK(s.primitives_declared == declared);
+            CHECK(s.primitives_declared >= s.primitives);
+            CHECK(s.primitives >= 1);
+            CHECK(s.nodes >= 1);
+            CHECK(s.rays_primary == 32 * 32);
+            CHECK(s.voxel_steps > 0);
+            CHECK(s.checks > 0);
+            CHECK(s.intersection_tests > 0);
+            if (merge) {
+                CHECK(s.area_moves > 0);
+                CHECK(s.area_moves <= s.voxel_steps);
+            } else
+                CHECK(s.area_moves == 0);
+        }
+    }
+    // no grid: grid=0, and the reference
+    for (const Opts &o : {Opts{0, 0, 1, 1, 1}, Opts{0, 0, 0, 0, 0}}) {
+        Render r = render(c, root, lights, o, 32);
+        const pray_stats &s = r.stats;
+        INFO(o.text(), ": ", stats_text(s));
+        REQUIRE(r.status == PRAY_OK);
+        CHECK(s.grid[0] == 0);
+        CHECK(s.grid[1] == 0);
+        CHECK(s.grid[2] == 0);
+        CHECK(s.voxels == 0);
+        CHECK(s.voxel_steps == 0);
+        CHECK(s.area_moves == 0);
+        CHECK(s.primitives_declared >= s.primitives);
+        CHECK(s.intersection_tests > 0);
+    }
+    pray_free(c);
+    pray_ctx *b = pray_new();  // a fresh context: the reference builds no grid at all
+    REQUIRE(b);
+    root = corner_cluster(b, &declared);
+    Render r = render(b, root, nullptr, reference(), 16);
+    INFO("brute=1: ", stats_text(r.stats));
+    REQUIRE(r.status == PRAY_OK);
+    CHECK(r.stats.grid[0] == 0);
+    CHECK(r.stats.grid[1] == 0);
+    CHECK(r.stats.grid[2] == 0);
+    CHECK(r.stats.voxels == 0);
+    CHECK(r.stats.primitives_declared == declared);
+    CHECK(r.stats.primitives_declared >= r.stats.primitives);
+    // every primitive is tested on every ray by the reference
+    CHECK(r.stats.intersection_tests >= r.stats.rays_primary * r.stats.primitives);
+    pray_free(b);
+}
+
+TEST_CASE("accel stats: of a program run; parts that cannot matter are not kept") {
+    // A sphere minus a sphere far away: with bounds the subtracted part is dropped.
+    const std::string program =
+        "M = phong({0.5}, {0}, 1)\n"
+        "A = sphere(M, [0, 0, 0], 0.5) - sphere(M, [3, 0, 0], 0.5)\n"
+        "B = A | sphere(M, [0.5, 0, 0.5], 0.2) | sphere(M, [-0.5, 0, 0.5], 0.2) | sphere(M, [0, 0.5, -0.5], 0.2)\n"
+        "rendertiff B | sphere(M, [0.9, 0.9, 0.9], 0.1), dirlight({1}, <1, 1, -1>)\n";
+    for (int bounds = 0; bounds < 2; bounds++) {
+        Run r = run_program("stats.ray", program, {"width=24", "height=24", "grid=6", "merge=1", "freeze=1", "brute=0",
+                                                    "bounds=" + std::to_string(bounds)});
+        INFO("bounds=", bounds, ": ", stats_text(r.stats));
+        REQUIRE_MESSAGE(r.status == PRAY_OK, r.error);
+        CHECK(r.stats.primitives_declared == 6);
+        CHECK(r.stats.primitives_declared >= r.stats.primitives);
+        if (bounds) CHECK(r.stats.primitives < r.stats.primitives_declared);
+        CHECK(r.stats.grid[0] > 0);
+        CHECK(r.stats.voxels == (long)r.stats.grid[0] * r.stats.grid[1] * r.stats.grid[2]);
+        CHECK(r.stats.lists >= 1);
+        CHECK(r.stats.areas >= 1);
+        CHECK(r.stats.rays_primary == 24 * 24);
+        CHECK(r.stats.voxel_steps > 0);
+    }
+    Run r = run_program("stats.ray", program, {"width=24", "height=24", "grid=0", "brute=0"});
+    INFO("grid=0: ", stats_text(r.stats));
+    REQUIRE_MESSAGE(r.status == PRAY_OK, r.error);
+    CHECK(r.stats.grid[0] == 0);
+    CHECK(r.stats.grid[1] == 0);
+    CHECK(r.stats.grid[2] == 0);
+    CHECK(r.stats.voxels == 0);
+}
