@@ -17,6 +17,7 @@ PACKAGES  = doctest-dev libstb-dev python3 python3-pil libtiff-tools
 
 PRAY  = pray$(EXE)
 TESTS = tests/pray_tests$(EXE)
+TESTS_FLOAT = tests/pray_tests_float$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
 .PHONY: all examples check deps matrix clean embed
@@ -44,8 +45,12 @@ examples: $(PRAY)
 	  printf '%-12s' $$n; $(RUN) ./$(PRAY) --quiet -o out/$$n.$$ext $$f >/dev/null || exit 1; echo " -> out/$$n.$$ext"; \
 	done
 
-$(TESTS): $(TEST_SRC) tests/testkit.hpp pray.cpp pray.hpp
+$(TESTS): $(TEST_SRC) tests/*.hpp pray.cpp pray.hpp
 	$(CXX) $(TESTFLAGS) $(TEST_SRC) -o $@ $(LDLIBS) -lpthread
+
+# The same tests with the renderer in single precision (PRAY_REAL=float).
+$(TESTS_FLOAT): $(TEST_SRC) tests/*.hpp pray.cpp pray.hpp
+	$(CXX) $(TESTFLAGS) -DPRAY_REAL=float $(TEST_SRC) -o $@ $(LDLIBS) -lpthread
 
 # The C example: pray.hpp must be usable from C.
 tests/embed$(EXE): examples/embed.c pray.cpp pray.hpp
@@ -54,8 +59,11 @@ tests/embed$(EXE): examples/embed.c pray.cpp pray.hpp
 	$(CXX) tests/embed.o tests/pray.o -o $@ $(LDLIBS)
 embed: tests/embed$(EXE)
 
-check: deps $(PRAY) $(TESTS) tests/embed$(EXE)
+check: deps $(PRAY) $(TESTS) $(TESTS_FLOAT) tests/embed$(EXE)
 	$(RUN) ./tests/embed$(EXE) tests/embed.ppm
+	@echo "== tests, PRAY_REAL=float"
+	$(RUN) ./$(TESTS_FLOAT)
+	@echo "== tests, PRAY_REAL=double"
 	$(RUN) ./$(TESTS)
 
 # Every configuration macro on its own, float and double, C++98/11/17, warnings as errors.
@@ -69,4 +77,4 @@ matrix:
 	  echo ok; done; done
 
 clean:
-	rm -rf $(PRAY) $(TESTS) tests/embed$(EXE) tests/*.o tests/*.ppm out
+	rm -rf $(PRAY) $(TESTS) $(TESTS_FLOAT) tests/embed$(EXE) tests/*.o tests/*.ppm out

@@ -1018,6 +1018,18 @@ void box_clip(Box *a, const Box &b) {
 }
 real comp(R3 v, int i) { return i == 0 ? v.x : i == 1 ? v.y : v.z; }
 
+// A box must contain its solid also after rounding in `real`: widen finite sides by a few units
+// in the last place of the largest coordinate involved.
+void box_pad(Box *b, double scale) {
+    const double eps = sizeof(real) == sizeof(float) ? FLT_EPSILON : DBL_EPSILON;
+    for (int i = 0; i < 3; i++) {
+        double m = fabs((double)b->lo[i]) > fabs((double)b->hi[i]) ? fabs((double)b->lo[i]) : fabs((double)b->hi[i]);
+        double pad = 8 * eps * (m + scale);
+        if (b->lo[i] > -REAL_BIG) b->lo[i] = (real)((double)b->lo[i] - pad);
+        if (b->hi[i] < REAL_BIG) b->hi[i] = (real)((double)b->hi[i] + pad);
+    }
+}
+
 Box prim_box(const Prim &q) {
     Box b = box_all();
     for (int i = 0; i < 3; i++) {
@@ -1037,6 +1049,7 @@ Box prim_box(const Prim &q) {
             if (others == 2 && n < 0) b.lo[i] = q.d / n;
         }
     }
+    box_pad(&b, (double)q.r + fabs((double)q.p.x) + fabs((double)q.p.y) + fabs((double)q.p.z));
     return b;
 }
 
@@ -1093,8 +1106,9 @@ void polyhedron_box(const Scene *s, const int *kids, int n, Box *b) {
                 }
             }
     if (!found) return;  // numerically empty: keep the plain box, never fold on this evidence
+    const double rel = sizeof(real) == sizeof(float) ? 64 * FLT_EPSILON : 1e-9;
     for (int l = 0; l < 3; l++) {
-        double pad = 1e-9 * (fabs(lo[l]) + fabs(hi[l]) + 1);
+        double pad = rel * (fabs(lo[l]) + fabs(hi[l]) + 1);
         if (lo[l] > -BIG / 2 && lo[l] - pad > (double)b->lo[l]) b->lo[l] = (real)(lo[l] - pad);
         if (hi[l] < BIG / 2 && hi[l] + pad < (double)b->hi[l]) b->hi[l] = (real)(hi[l] + pad);
     }
@@ -1280,17 +1294,30 @@ void snap_key(const Prim &q, SnapKey *k) {
     }
 }
 
+// Within a few units in the last place of the largest coordinate involved: rounding, not design.
 bool snap_close(const Prim &a, const Prim &b, int sa, int sb) {
-    const double tol = 64 * (sizeof(real) == sizeof(float) ? FLT_EPSILON : DBL_EPSILON);
-    double scale = 1;
+    const double eps = sizeof(real) == sizeof(float) ? FLT_EPSILON : DBL_EPSILON;
+    double m = 0;
+    const Prim *both[2] = {&a, &b};
+    for (int k = 0; k < 2; k++) {
+        const Prim &q = *both[k];
+        double v[5] = {(double)q.p.x, (double)q.p.y, (double)q.p.z, (double)q.r, (double)q.d};
+        for (int i = 0; i < 5; i++)
+            if (fabs(v[i]) > m) m = fabs(v[i]);
+    }
+    double tol = 8 * eps * m;
     R3 na = a.n * (real)sa, nb = b.n * (real)sb;
-    R3 dn = na - nb, dp = a.p - b.p;
-    scale += fabs((double)a.p.x) + fabs((double)a.p.y) + fabs((double)a.p.z) + fabs((double)a.r);
-    if (a.kind == O_SPHERE) return fabs((double)dot(dp, dp)) <= tol * tol * scale * scale && fabs((double)(a.r - b.r)) <= tol * scale;
-    if (fabs((double)dn.x) > tol || fabs((double)dn.y) > tol || fabs((double)dn.z) > tol) return false;
-    if (a.kind == O_PLANE) return fabs((double)(a.d * (real)sa - b.d * (real)sb)) <= tol * (1 + fabs((double)a.d));
+    R3 dp = a.p - b.p;
+    if (a.kind == O_SPHERE)
+        return fabs((double)dp.x) <= tol && fabs((double)dp.y) <= tol && fabs((double)dp.z) <= tol &&
+               fabs((double)(a.r - b.r)) <= tol;
+    R3 dn = na - nb;
+    const double ntol = 8 * eps;
+    if (fabs((double)dn.x) > ntol || fabs((double)dn.y) > ntol || fabs((double)dn.z) > ntol) return false;
+    if (a.kind == O_PLANE) return fabs((double)(a.d * (real)sa - b.d * (real)sb)) <= tol;
     R3 perp = dp - na * dot(dp, na);  // axes: the same line within tolerance
-    return fabs((double)(a.r - b.r)) <= tol * scale && (double)dot(perp, perp) <= tol * tol * scale * scale;
+    return fabs((double)(a.r - b.r)) <= tol && fabs((double)perp.x) <= tol && fabs((double)perp.y) <= tol &&
+           fabs((double)perp.z) <= tol;
 }
 
 pray_status snap_coincident(pray_ctx *c, Scene *s) {
@@ -2125,9 +2152,15 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
     cand.init();
     start.init();
     cls.init();
+    double margin = 0;
     if (want > 0) {
         a->h = (real)(ext / want);
-        double margin = (double)a->h * 1e-6 + 64 * eps * (mag + ext) * (want + 4);
+        margin = (double)a->h * 1e-6 + 64 * eps * (mag + ext) * (want + 4);
+        // far from the origin in low precision the voxels would be smaller than the rounding
+        // of the positions: then no grid
+        if (margin > (double)a->h / 4) want = 0;
+    }
+    if (want > 0) {
         long nv = 1;
         for (int l = 0; l < 3; l++) {
             double len = (double)(region.hi[l] - region.lo[l]) + 2 * margin;
@@ -2677,7 +2710,9 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     s->kids.init();
     s->prune = opt_int(c, OPT_BOUNDS) && !opt_int(c, OPT_BRUTE);
     s->root = flatten(c, s, root);
-    if (s->root == -3 || scene_compact(c, s) || snap_coincident(c, s)) return c->status;
+    // snapped before compaction, over every primitive flattened, so that the reference and the
+    // simplified scene give the same surviving primitives the same numbers
+    if (s->root == -3 || snap_coincident(c, s) || scene_compact(c, s)) return c->status;
     c->stats.primitives_declared = root->nprims;
     if (!opt_int(c, OPT_BRUTE) && accel_build(c, s)) return c->status;
     for (int i = 0; lights && i < lights->n; i++) {

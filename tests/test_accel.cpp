@@ -19,6 +19,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <map>
@@ -76,14 +77,15 @@ bool apply(pray_ctx *c, const Opts &o) {
 enum RayKind {
     R_RANDOM, R_AXIS, R_GRID_EDGE, R_GRID_FACE, R_GRID_CORNER, R_GRID_SLOPE, R_FRACTION, R_BOX_CORNER,
     R_IN_GRID, R_ON_BOX, R_IN_SOLID, R_TANGENT_SPHERE, R_TANGENT_CYL, R_ALONG_CYL, R_IN_FACE, R_TMAX,
-    R_TMAX_HIT, R_NKINDS
+    R_TMAX_HIT, R_NEAR_AXIS, R_TMAX_GRID, R_GRID_EXIT, R_NKINDS
 };
 const char *ray_kind_name(int k) {
     static const char *n[] = {"random", "axis-parallel", "along grid edge", "in grid face", "grid corner diagonal",
                               "grid corner slope", "on 1/8,1/16 fractions", "through box corner",
                               "starting inside grid", "starting on box boundary", "starting inside solid",
                               "tangent to sphere", "tangent to cylinder", "along cylinder surface",
-                              "in a plane face", "tmax limit", "tmax at a hit"};
+                              "in a plane face", "tmax limit", "tmax at a hit", "nearly axis-parallel",
+                              "tmax at a grid corner", "crossing a face where it leaves the grid"};
     return n[k];
 }
 
@@ -192,6 +194,32 @@ std::vector<RayCase> make_rays(const Scene &s, Rng &rng) {
                 int m = rng.below(4);
                 double back = m == 3 ? (g.n[0] + g.n[1] + g.n[2] + 1) * g.h : m * g.h;
                 push(sub(P, mul(d, back)), d, R_GRID_CORNER);
+            }
+            // diagonals ending exactly at a corner of a voxel (tmax), from inside the grid
+            {
+                pray_vec P = corner();
+                pray_vec d = diag_dir();
+                int k = 1 + rng.below(3);
+                push(P, d, R_TMAX_GRID, k * g.h * len(d));
+            }
+            // leaving (or entering) the grid's box exactly where the ray crosses a face of an
+            // axis-aligned box: the last stretch in the grid and the one after it must meet
+            for (int i = 0; i < 2 && !s.boxes.empty(); i++) {
+                const BoxRec &b = s.boxes[rng.below((int)s.boxes.size())];
+                int l = rng.below(3), m = (l + 1 + rng.below(2)) % 3, q = 3 - l - m, k = -1;
+                for (int j = 0; j < 3; j++)
+                    if (std::fabs(comp(b.u[j], m)) == 1) k = j;
+                if (k < 0) continue;  // a tilted box
+                bool high = rng.chance(0.5);
+                pray_vec P = V(0, 0, 0);
+                set_comp(P, l, high ? g.face(l, g.n[l]) : g.face(l, 0));
+                set_comp(P, m, comp(b.c, m) + rng.sign() * b.h[k]);
+                set_comp(P, q, rng.chance(0.5) ? face(q) : comp(b.c, q) + rng.range(-1, 1) * ext / 4);
+                pray_vec d = rng.chance(0.5) ? diag_dir() : rng.dir();
+                if (comp(d, l) == 0) set_comp(d, l, 1);
+                double out = high ? 1 : -1;  // leaving the grid through P, mostly
+                if (rng.chance(0.75) ? comp(d, l) * out < 0 : comp(d, l) * out > 0) set_comp(d, l, -comp(d, l));
+                push(sub(P, mul(unit(d), rng.range(0.25, 2) * ext)), d, R_GRID_EXIT);
             }
             // small integer slopes through a corner: through corners and edges periodically
             {
@@ -317,6 +345,18 @@ std::vector<RayCase> make_rays(const Scene &s, Rng &rng) {
             push(sub(q.p, mul(d, far)), d, R_IN_FACE);
         }
     }
+    // nearly parallel to an axis: the other components tiny, down to subnormal numbers
+    for (int i = 0; i < 8; i++) {
+        static const double tiny[] = {1e-9, 1e-17, 1e-200, 4e-310};
+        int a = rng.below(3);
+        pray_vec d = axis_vec(a, rng.sign());
+        for (int l = 0; l < 3; l++)
+            if (l != a && rng.chance(0.7)) set_comp(d, l, rng.sign() * tiny[rng.below(4)]);
+        pray_vec o = rng.in_box(lo, hi);
+        if (rng.chance(0.5)) set_comp(o, (a + 1) % 3, fraction((a + 1) % 3));
+        if (rng.chance(0.5)) set_comp(o, a, comp(C, a) - comp(d, a) * far);
+        push(o, d, R_NEAR_AXIS);
+    }
     // tmax limits (shadow-like)
     size_t n0 = v.size();
     for (int i = 0; i < 14 && n0; i++) {
@@ -405,7 +445,7 @@ void check_scene(int kind, uint64_t seed, Report &rep) {
     REQUIRE(c);
     Scene s = make_scene(c, kind, seed);
     INFO(s.label);
-    CHECK_MESSAGE(s.root != nullptr, pray_error(c));
+    CHECK_MESSAGE(s.root != nullptr, std::string(pray_error(c)));
     if (!s.root) {
         pray_free(c);
         return;
@@ -415,7 +455,7 @@ void check_scene(int kind, uint64_t seed, Report &rep) {
     // the reference
     REQUIRE(apply(c, reference()));
     pray_scene *ref = pray_prepare(c, s.root);
-    CHECK_MESSAGE(ref != nullptr, pray_error(c));
+    CHECK_MESSAGE(ref != nullptr, std::string(pray_error(c)));
     if (!ref) {
         rep.failed_prepares++;
         pray_free(c);
@@ -436,7 +476,7 @@ void check_scene(int kind, uint64_t seed, Report &rep) {
     }
     for (size_t i = 0; i < rays.size(); i++)
         if (want[i].n < 0) {
-            FAIL_CHECK("the reference failed on " << fmt_ray(rays[i]) << ": " << pray_error(c));
+            FAIL_CHECK("the reference failed on " << fmt_ray(rays[i]) << ": " << std::string(pray_error(c)));
             want[i].n = 0;
         }
     pray_scene_free(c, ref);
@@ -451,7 +491,7 @@ void check_scene(int kind, uint64_t seed, Report &rep) {
         pray_scene *q = pray_prepare(c, s.root);
         if (!q) {
             rep.failed_prepares++;
-            FAIL_CHECK(s.label << ", " << o.text() << ": pray_prepare failed: " << pray_error(c));
+            FAIL_CHECK(s.label << ", " << o.text() << ": pray_prepare failed: " << std::string(pray_error(c)));
             continue;
         }
         for (size_t i = 0; i < rays.size(); i++) {
@@ -464,7 +504,16 @@ void check_scene(int kind, uint64_t seed, Report &rep) {
     pray_free(c);
 }
 
+// PRAY_ACCEL_SCALE=k in the environment runs k times as many scenes (a longer soak than the
+// default run of `make check`; the seeds go on from the default ones).
+int scale_from_env() {
+    const char *e = std::getenv("PRAY_ACCEL_SCALE");
+    int k = e ? std::atoi(e) : 1;
+    return k < 1 ? 1 : k;
+}
+
 void run_kind(int kind, int first_seed, int count, Report &total) {
+    count *= scale_from_env();
     Report rep;
     auto t0 = std::chrono::steady_clock::now();
     for (int i = 0; i < count; i++) check_scene(kind, (uint64_t)(first_seed + i), rep);
@@ -524,7 +573,7 @@ Run run_program(const std::string &name, const std::string &text, const std::vec
     for (const std::string &o : options) {
         size_t eq = o.find('=');
         pray_status st = pray_option_fix(c, o.substr(0, eq).c_str(), o.substr(eq + 1).c_str());
-        CHECK_MESSAGE(st == PRAY_OK, o << ": " << pray_error(c));
+        CHECK_MESSAGE(st == PRAY_OK, o << ": " << std::string(pray_error(c)));
     }
     r.status = pray_run_string(c, name.c_str(), text.data(), text.size());
     if (r.status != PRAY_OK) r.error = pray_error(c);
@@ -712,7 +761,7 @@ TEST_CASE("accel images: random scenes rendered with every switch combination eq
         REQUIRE(c);
         Scene s = make_scene(c, pk.kind, (uint64_t)pk.seed);
         CAPTURE(s.label);
-        REQUIRE_MESSAGE(s.root, pray_error(c));
+        REQUIRE_MESSAGE(s.root, std::string(pray_error(c)));
         pray_light *lights = some_lights(c);
         REQUIRE(lights);
         Render ref = render(c, s.root, lights, reference(), 40);
@@ -886,4 +935,87 @@ TEST_CASE("accel stats: of a program run; parts that cannot matter are not kept"
     CHECK(r.stats.grid[1] == 0);
     CHECK(r.stats.grid[2] == 0);
     CHECK(r.stats.voxels == 0);
+}
+
+TEST_CASE("accel hits: degenerate roots (nothing, one, complements, a lone primitive) with every combination") {
+    pray_ctx *c = pray_new();
+    REQUIRE(c);
+    pray_rgb d = {0.5, 0.5, 0.5}, z = {0, 0, 0};
+    pray_model *m = pray_phong(c, d, z, z, 1);
+    struct Case {
+        const char *name;
+        pray_object *root;
+    };
+    pray_object *ball = pray_sphere(c, m, V(0.25, 0, 0), 0.5);
+    const Case cases[] = {
+        {"nothing", pray_nothing(c)},
+        {"one", pray_one(c, m)},
+        {"complement of nothing", pray_complement(c, pray_nothing(c))},
+        {"a lone sphere", ball},
+        {"a lone half-space", pray_plane(c, m, V(0, 0, 0.125), V(0, 0, 1))},
+        {"a lone cylinder", pray_cylinder(c, m, V(0, 0, 0), V(0, 1, 0), 0.25)},
+        {"complement of a sphere", pray_complement(c, ball)},
+        {"sphere minus one", pray_csg(c, PRAY_DIFFERENCE, ball, pray_one(c, m))},
+        {"sphere and nothing", pray_csg(c, PRAY_INTERSECTION, ball, pray_nothing(c))},
+        {"sphere minus itself", pray_csg(c, PRAY_DIFFERENCE, ball, ball)},
+        {"one minus a sphere", pray_csg(c, PRAY_DIFFERENCE, pray_one(c, m), ball)},
+        {"sphere minus a far sphere", pray_csg(c, PRAY_DIFFERENCE, ball, pray_sphere(c, m, V(5, 0, 0), 0.5))},
+        {"two far apart spheres intersected", pray_csg(c, PRAY_INTERSECTION, ball, pray_sphere(c, m, V(-5, 0, 0), 0.5))},
+    };
+    RayCase rays[] = {
+        {V(-3, 0, 0), V(1, 0, 0), HUGE_VAL, R_AXIS},      {V(0.25, -3, 0.5), V(0, 1, 0), HUGE_VAL, R_TANGENT_SPHERE},
+        {V(0.25, 0, 0), V(0, 0, 1), HUGE_VAL, R_IN_SOLID}, {V(-3, -3, -3), V(1, 1, 1), HUGE_VAL, R_GRID_CORNER},
+        {V(-3, 0, 0.125), V(1, 0, 0), HUGE_VAL, R_IN_FACE}, {V(0.25, 0, 0), V(1, 0, 0), 0.5, R_TMAX_HIT},
+    };
+    long mismatches = 0;
+    std::vector<std::string> first;
+    for (const Case &k : cases) {
+        CAPTURE(k.name);
+        REQUIRE(k.root);
+        REQUIRE(apply(c, reference()));
+        pray_scene *ref = pray_prepare(c, k.root);
+        REQUIRE_MESSAGE(ref, std::string(pray_error(c)));
+        std::vector<Hits> want;
+        for (const RayCase &r : rays) {
+            want.push_back(intersect(c, ref, r));
+            CHECK(want.back().n >= 0);
+        }
+        pray_scene_free(c, ref);
+        // the reference itself, where the answer is plain
+        std::string name = k.name;
+        if (name == "a lone sphere") {
+            REQUIRE(want[0].n == 2);
+            CHECK(same_t(want[0].h[0].t, 2.75));
+            CHECK(same_t(want[0].h[1].t, 3.75));
+            CHECK(want[0].h[0].entering == 1);
+            CHECK(want[0].h[1].entering == 0);
+            CHECK(want[0].h[0].primitive == 0);
+            CHECK(want[1].n == 0);  // tangent
+        }
+        if (name == "nothing" || name == "one" || name == "sphere minus itself" || name == "sphere and nothing" ||
+            name == "two far apart spheres intersected")
+            for (const Hits &h : want) CHECK(h.n == 0);
+        if (name == "sphere minus a far sphere") CHECK(want[0].n == 2);
+        if (name == "complement of a sphere") {
+            REQUIRE(want[0].n == 2);
+            CHECK(want[0].h[0].entering == 0);
+        }
+        for (const Opts &o : all_combinations()) {
+            REQUIRE(apply(c, o));
+            pray_scene *q = pray_prepare(c, k.root);
+            CHECK_MESSAGE(q, o.text() << ": " << std::string(pray_error(c)));
+            if (!q) continue;
+            for (size_t i = 0; i < sizeof rays / sizeof rays[0]; i++) {
+                Hits got = intersect(c, q, rays[i]);
+                if (!same_hits(want[i], got) && ++mismatches <= 10)
+                    first.push_back(std::string(k.name) + ", " + o.text() + ", " + fmt_ray(rays[i]) + "\n      expected " +
+                                    fmt_hits(want[i]) + "\n      actual   " + fmt_hits(got));
+            }
+            pray_scene_free(c, q);
+        }
+    }
+    std::string all;
+    for (auto &f : first) all += "\n  - " + f;
+    CHECK_MESSAGE(mismatches == 0, mismatches << " mismatches:" << all);
+    pray_free(c);
 }
