@@ -1553,11 +1553,10 @@ struct Scratch {
     // per ray, stamped with the ray number (thesis 3.5: no explicit unfreezing)
     unsigned ray;
     Span *span;                     // per primitive: its interval along the ray, once per ray
-    unsigned *pfrozen, *nfrozen;    // frozen for this ray: actions do nothing
+    unsigned *nfrozen;              // frozen for this ray: an ancestor's status is fixed
     unsigned *nfixed;               // status known for the rest of this ray ...
     unsigned char *nfixval;         // ... and its value
     int root_fixed;                 // the root's status cannot change any more on this ray
-    Array<int> stack;
 };
 
 bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
@@ -1569,22 +1568,17 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->nfirst = (unsigned char *)mem_zalloc(c, nn);
     w->cnt = (int *)mem_zalloc(c, sizeof(int) * nn);
     w->span = (Span *)mem_zalloc(c, sizeof(Span) * np);
-    w->pfrozen = (unsigned *)mem_zalloc(c, sizeof(unsigned) * np);
     w->nfrozen = (unsigned *)mem_zalloc(c, sizeof(unsigned) * nn);
     w->nfixed = (unsigned *)mem_zalloc(c, sizeof(unsigned) * nn);
     w->nfixval = (unsigned char *)mem_zalloc(c, nn);
-    w->stack.init();
-    if (!w->stack.reserve(c, s->prims.n + s->nodes.n + 1)) return false;
-    return w->cross && w->pstat && w->nstat && w->nfirst && w->cnt && w->span && w->pfrozen && w->nfrozen && w->nfixed && w->nfixval;
+    return w->cross && w->pstat && w->nstat && w->nfirst && w->cnt && w->span && w->nfrozen && w->nfixed && w->nfixval;
 }
 
 void scratch_release(pray_ctx *c, Scratch *w) {
     mem_free(c, w->span);
-    mem_free(c, w->pfrozen);
     mem_free(c, w->nfrozen);
     mem_free(c, w->nfixed);
     mem_free(c, w->nfixval);
-    w->stack.release(c);
     mem_free(c, w->cross);
     mem_free(c, w->pstat);
     mem_free(c, w->nstat);
@@ -2313,23 +2307,11 @@ inline const Span &span_get(const Scene *s, Scratch *w, const Ray &ray, int p, i
     return sp;
 }
 
-// Freeze the subtree of element e for this ray (3.5).
-void freeze_tree(const Scene *s, Scratch *w, int e) {
-    w->stack.n = 0;
-    int top = e;
-    for (;;) {
-        if (e_is_node(top)) {
-            int j = e_index(top);
-            if (w->nfrozen[j] != w->ray) {
-                w->nfrozen[j] = w->ray;
-                const Node &nd = s->nodes[j];
-                for (int i = 0; i < nd.n; i++) w->stack.p[w->stack.n++] = s->kids[nd.k0 + i];
-            }
-        } else
-            w->pfrozen[e_index(top)] = w->ray;
-        if (!w->stack.n) break;
-        top = w->stack.p[--w->stack.n];
-    }
+// Frozen for this ray (3.5): the status of the parent is fixed, or the parent is frozen. The
+// signal reaches a node's subnodes lazily: each evaluation passes it down its active nodes, so
+// fixing a node costs one stamp however large its subtree.
+inline bool frozen(const Scratch *w, int parent) {
+    return parent >= 0 && (w->nfixed[parent] == w->ray || w->nfrozen[parent] == w->ray);
 }
 
 // Element e is known to keep status st for the rest of the ray: tell its parent, which may then
@@ -2341,7 +2323,7 @@ void settle(const Scene *s, Scratch *w, int e, bool st) {
             if (e == s->root) w->root_fixed = 1;
             return;
         }
-        if (w->nfrozen[p] == w->ray || w->nfixed[p] == w->ray) return;
+        if (frozen(w, p) || w->nfixed[p] == w->ray) return;
         const Node &nd = s->nodes[p];
         bool first = elem_first(s, e);
         int fix = -1;
@@ -2358,8 +2340,6 @@ void settle(const Scene *s, Scratch *w, int e, bool st) {
             w->root_fixed = 1;
             return;
         }
-        for (int i = 0; i < nd.n; i++)
-            if (s->kids[nd.k0 + i] != e) freeze_tree(s, w, s->kids[nd.k0 + i]);
         e = 2 * p + 1;
         st = fix != 0;
     }
@@ -2401,10 +2381,11 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
     const int *nodes = d + 4, *prims = d + 4 + 3 * na;
     w->k.set_in += d[2];
     w->k.set_out += d[3];
-    for (int i = 0; i < na; i++) {
+    for (int i = na - 1; i >= 0; i--) {  // parents first: pass freezing down
         int j = nodes[3 * i];
         w->cnt[j] = nodes[3 * i + 1];
         w->nfirst[j] = (unsigned char)nodes[3 * i + 2];
+        if (frozen(w, s->nodes[j].parent)) w->nfrozen[j] = w->ray;
     }
     // check actions: the primitive's status at a and its crossings in (a, b]; a primitive that
     // keeps its status for the rest of the ray is settled (3.5), which may freeze others
@@ -2412,7 +2393,7 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
     w->k.checks += np;
     for (int i = 0; i < np; i++) {
         int p = prims[i];
-        if (w->pfrozen[p] == w->ray) {
+        if (frozen(w, s->prims[p].parent)) {
             w->k.frozen += 1;
             continue;
         }
@@ -2455,7 +2436,7 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
         int last = -1;
         for (; i < nc && w->cross[i].t == t; i++) {
             const Cross &x = w->cross[i];
-            if (w->pfrozen[x.prim] == w->ray) continue;
+            if (frozen(w, s->prims[x.prim].parent)) continue;
             bool st = x.enter != 0;
             if ((w->pstat[x.prim] != 0) == st) continue;
             w->pstat[x.prim] = st;
@@ -2510,7 +2491,6 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
     w->ray++;
     if (w->ray == 0) {  // the stamps wrapped around: clear them
         for (int i = 0; i < s->prims.n; i++) w->span[i].stamp = 0;
-        memset(w->pfrozen, 0, sizeof(unsigned) * (size_t)s->prims.n);
         memset(w->nfrozen, 0, sizeof(unsigned) * (size_t)s->nodes.n);
         memset(w->nfixed, 0, sizeof(unsigned) * (size_t)s->nodes.n);
         w->ray = 1;
@@ -2520,12 +2500,15 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
         // without a grid, a bounded node whose box the ray misses is outside for the whole ray
         for (int j = s->nodes.n - 1; j >= 0; j--) {
             const Node &nd = s->nodes[j];
-            if (w->nfrozen[j] == w->ray || w->nfixed[j] == w->ray || !box_finite(nd.box)) continue;
+            if (frozen(w, nd.parent)) {
+                w->nfrozen[j] = w->ray;
+                continue;
+            }
+            if (w->nfixed[j] == w->ray || !box_finite(nd.box)) continue;
             real t0, t1;
             if (ray_box(ray, nd.box.lo, nd.box.hi, &t0, &t1) && t1 > 0 && t0 < tmax) continue;
             w->nfixed[j] = w->ray;
             w->nfixval[j] = 0;
-            for (int i = 0; i < nd.n; i++) freeze_tree(s, w, s->kids[nd.k0 + i]);
             if (A->freeze) settle(s, w, 2 * j + 1, false);
         }
     }

@@ -295,11 +295,38 @@ pray_status pray_render_file(const char *program, const char *const *options, in
    5. Threads
    A context is used by one thread at a time; two contexts may render at once. No global state.
 
-   6. The language
-   See docs/pray-language.md for the full manual. A program:
+   6. Rendering, and how it is made fast
+   A ray's visible surface is found by sweeping the crossings of the primitives along it through
+   an n-ary CSG status tree (thesis 3.4). Option brute=1 does exactly that for every primitive:
+   the reference. By default the scene is simplified, a uniform grid of voxels with per-voxel
+   action lists is built (thesis 3.3-3.6: leading-axis traversal, set/check actions, freezing,
+   areas), and bounding boxes prune what cannot be met. Options grid, freeze, merge and bounds
+   switch the parts on and off; every setting gives the image of brute=1, byte for byte.
+   docs/acceleration.md explains the methods, docs/benchmarks.md measures them.
+   Secondary rays know the primitive they start on and never meet it again at their origin.
+
+   7. The language
+   docs/pray-language.md is the full manual; pray-language.md of the specification fixes it.
+   A program is lines of statements; values are numbers, points [x,y,z], vectors <x,y,z>,
+   intensities {r,g,b}, lights, models, objects and strings. A program:
        RedSurface = phong({0.8, 0.1, 0.1}, {0.3, 0.3, 0.3}, 3)
        Light = dirlight({1}, norm(<1, 1, 1>))
        Centre = [0, 0, 0]
        Sphere = sphere(RedSurface, Centre, 0.2)
        rendertiff Sphere, Light
+   Statements: NAME = expr, delete, print, if/then/else/endif, while/endwhile, quit, background,
+   perspective, parallel, option, rendertiff. Operators from the highest priority: unary + -
+   (on objects: complement), . (scale, translate, rotate), ^, * / %, + -, comparisons
+   = == # < > <= >=, &, | \ (objects: union and difference; numbers: bitwise).
+
+   8. Limits
+   Images up to 65536 pixels a side and 2^28 pixels; CSG trees up to 2000 levels deep; program
+   blocks and expressions nested up to 256 levels; strings up to 16 MiB; programs stop after
+   option maxsteps statements (10 million by default). A context's memory may be capped with
+   pray_set_memory_limit; going over it is an error (PRAY_ERR_NOMEM), never an abort.
+
+   9. Status codes
+   PRAY_OK 0, PRAY_ERR_NOMEM 1, PRAY_ERR_IO 2, PRAY_ERR_SYNTAX 3, PRAY_ERR_RUNTIME 4,
+   PRAY_ERR_LIMIT 5, PRAY_ERR_ARG 6. The command line exits with 0 (ok), 1 (error in the
+   program), 2 (usage) or 3 (input/output).
 */
