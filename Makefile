@@ -3,6 +3,7 @@
 #   make examples   render every examples/*.ray into out/
 #   make check      build and run all tests (installs the test packages if missing)
 #   make matrix     compile pray.cpp under every configuration macro and language level
+#   make bench      the acceleration benchmarks (bench/run.sh), results in docs/benchmarks.md
 #   make clean
 
 CXX      ?= c++
@@ -20,7 +21,7 @@ TESTS = tests/pray_tests$(EXE)
 TESTS_FLOAT = tests/pray_tests_float$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
-.PHONY: all examples check deps matrix clean embed
+.PHONY: all examples check deps matrix clean embed bench
 
 all: $(PRAY)
 
@@ -65,6 +66,10 @@ check: deps $(PRAY) $(TESTS) $(TESTS_FLOAT) tests/embed$(EXE)
 	$(RUN) ./$(TESTS_FLOAT)
 	@echo "== tests, PRAY_REAL=double"
 	$(RUN) ./$(TESTS)
+
+# Benchmarks print tables; they are never part of check.
+bench: $(PRAY)
+	bench/run.sh
 
 # Every configuration macro on its own, float and double, C++98/11/17, warnings as errors.
 MATRIX_STDS = -std=c++98 -std=c++11 -std=c++17

@@ -51,6 +51,14 @@ for s in cube room fractal; do
     "$(stat tests $OUT/g1.txt)" "$(stat tests $OUT/n0.txt)" "$(stat frozen $OUT/g1.txt)" "$(stat lists $OUT/g1.txt)"
 done
 
+if [ -z "$QUICK" ]; then
+  SIZE=512x512
+  run examples/fractal.ray fg; run examples/fractal.ray fb --brute
+  awk -v g="$(stat render $OUT/fg.txt)" -v b="$(stat render $OUT/fb.txt)" \
+    'BEGIN { printf "\nfractal at 512x512: grid %.3f s, reference %.3f s: %.1f times faster\n", g, b, b / g }'
+  SIZE=256x256
+fi
+
 echo
 echo "Scaling: N random spheres minus a sphere and a cylinder, 128x128"
 echo
