@@ -704,16 +704,23 @@ pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
         o->p = xf_point(f, a->p);
         o->r = a->r * s;
         break;
-    case O_PLANE:
+    case O_PLANE:  // directions are turned, not scaled, so that their lengths stay in range
         o->p = xf_point(f, a->p);
-        o->v = xf_normal(f, a->v);
+        o->v = vmul(xf_normal(f, a->v), 1.0 / s);
         break;
     case O_CYLINDER:
         o->p = xf_point(f, a->p);
-        o->v = xf_dir(f, a->v);
+        o->v = vmul(xf_dir(f, a->v), 1.0 / s);
         o->r = a->r * s;
         break;
     default: break;
+    }
+    if (a->kind <= O_CYLINDER &&
+        (!vfinite(o->p) || !vfinite(o->v) || !finite_num(o->r) || (a->kind != O_PLANE && !(o->r > 0)) ||
+         (a->kind != O_SPHERE && vlen(o->v) == 0))) {
+        release_handle(c, o);
+        fail(c, PRAY_ERR_ARG, "the transformation takes a primitive out of the range of numbers");
+        return NULL;
     }
     if (is_node(a->kind)) {
         o->kids = kids_new(c, a->nkids);
@@ -2194,11 +2201,13 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
                         }
             }
             if (pass == 0) {
-                for (long v = 0; v < nv; v++) start[(int)v + 1] += start[(int)v];
-                if (start[(int)nv] > 64 * 1048576) {
-                    st = fail(c, PRAY_ERR_LIMIT, "the grid would hold %d primitive references; lower option grid", start[(int)nv]);
+                double total = 0;  // summed before the int prefix sums, which it keeps in range
+                for (long v = 0; v < nv; v++) total += start[(int)v + 1];
+                if (total > 64.0 * 1048576) {
+                    st = fail(c, PRAY_ERR_LIMIT, "the grid would hold %.0f primitive references; lower option grid", total);
                     break;
                 }
+                for (long v = 0; v < nv; v++) start[(int)v + 1] += start[(int)v];
                 if (!cand.reserve(c, start[(int)nv] + 1)) st = c->status;
                 cand.n = start[(int)nv];
             } else {
@@ -2978,9 +2987,6 @@ const char *pray_features(void) {
 #endif
 #if PRAY_HAS_PNG
            "png "
-#endif
-#ifndef PRAY_NO_THREADS
-           "threads "
 #endif
            "real=" PRAY_STRINGIFY(PRAY_REAL);
 }
