@@ -2125,7 +2125,7 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
             double hh = ext / want;
             double vox = 1;
             for (int l = 0; l < 3; l++) vox *= ceil((double)(region.hi[l] - region.lo[l]) / hh * (1 + 1e-9)) + 1;
-            if (vox * sizeof(int) * 2 <= budget || want <= 1) break;
+            if ((vox * sizeof(int) * 2 <= budget && vox <= 268435456.0) || want <= 1) break;
             want = (int)(want * 0.8);
         }
     }
