@@ -1984,7 +1984,7 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
         lb_contribute(b, e, classes[i]);
         if (e == s->root) root_cls = classes[i];
     }
-    qsort(b.touched.p, (size_t)b.touched.n, sizeof(int), int_cmp);
+    if (b.touched.n > 1) qsort(b.touched.p, (size_t)b.touched.n, sizeof(int), int_cmp);
     for (int i = 0; i < b.touched.n; i++) {
         int p = b.touched[i];
         int cl = node_class(s->nodes[p], b.acc_in[p], b.acc_bd[p], b.first_cls[p]);
@@ -2016,8 +2016,8 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
             if (b.cls[k] == CL_BD) ok = stk.push(b.c, k);
     }
     if (ok) {
-        qsort(nodes.p, (size_t)nodes.n, sizeof(int), int_cmp);
-        qsort(prims_out.p, (size_t)prims_out.n, sizeof(int), int_cmp);
+        if (nodes.n > 1) qsort(nodes.p, (size_t)nodes.n, sizeof(int), int_cmp);
+        if (prims_out.n > 1) qsort(prims_out.p, (size_t)prims_out.n, sizeof(int), int_cmp);
         for (int i = 0; ok && i < nodes.n; i++) {
             int p = nodes[i];
             const Node &nd = s->nodes[p];
@@ -2119,16 +2119,6 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
         if (m > mag) mag = m;
     }
     const double eps = sizeof(real) == sizeof(float) ? FLT_EPSILON : DBL_EPSILON;
-    double budget = opt_int(c, OPT_GRIDMEM) * 1048576.0;
-    if (want > 0) {
-        for (;;) {
-            double hh = ext / want;
-            double vox = 1;
-            for (int l = 0; l < 3; l++) vox *= ceil((double)(region.hi[l] - region.lo[l]) / hh * (1 + 1e-9)) + 1;
-            if ((vox * sizeof(int) * 2 <= budget && vox <= 268435456.0) || want <= 1) break;
-            want = (int)(want * 0.8);
-        }
-    }
     // With bounds, a primitive matters only where all its ancestors' boxes reach: outside a
     // node's box the node is outside, and so is what its primitives alone would make of it
     // (a box smaller than all of space implies that). So each primitive is placed in the grid
@@ -2153,24 +2143,48 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
     cand.init();
     start.init();
     cls.init();
-    double margin = 0;
-    if (want > 0) {
+    // The layout: cubic voxels, a margin that keeps classification safe from rounding in the
+    // traversal, the grid centred on the region. The voxel table and the references to the
+    // primitives must fit the budget (option gridmem): otherwise the grid is made coarser.
+    double budget = opt_int(c, OPT_GRIDMEM) * 1048576.0, margin = 0;
+    long nv = 0;
+    while (want > 0 && st == PRAY_OK) {
         a->h = (real)(ext / want);
         margin = (double)a->h * 1e-6 + 64 * eps * (mag + ext) * (want + 4);
-        // far from the origin in low precision the voxels would be smaller than the rounding
-        // of the positions: then no grid
-        if (margin > (double)a->h / 4) want = 0;
-    }
-    if (want > 0) {
-        long nv = 1;
+        // far from the origin in low precision the voxels would be smaller than the rounding of
+        // the positions: then no grid
+        if (margin > (double)a->h / 4) {
+            want = 0;
+            break;
+        }
+        double vox = 1;
         for (int l = 0; l < 3; l++) {
             double len = (double)(region.hi[l] - region.lo[l]) + 2 * margin;
             a->n[l] = (int)ceil(len / (double)a->h);
             if (a->n[l] < 1) a->n[l] = 1;
-            // centre the grid on the region
             a->org[l] = (real)((double)(region.lo[l] + region.hi[l]) / 2 - a->n[l] * (double)a->h / 2);
-            nv *= a->n[l];
+            vox *= a->n[l];
         }
+        double refs = 0;
+        for (int i = 0; i < np && vox <= 268435456.0; i++) {
+            double cnt = 1;
+            for (int l = 0; l < 3; l++) {
+                double gl = ((double)eff[i].lo[l] - margin - (double)a->org[l]) / (double)a->h;
+                double gh = ((double)eff[i].hi[l] + margin - (double)a->org[l]) / (double)a->h;
+                double lo = gl < 0 ? 0 : gl >= a->n[l] ? a->n[l] : floor(gl);
+                double hi = gh < 0 ? -1 : gh >= a->n[l] ? a->n[l] - 1 : floor(gh);
+                cnt *= hi >= lo ? hi - lo + 1 : 0;
+            }
+            refs += cnt;
+        }
+        if (vox <= 268435456.0 && refs <= 64.0 * 1048576 && (2 * vox + refs) * sizeof(int) <= budget) {
+            nv = (long)vox;
+            break;
+        }
+        want = want > 1 ? (int)(want * 0.8) : 0;
+    }
+    if (want <= 0) a->n[0] = a->n[1] = a->n[2] = 0;
+    if (want > 0) {
         a->voxel = (int *)mem_zalloc(c, sizeof(int) * (size_t)nv);
         if (!a->voxel) st = c->status;
         // candidates per voxel, in two passes (count, then fill)
@@ -2201,12 +2215,6 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
                         }
             }
             if (pass == 0) {
-                double total = 0;  // summed before the int prefix sums, which it keeps in range
-                for (long v = 0; v < nv; v++) total += start[(int)v + 1];
-                if (total > 64.0 * 1048576) {
-                    st = fail(c, PRAY_ERR_LIMIT, "the grid would hold %.0f primitive references; lower option grid", total);
-                    break;
-                }
                 for (long v = 0; v < nv; v++) start[(int)v + 1] += start[(int)v];
                 if (!cand.reserve(c, start[(int)nv] + 1)) st = c->status;
                 cand.n = start[(int)nv];
@@ -2291,7 +2299,7 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
     cls.release(c);
     mem_free(c, eff);
     lb_release(b);
-    long nv = (long)a->n[0] * a->n[1] * a->n[2];
+    nv = (long)a->n[0] * a->n[1] * a->n[2];
     a->memory = (double)sizeof(Accel) + (double)nv * sizeof(int) + (double)a->data.cap * sizeof(int) +
                 (double)a->off.cap * sizeof(int);
     c->stats.grid[0] = a->n[0];
