@@ -105,6 +105,18 @@
 #define PRAY_HAS_UNISTD 1
 #endif
 
+// Threads: Win32 or POSIX, or none (PRAY_NO_THREADS, and wherever neither is there: DOS).
+#if defined(PRAY_NO_THREADS)
+#define PRAY_HAS_THREADS 0
+#elif defined(_WIN32)
+#define PRAY_HAS_THREADS 1
+#elif defined(PRAY_HAS_UNISTD) && defined(_POSIX_THREADS) && _POSIX_THREADS > 0
+#include <pthread.h>
+#define PRAY_HAS_THREADS 1
+#else
+#define PRAY_HAS_THREADS 0
+#endif
+
 namespace {
 
 typedef PRAY_REAL real;
@@ -150,6 +162,107 @@ bool stderr_is_terminal() {
 #endif
 }
 #endif
+
+// A lock and a way to run a function on several threads at once.
+struct Mutex {
+#if PRAY_HAS_THREADS && defined(_WIN32)
+    CRITICAL_SECTION m;
+    void init() { InitializeCriticalSection(&m); }
+    void lock() { EnterCriticalSection(&m); }
+    void unlock() { LeaveCriticalSection(&m); }
+    void destroy() { DeleteCriticalSection(&m); }
+#elif PRAY_HAS_THREADS
+    pthread_mutex_t m;
+    void init() { pthread_mutex_init(&m, NULL); }
+    void lock() { pthread_mutex_lock(&m); }
+    void unlock() { pthread_mutex_unlock(&m); }
+    void destroy() { pthread_mutex_destroy(&m); }
+#else
+    void init() {}
+    void lock() {}
+    void unlock() {}
+    void destroy() {}
+#endif
+};
+
+typedef void (*ThreadFn)(void *arg);
+
+#if PRAY_HAS_THREADS && defined(_WIN32)
+struct ThreadStart {
+    ThreadFn fn;
+    void *arg;
+};
+DWORD WINAPI thread_main(LPVOID p) {
+    ThreadStart *t = (ThreadStart *)p;
+    t->fn(t->arg);
+    return 0;
+}
+#elif PRAY_HAS_THREADS
+struct ThreadStart {
+    ThreadFn fn;
+    void *arg;
+};
+void *thread_main(void *p) {
+    ThreadStart *t = (ThreadStart *)p;
+    t->fn(t->arg);
+    return NULL;
+}
+#endif
+
+// Run fn(args[i]) for i < n, on n threads where possible (the caller's is one of them).
+// `starts` has room for n entries. Where a thread cannot be started, the caller runs its share.
+void run_parallel(int n, ThreadFn fn, void **args, void *starts) {
+#if PRAY_HAS_THREADS
+    ThreadStart *ts = (ThreadStart *)starts;
+#if defined(_WIN32)
+    HANDLE h[64];
+#else
+    pthread_t h[64];
+#endif
+    bool started[64];
+    if (n > 64) n = 64;
+    for (int i = 1; i < n; i++) {
+        ts[i].fn = fn;
+        ts[i].arg = args[i];
+#if defined(_WIN32)
+        h[i] = CreateThread(NULL, 0, thread_main, &ts[i], 0, NULL);
+        started[i] = h[i] != NULL;
+#else
+        started[i] = pthread_create(&h[i], NULL, thread_main, &ts[i]) == 0;
+#endif
+    }
+    fn(args[0]);
+    for (int i = 1; i < n; i++) {
+        if (!started[i]) {
+            fn(args[i]);
+            continue;
+        }
+#if defined(_WIN32)
+        WaitForSingleObject(h[i], INFINITE);
+        CloseHandle(h[i]);
+#else
+        pthread_join(h[i], NULL);
+#endif
+    }
+#else
+    (void)starts;
+    for (int i = 0; i < n; i++) fn(args[i]);
+#endif
+}
+
+// Processors to use when the option threads is 0 (automatic).
+int cpu_count() {
+#if PRAY_HAS_THREADS && defined(_WIN32)
+    SYSTEM_INFO si;
+    GetSystemInfo(&si);
+    return (int)si.dwNumberOfProcessors;
+#elif PRAY_HAS_THREADS && defined(_SC_NPROCESSORS_ONLN)
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n > 0 ? (int)n : 1;
+#else
+    return 1;
+#endif
+}
 
 // Limits of one run (the robustness issue makes more of them options).
 const int MAX_NESTING = 256;        // blocks and parentheses
@@ -2613,13 +2726,15 @@ struct Tracer {
     pray_rgb bg;  // background of the current pixel's row
 };
 
-pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind) {
+// The colour a ray brings back. `hit`, when given, receives the primitive it meets (-1: none).
+pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, int *hit = NULL) {
     const Scene *s = tr.s;
     if (level > s->depth) return cmake(0, 0, 0);
     tr.w->k.rays[kind] += 1;
     FirstHit fh;
     fh.found = false;
     find_hits(s, tr.w, ray, REAL_INF, self, fh);
+    if (hit) *hit = fh.found ? fh.h.prim : -1;
     if (!fh.found) return tr.bg;
     const Hit &h = fh.h;
     const Prim &q = s->prims[h.prim];
@@ -2739,49 +2854,260 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     return PRAY_OK;
 }
 
-pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
-    int W = s->width, H = s->height, A = s->antialias;
+// ---- the render driver: bands of rows handed out to threads; undersampling (3.2) ----
+// A sample: a pixel's colour and the primitive its centre ray meets.
+struct Sample {
+    pray_rgb c;
+    int hit;
+    int known;
+};
+
+struct Job;
+
+struct Worker {
+    Job *job;
     Scratch w;
-    if (!scratch_init(c, &w, s)) {
-        scratch_release(c, &w);
-        return c->status;
-    }
-    pray_status st = PRAY_OK;
     Tracer tr;
-    tr.s = s;
-    tr.w = &w;
-    double inv = 1.0 / ((double)A * A);
-    for (int j = 0; j < H && st == PRAY_OK; j++) {
-        double f = H > 1 ? (double)j / (H - 1) : 0.0;
-        tr.bg = cadd(s->bg_top, cscale(cadd(s->bg_bottom, cscale(s->bg_top, -1)), f));
-        for (int i = 0; i < W; i++) {
-            pray_rgb sum = cmake(0, 0, 0);
-            for (int b = 0; b < A; b++)
-                for (int a = 0; a < A; a++) {
-                    real u = (real)(2.0 * (i + (a + 0.5) / A) / W - 1.0);
-                    real v = (real)(2.0 * (j + (b + 0.5) / A) / H - 1.0);
-                    sum = cadd(sum, trace(tr, camera_ray(s, u, v), 1, -1, RAY_PRIMARY));
-                }
-            float *px = out->pixels + ((size_t)j * W + i) * 3;
-            px[0] = (float)(sum.r * inv);
-            px[1] = (float)(sum.g * inv);
-            px[2] = (float)(sum.b * inv);
-        }
-        if (c->progress_fn && c->progress_fn(c->progress_ud, j + 1, H))
-            st = fail(c, PRAY_ERR_LIMIT, "render cancelled");
+    Array<Sample> cache;  // undersampling: the samples of the current band
+    pray_status st;
+};
+
+struct Job {
+    pray_ctx *c;
+    const Scene *s;
+    pray_image *out;
+    Mutex mu;
+    int next_band, bands, band_rows, rows_done;
+    int cancelled;
+    double adaptive;  // undersampling threshold, 0 = off
+};
+
+const int ADAPT_STEP = 4;  // spacing of the coarse lattice of undersampling
+
+bool differ(const Sample &a, const Sample &b, double th) {
+    return a.hit != b.hit || fabs(a.c.r - b.c.r) > th || fabs(a.c.g - b.c.g) > th || fabs(a.c.b - b.c.b) > th;
+}
+
+// One pixel: its A x A stratified samples averaged. With undersampling, the four corner samples
+// are traced first and the rest only where those differ.
+Sample pixel(Worker &k, int i, int j) {
+    const Scene *s = k.job->s;
+    int W = s->width, H = s->height, A = s->antialias;
+    Sample r;
+    r.known = 1;
+    if (A == 1) {
+        real u = (real)(2.0 * (i + 0.5) / W - 1.0), v = (real)(2.0 * (j + 0.5) / H - 1.0);
+        r.c = trace(k.tr, camera_ray(s, u, v), 1, -1, RAY_PRIMARY, &r.hit);
+        return r;
     }
-    c->stats.rays_primary += w.k.rays[RAY_PRIMARY];
-    c->stats.rays_shadow += w.k.rays[RAY_SHADOW];
-    c->stats.rays_reflected += w.k.rays[RAY_REFLECT];
-    c->stats.rays_refracted += w.k.rays[RAY_REFRACT];
-    c->stats.intersection_tests += w.k.tests;
-    c->stats.voxel_steps += w.k.steps;
-    c->stats.area_moves += w.k.moves;
-    c->stats.set_inside += w.k.set_in;
-    c->stats.set_outside += w.k.set_out;
-    c->stats.checks += w.k.checks;
-    c->stats.frozen_skips += w.k.frozen;
-    scratch_release(c, &w);
+    pray_rgb sub[4];
+    int hits[4], n = 0;
+    if (k.job->adaptive > 0) {
+        for (int b = 0; b < A; b += A - 1)
+            for (int a = 0; a < A; a += A - 1) {
+                real u = (real)(2.0 * (i + (a + 0.5) / A) / W - 1.0);
+                real v = (real)(2.0 * (j + (b + 0.5) / A) / H - 1.0);
+                sub[n] = trace(k.tr, camera_ray(s, u, v), 1, -1, RAY_PRIMARY, &hits[n]);
+                n++;
+            }
+        bool same = true;
+        for (int q = 1; q < 4 && same; q++) {
+            Sample x = {sub[0], hits[0], 1}, y = {sub[q], hits[q], 1};
+            same = !differ(x, y, k.job->adaptive);
+        }
+        if (same) {
+            r.c = cscale(cadd(cadd(sub[0], sub[1]), cadd(sub[2], sub[3])), 0.25);
+            r.hit = hits[0];
+            return r;
+        }
+    }
+    pray_rgb sum = cmake(0, 0, 0);
+    r.hit = -1;
+    for (int b = 0; b < A; b++)
+        for (int a = 0; a < A; a++) {
+            int corner = (a == 0 || a == A - 1) && (b == 0 || b == A - 1);
+            pray_rgb x;
+            int h;
+            if (n && corner) {
+                int q = (b == 0 ? 0 : 2) + (a == 0 ? 0 : 1);
+                x = sub[q];
+                h = hits[q];
+            } else {
+                real u = (real)(2.0 * (i + (a + 0.5) / A) / W - 1.0);
+                real v = (real)(2.0 * (j + (b + 0.5) / A) / H - 1.0);
+                x = trace(k.tr, camera_ray(s, u, v), 1, -1, RAY_PRIMARY, &h);
+            }
+            sum = cadd(sum, x);
+            if (2 * a + 1 == A && 2 * b + 1 == A) r.hit = h;  // the centre, for odd A
+            if (r.hit < 0 && a == 0 && b == 0) r.hit = h;
+        }
+    r.c = cscale(sum, 1.0 / ((double)A * A));
+    return r;
+}
+
+void put_pixel(const Job *job, int i, int j, pray_rgb c) {
+    float *px = job->out->pixels + ((size_t)j * job->s->width + i) * 3;
+    px[0] = (float)c.r;
+    px[1] = (float)c.g;
+    px[2] = (float)c.b;
+}
+
+void set_row_background(Worker &k, int j) {
+    const Scene *s = k.job->s;
+    double f = s->height > 1 ? (double)j / (s->height - 1) : 0.0;
+    k.tr.bg = cadd(s->bg_top, cscale(cadd(s->bg_bottom, cscale(s->bg_top, -1)), f));
+}
+
+// Undersampling: the sample of pixel (i, j), rows y0 .. y0 + ADAPT_STEP of the band cached.
+Sample &band_sample(Worker &k, int y0, int i, int j) {
+    Sample &x = k.cache[(j - y0) * k.job->s->width + i];
+    if (!x.known) {
+        set_row_background(k, j);
+        x = pixel(k, i, j);
+    }
+    return x;
+}
+
+// Fill the cell with corners (x0, y0) .. (x1, y1): interpolate when its corners agree, else split.
+void refine(Worker &k, int yb, int x0, int y0, int x1, int y1) {
+    Sample c00 = band_sample(k, yb, x0, y0), c10 = band_sample(k, yb, x1, y0);
+    Sample c01 = band_sample(k, yb, x0, y1), c11 = band_sample(k, yb, x1, y1);
+    double th = k.job->adaptive;
+    if (x1 - x0 <= 1 && y1 - y0 <= 1) return;
+    if (!differ(c00, c10, th) && !differ(c00, c01, th) && !differ(c00, c11, th) && !differ(c10, c01, th) &&
+        !differ(c10, c11, th) && !differ(c01, c11, th)) {
+        for (int j = y0; j <= y1; j++)
+            for (int i = x0; i <= x1; i++) {
+                Sample &x = k.cache[(j - yb) * k.job->s->width + i];
+                if (x.known) continue;
+                double fx = x1 > x0 ? (double)(i - x0) / (x1 - x0) : 0;
+                double fy = y1 > y0 ? (double)(j - y0) / (y1 - y0) : 0;
+                pray_rgb top = cadd(cscale(c00.c, 1 - fx), cscale(c10.c, fx));
+                pray_rgb bot = cadd(cscale(c01.c, 1 - fx), cscale(c11.c, fx));
+                x.c = cadd(cscale(top, 1 - fy), cscale(bot, fy));
+                x.hit = c00.hit;
+                x.known = 2;  // interpolated
+            }
+        return;
+    }
+    int xm = (x0 + x1) / 2, ym = (y0 + y1) / 2;
+    if (x1 - x0 <= 1) {
+        refine(k, yb, x0, y0, x1, ym);
+        refine(k, yb, x0, ym, x1, y1);
+    } else if (y1 - y0 <= 1) {
+        refine(k, yb, x0, y0, xm, y1);
+        refine(k, yb, xm, y0, x1, y1);
+    } else {
+        refine(k, yb, x0, y0, xm, ym);
+        refine(k, yb, xm, y0, x1, ym);
+        refine(k, yb, x0, ym, xm, y1);
+        refine(k, yb, xm, ym, x1, y1);
+    }
+}
+
+void render_band(Worker &k, int band) {
+    Job *job = k.job;
+    const Scene *s = job->s;
+    int W = s->width, H = s->height;
+    int y0 = band * job->band_rows, y1 = y0 + job->band_rows;
+    if (y1 > H) y1 = H;
+    if (job->adaptive <= 0) {
+        for (int j = y0; j < y1; j++) {
+            set_row_background(k, j);
+            for (int i = 0; i < W; i++) put_pixel(job, i, j, pixel(k, i, j).c);
+        }
+        return;
+    }
+    // the band's cells span rows y0 .. y0 + step (the last row shared with the next band)
+    int yl = y0 + ADAPT_STEP < H - 1 ? y0 + ADAPT_STEP : H - 1;
+    for (int q = 0; q < (ADAPT_STEP + 1) * W; q++) k.cache[q].known = 0;
+    for (int x0 = 0; x0 < W - 1 || x0 == 0; x0 += ADAPT_STEP) {
+        int x1 = x0 + ADAPT_STEP < W - 1 ? x0 + ADAPT_STEP : W - 1;
+        refine(k, y0, x0, y0, x1, yl);
+        if (x1 == W - 1) break;
+    }
+    for (int j = y0; j < y1; j++)
+        for (int i = 0; i < W; i++) put_pixel(job, i, j, band_sample(k, y0, i, j).c);
+}
+
+void worker_main(void *arg) {
+    Worker &k = *(Worker *)arg;
+    Job *job = k.job;
+    for (;;) {
+        job->mu.lock();
+        int band = job->cancelled ? job->bands : job->next_band++;
+        job->mu.unlock();
+        if (band >= job->bands) return;
+        render_band(k, band);
+        job->mu.lock();
+        int y0 = band * job->band_rows;
+        int rows = y0 + job->band_rows > job->s->height ? job->s->height - y0 : job->band_rows;
+        job->rows_done += rows;
+        pray_ctx *c = job->c;
+        if (!job->cancelled && c->progress_fn && c->progress_fn(c->progress_ud, job->rows_done, job->s->height))
+            job->cancelled = 1;
+        job->mu.unlock();
+    }
+}
+
+pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
+    int nt = opt_int(c, OPT_THREADS);
+    if (nt <= 0) nt = cpu_count();
+    if (!PRAY_HAS_THREADS || nt < 1) nt = 1;
+    if (nt > 64) nt = 64;
+    Job job;
+    memset(&job, 0, sizeof job);
+    job.c = c;
+    job.s = s;
+    job.out = out;
+    job.adaptive = c->cur.opt.v[OPT_ADAPTIVE];
+    job.band_rows = job.adaptive > 0 ? ADAPT_STEP : 4;
+    job.bands = (s->height + job.band_rows - 1) / job.band_rows;
+    if (nt > job.bands) nt = job.bands;
+    // everything a thread needs is allocated here, before any starts: the context's allocator
+    // is used by one thread only
+    Worker *ws = (Worker *)mem_zalloc(c, sizeof(Worker) * (size_t)nt);
+    void **args = (void **)mem_zalloc(c, sizeof(void *) * (size_t)nt);
+    void *starts = mem_zalloc(c, 64 * sizeof(void *) * 2);
+    pray_status st = ws && args && starts ? PRAY_OK : c->status;
+    int made = 0;
+    for (; st == PRAY_OK && made < nt; made++) {
+        Worker &k = ws[made];
+        k.job = &job;
+        k.cache.init();
+        if (!scratch_init(c, &k.w, s)) st = c->status;
+        else if (job.adaptive > 0 && !k.cache.reserve(c, (ADAPT_STEP + 1) * s->width)) st = c->status;
+        k.tr.s = s;
+        k.tr.w = &k.w;
+        args[made] = &k;
+    }
+    if (st == PRAY_OK) {
+        job.mu.init();
+        run_parallel(nt, worker_main, args, starts);
+        job.mu.destroy();
+        if (job.cancelled) st = fail(c, PRAY_ERR_LIMIT, "render cancelled");
+    }
+    for (int i = 0; ws && i < made; i++) {
+        const Counters &k = ws[i].w.k;
+        c->stats.rays_primary += k.rays[RAY_PRIMARY];
+        c->stats.rays_shadow += k.rays[RAY_SHADOW];
+        c->stats.rays_reflected += k.rays[RAY_REFLECT];
+        c->stats.rays_refracted += k.rays[RAY_REFRACT];
+        c->stats.intersection_tests += k.tests;
+        c->stats.voxel_steps += k.steps;
+        c->stats.area_moves += k.moves;
+        c->stats.set_inside += k.set_in;
+        c->stats.set_outside += k.set_out;
+        c->stats.checks += k.checks;
+        c->stats.frozen_skips += k.frozen;
+        scratch_release(c, &ws[i].w);
+        ws[i].cache.release(c);
+    }
+    c->stats.rays_primary_full += (double)s->width * s->height * s->antialias * s->antialias;
+    c->stats.threads = nt;
+    mem_free(c, ws);
+    mem_free(c, args);
+    mem_free(c, starts);
     return st;
 }
 
@@ -2995,6 +3321,9 @@ const char *pray_features(void) {
 #endif
 #if PRAY_HAS_PNG
            "png "
+#endif
+#if PRAY_HAS_THREADS
+           "threads "
 #endif
            "real=" PRAY_STRINGIFY(PRAY_REAL);
 }
@@ -5451,15 +5780,15 @@ void print_stats(pray_ctx *c) {
     fprintf(stderr,
             "primitives: %ld declared, %ld kept; nodes %ld\n"
             "grid: %d x %d x %d = %ld voxels, %ld distinct lists, %ld areas, %.0f bytes\n"
-            "rays: primary %.0f, shadow %.0f, reflected %.0f, refracted %.0f\n"
+            "rays: primary %.0f (of %.0f without undersampling), shadow %.0f, reflected %.0f, refracted %.0f\n"
             "traversal: %.0f voxel steps, %.0f area moves\n"
             "actions: set inside %.0f, set outside %.0f, check %.0f (frozen skips %.0f)\n"
             "intersection tests %.0f\n"
-            "time: parse %.3f s, prepare %.3f s, render %.3f s\n",
+            "time: parse %.3f s, prepare %.3f s, render %.3f s on %d thread%s\n",
             s.primitives_declared, s.primitives, s.nodes, s.grid[0], s.grid[1], s.grid[2], s.voxels, s.lists,
-            s.areas, s.memory, s.rays_primary, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.voxel_steps,
+            s.areas, s.memory, s.rays_primary, s.rays_primary_full, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.voxel_steps,
             s.area_moves, s.set_inside, s.set_outside, s.checks, s.frozen_skips, s.intersection_tests,
-            s.time_parse, s.time_prepare, s.time_render);
+            s.time_parse, s.time_prepare, s.time_render, s.threads, s.threads == 1 ? "" : "s");
 }
 
 int run_stdin(pray_ctx *c) {

@@ -210,6 +210,8 @@ typedef struct pray_stats {
     long voxels, lists, areas;       /* voxels; distinct action lists; areas of equal lists */
     double memory;                   /* bytes of the acceleration structure */
     double rays_primary, rays_shadow, rays_reflected, rays_refracted;
+    double rays_primary_full;        /* primary rays without undersampling (option adaptive) */
+    int threads;                     /* threads of the last render */
     double voxel_steps, area_moves;  /* traversal steps; steps inside an area (no evaluation) */
     double set_inside, set_outside, checks; /* actions executed, by kind */
     double intersection_tests;       /* ray/primitive intersections computed */
