@@ -30,6 +30,7 @@
 
 #include "pray.hpp"
 
+#include <errno.h>
 #include <float.h>
 #include <limits.h>
 #include <math.h>
@@ -286,8 +287,8 @@ struct Block {
 // Options by index; the table in section 6 has their names, defaults and ranges.
 enum {
     OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_DEPTH, OPT_FREEZE,
-    OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_MAXSTEPS, OPT_MERGE, OPT_OUTPUT, OPT_SHADOWS, OPT_THREADS,
-    OPT_WIDTH, OPT_COUNT
+    OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_MAXSTEPS, OPT_MERGE, OPT_OUTPUT, OPT_SHADOWS, OPT_TEXMEM,
+    OPT_THREADS, OPT_WIDTH, OPT_COUNT
 };
 
 struct Options {
@@ -323,6 +324,8 @@ struct pray_ctx {
     unsigned fixed;  // bit per option: set from the command line, programs cannot change it
     pray_stats stats;
     int frames;
+    pray_texture *textures;  // files decoded in this run
+    char run_dir[512];       // directory of the running program, for texture files
 };
 
 namespace {
@@ -591,7 +594,12 @@ pray_vec xf_normal(const Xform &f, pray_vec n) {
 // [SECTION] 5 Scene values: models, lights, solids (reference counted handles)
 // =============================================================================================
 namespace {
-enum HandleKind { H_OBJECT = 1, H_MODEL, H_LIGHT, H_KIDS, H_STRING };
+enum HandleKind { H_OBJECT = 1, H_MODEL, H_LIGHT, H_KIDS, H_STRING, H_TEXTURE };
+// Models: plain coefficients, or a tree of textured parts evaluated where a ray hits.
+enum ModelKind { M_FLAT, M_TEX, M_BUMP, M_MOVE, M_SUM, M_SCALE };
+// Texture coordinates of a primitive: none, a plane's, a sphere's.
+enum MapKind { MAP_NONE, MAP_PLANE, MAP_SPHERE };
+const int MAX_MODEL_DEPTH = 256;
 struct Handle {
     int refs;
     int kind;
@@ -610,6 +618,23 @@ struct pray_model {
     pray_rgb diffuse, specular, ambient, emit, reflect, transmit;
     double exponent, index;
     int has_exponent, has_index;
+    // M_TEX: a (where the texture is 0) and b (where it is 1) blended by tex; M_BUMP: a with its
+    // normal tilted by amount x the texture's luminance gradient; M_MOVE: a with its texture
+    // coordinates shifted by (dx, dy); M_SUM: a + b; M_SCALE: a x factor.
+    int kind, depth;
+    pray_model *a, *b;
+    struct pray_texture *tex;
+    double amount, dx, dy;
+    pray_rgb factor;
+};
+
+// A decoded texture image: RGB floats, rows from the first row of the file.
+struct pray_texture {
+    Handle h;
+    int w, hgt;
+    float *rgb;
+    char *name;
+    pray_texture *next;  // the context's cache of loaded files
 };
 
 struct pray_light {
@@ -626,6 +651,8 @@ struct pray_object {
     pray_model *mat;
     pray_vec p, v;
     double r;
+    int map;         // MapKind: texture coordinates (planemap, spheremap)
+    pray_vec mu, mv; // their U and V vectors
     Kids *kids;
     int nkids;
     long nprims;
@@ -668,13 +695,28 @@ void release_handle(pray_ctx *c, void *p) {
         break;
     }
     case H_LIGHT: mem_free(c, ((pray_light *)p)->src); break;
+    case H_MODEL: {
+        pray_model *m = (pray_model *)p;
+        release_handle(c, m->a);
+        release_handle(c, m->b);
+        release_handle(c, m->tex);
+        break;
+    }
+    case H_TEXTURE: {
+        pray_texture *t = (pray_texture *)p;
+        mem_free(c, t->rgb);
+        mem_free(c, t->name);
+        break;
+    }
     default: break;
     }
     mem_free(c, p);
 }
 
 pray_model *model_new(pray_ctx *c) {
-    return (pray_model *)handle_new(c, sizeof(pray_model), H_MODEL);
+    pray_model *m = (pray_model *)handle_new(c, sizeof(pray_model), H_MODEL);
+    if (m) m->depth = 1;
+    return m;
 }
 
 pray_light *light_new(pray_ctx *c, int n) {
@@ -821,6 +863,14 @@ pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
         o->p = xf_point(f, a->p);
         o->v = vmul(xf_normal(f, a->v), 1.0 / s);
         break;
+    default: break;
+    }
+    o->map = a->map;
+    if (a->map) {  // texture coordinates go with the solid, scale included
+        o->mu = xf_dir(f, a->mu);
+        o->mv = xf_dir(f, a->mv);
+    }
+    switch (a->kind) {
     case O_CYLINDER:
         o->p = xf_point(f, a->p);
         o->v = vmul(xf_dir(f, a->v), 1.0 / s);
@@ -878,7 +928,28 @@ pray_light *light_union(pray_ctx *c, const pray_light *a, const pray_light *b) {
     return l;
 }
 
-pray_model *model_sum(pray_ctx *c, const pray_model *a, const pray_model *b) {
+// A model node of the given kind over a and b (b may be NULL).
+pray_model *model_node(pray_ctx *c, int kind, pray_model *a, pray_model *b) {
+    int depth = 1 + (a->depth > (b ? b->depth : 0) ? a->depth : b->depth);
+    if (depth > MAX_MODEL_DEPTH) {
+        fail(c, PRAY_ERR_LIMIT, "model nested deeper than %d levels", MAX_MODEL_DEPTH);
+        return NULL;
+    }
+    pray_model *m = model_new(c);
+    if (!m) return NULL;
+    m->kind = kind;
+    m->depth = depth;
+    m->a = a;
+    m->b = b;
+    retain(a);
+    retain(b);
+    m->has_exponent = a->has_exponent || (b && b->has_exponent);
+    m->has_index = a->has_index || (b && b->has_index);
+    return m;
+}
+
+pray_model *model_sum(pray_ctx *c, pray_model *a, pray_model *b) {
+    if (a->kind != M_FLAT || b->kind != M_FLAT) return model_node(c, M_SUM, a, b);
     pray_model *m = model_new(c);
     if (!m) return NULL;
     m->diffuse = cadd(a->diffuse, b->diffuse);
@@ -894,7 +965,12 @@ pray_model *model_sum(pray_ctx *c, const pray_model *a, const pray_model *b) {
     return m;
 }
 
-pray_model *model_times(pray_ctx *c, const pray_model *a, pray_rgb f) {
+pray_model *model_times(pray_ctx *c, pray_model *a, pray_rgb f) {
+    if (a->kind != M_FLAT) {
+        pray_model *m = model_node(c, M_SCALE, a, NULL);
+        if (m) m->factor = f;
+        return m;
+    }
     pray_model *m = model_new(c);
     if (!m) return NULL;
     *m = *a;
@@ -923,7 +999,8 @@ const OptDef OPTS[OPT_COUNT] = {
     {"freeze", 1, 0, 1, 1},       {"grid", -1, -1, 4096, 1},  {"gridmem", 64, 1, 65536, 1},
     {"height", 256, 1, MAX_IMAGE_SIDE, 1},
     {"maxsteps", 1e7, 0, 1e15, 1}, {"merge", 1, 0, 1, 1},     {"output", 0, 0, 0, 0},
-    {"shadows", 1, 0, 1, 1},      {"threads", 0, 0, 1024, 1}, {"width", 256, 1, MAX_IMAGE_SIDE, 1},
+    {"shadows", 1, 0, 1, 1},      {"texmem", 256, 1, 65536, 1},
+    {"threads", 0, 0, 1024, 1},   {"width", 256, 1, MAX_IMAGE_SIDE, 1},
 };
 
 int opt_find(const char *name) {
@@ -1018,6 +1095,7 @@ inline R3 operator+(R3 a, R3 b) { return r3(a.x + b.x, a.y + b.y, a.z + b.z); }
 inline R3 operator-(R3 a, R3 b) { return r3(a.x - b.x, a.y - b.y, a.z - b.z); }
 inline R3 operator*(R3 a, real s) { return r3(a.x * s, a.y * s, a.z * s); }
 inline real dot(R3 a, R3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline R3 cross(R3 a, R3 b) { return r3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x); }
 inline R3 unit(R3 a) {
     real l = (real)sqrt((double)dot(a, a));
     return l > 0 ? a * ((real)1 / l) : a;
@@ -1043,6 +1121,8 @@ struct Prim {
     R3 n;               // unit outward normal of a plane, unit axis of a cylinder
     real r, r2, d;      // radius, radius squared, plane offset n.p
     const pray_model *mat;
+    int map;            // MapKind; texture coordinates from p (origin) and mu, mv
+    R3 mu, mv;
     int id;             // position among the declared primitives, left to right
     int parent;         // node index, -1 for the root
     unsigned char first;  // first child of a difference
@@ -1302,6 +1382,9 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
         q.mat = o->mat;
         q.parent = -1;
         q.id = s->leaves++;
+        q.map = o->map;
+        q.mu = r3of(o->mu);
+        q.mv = r3of(o->mv);
         if (o->kind == O_SPHERE) {
             q.r = (real)o->r;
         } else if (o->kind == O_PLANE) {
@@ -1457,7 +1540,7 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
             Prim &b = s->prims[k[j].prim];
             if (!snap_close(a, b, k[i].sign, k[j].sign)) break;
             int f = k[i].sign * k[j].sign;  // +1 same orientation, -1 opposite
-            b.p = a.p;
+            if (a.kind != O_PLANE) b.p = a.p;  // a plane's point is its texture origin only
             b.r = a.r;
             b.r2 = a.r2;
             b.n = a.n * (real)f;
@@ -1847,11 +1930,15 @@ struct FirstHit {
 
 // Transmission along a shadow ray: the product of the transmit weights of every surface
 // crossed; stops at the first opaque one.
+pray_rgb transmit_at(const Prim &q, R3 x);
+
 struct ShadowHit {
     const Scene *s;
+    const Ray *ray;
     pray_rgb f;
     bool operator()(const Hit &x) {
-        f = cmul(f, s->prims[x.prim].mat->transmit);
+        const Prim &q = s->prims[x.prim];
+        f = cmul(f, q.mat->kind == M_FLAT ? q.mat->transmit : transmit_at(q, ray->o + ray->d * x.t));
         return !czero(f);
     }
 };
@@ -2718,6 +2805,602 @@ void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, 
 }
 
 // =============================================================================================
+// [SECTION] 9c TIFF reader and textures: baseline TIFF in both byte orders for textures and fonts
+// =============================================================================================
+// Bilevel, greyscale, palette, RGB and RGBA; 1, 4, 8 and 16 bits per sample; strips and tiles;
+// no compression, PackBits, LZW with or without the horizontal predictor. Every offset and size
+// is checked against the file; anything else is refused with the feature it lacks.
+namespace {
+
+struct TiffIn {
+    pray_ctx *c;
+    const char *name;
+    const unsigned char *p;
+    size_t n;
+    int big;  // "MM": big-endian
+    pray_status err(const char *fmt, ...) PRAY_PRINTF(2, 3);
+    unsigned u16(size_t at) const {
+        return big ? (unsigned)p[at] << 8 | p[at + 1] : (unsigned)p[at + 1] << 8 | p[at];
+    }
+    unsigned long u32(size_t at) const {
+        return big ? (unsigned long)u16(at) << 16 | u16(at + 2) : (unsigned long)u16(at + 2) << 16 | u16(at);
+    }
+};
+
+pray_status TiffIn::err(const char *fmt, ...) {
+    va_list ap;
+    va_start(ap, fmt);
+    char tmp[600];
+    vsnprintf(tmp, sizeof tmp, fmt, ap);
+    va_end(ap);
+    return fail(c, PRAY_ERR_IO, "%s: %s", name, tmp);
+}
+
+struct TiffTag {
+    unsigned type;
+    unsigned long count, value;  // value: the value itself when it fits in 4 bytes, else its offset
+    size_t at;                   // where the entry's value field is
+    int present;
+};
+
+// Tags read, by number.
+enum {
+    TT_WIDTH = 256, TT_LENGTH = 257, TT_BPS = 258, TT_COMPRESSION = 259, TT_PHOTOMETRIC = 262,
+    TT_STRIPOFFSETS = 273, TT_SPP = 277, TT_ROWSPERSTRIP = 278, TT_STRIPBYTES = 279, TT_PLANAR = 284,
+    TT_PREDICTOR = 317, TT_COLORMAP = 320, TT_TILEWIDTH = 322, TT_TILELENGTH = 323, TT_TILEOFFSETS = 324,
+    TT_TILEBYTES = 325, TT_EXTRASAMPLES = 338, TT_SAMPLEFORMAT = 339
+};
+const unsigned TIFF_TAGS[] = {TT_WIDTH, TT_LENGTH, TT_BPS, TT_COMPRESSION, TT_PHOTOMETRIC, TT_STRIPOFFSETS,
+                              TT_SPP, TT_ROWSPERSTRIP, TT_STRIPBYTES, TT_PLANAR, TT_PREDICTOR, TT_COLORMAP,
+                              TT_TILEWIDTH, TT_TILELENGTH, TT_TILEOFFSETS, TT_TILEBYTES, TT_EXTRASAMPLES,
+                              TT_SAMPLEFORMAT};
+const int NTIFF_TAGS = (int)(sizeof TIFF_TAGS / sizeof TIFF_TAGS[0]);
+
+size_t tiff_type_size(unsigned type) {
+    switch (type) {
+    case 1: case 2: case 6: case 7: return 1;  // BYTE ASCII SBYTE UNDEFINED
+    case 3: case 8: return 2;                  // SHORT SSHORT
+    case 4: case 9: case 11: return 4;         // LONG SLONG FLOAT
+    case 5: case 10: case 12: return 8;        // RATIONAL SRATIONAL DOUBLE
+    default: return 0;
+    }
+}
+
+// Value i of an integer tag; false when it is not there or not an integer.
+bool tiff_value(const TiffIn &in, const TiffTag &t, unsigned long i, unsigned long *v) {
+    if (!t.present || i >= t.count) return false;
+    size_t sz = tiff_type_size(t.type);
+    if (t.type != 1 && t.type != 3 && t.type != 4) return false;
+    size_t base = t.count * sz <= 4 ? t.at : (size_t)t.value;
+    size_t at = base + (size_t)i * sz;
+    if (at + sz > in.n) return false;
+    *v = sz == 1 ? in.p[at] : sz == 2 ? in.u16(at) : in.u32(at);
+    return true;
+}
+
+// PackBits: literal runs and repeats, into exactly `want` bytes.
+bool unpackbits(const unsigned char *src, size_t n, unsigned char *dst, size_t want) {
+    size_t i = 0, o = 0;
+    while (o < want) {
+        if (i >= n) return false;
+        int k = (signed char)src[i++];
+        if (k >= 0) {
+            size_t len = (size_t)k + 1;
+            if (i + len > n || o + len > want) return false;
+            memcpy(dst + o, src + i, len);
+            i += len;
+            o += len;
+        } else if (k != -128) {
+            size_t len = (size_t)(1 - k);
+            if (i >= n || o + len > want) return false;
+            memset(dst + o, src[i++], len);
+            o += len;
+        }
+    }
+    return true;
+}
+
+// LZW as TIFF has it: codes of 9 to 12 bits, most significant bit first, 256 clears, 257 ends,
+// the code width grows one code early.
+bool unlzw(pray_ctx *c, const unsigned char *src, size_t n, unsigned char *dst, size_t want) {
+    struct Entry {
+        unsigned short prefix, len;
+        unsigned char first, last;
+    };
+    Entry *tab = (Entry *)mem_alloc(c, sizeof(Entry) * 4096);
+    if (!tab) return false;
+    for (int i = 0; i < 256; i++) {
+        tab[i].prefix = 0xFFFF;
+        tab[i].len = 1;
+        tab[i].first = tab[i].last = (unsigned char)i;
+    }
+    size_t o = 0, bitpos = 0, nbits = n * 8;
+    int width = 9, next = 258, prev = -1;
+    bool ok = true;
+    for (;;) {
+        if (bitpos + (size_t)width > nbits) break;  // ran out: the strip ends without 257
+        int code = 0;
+        for (int b = 0; b < width; b++, bitpos++) code = code << 1 | (src[bitpos >> 3] >> (7 - (bitpos & 7)) & 1);
+        if (code == 257) break;
+        if (code == 256) {
+            width = 9;
+            next = 258;
+            prev = -1;
+            continue;
+        }
+        int out;  // the code whose string goes out
+        if (code < next && (code < 256 || code >= 258)) {
+            out = code;
+            if (prev >= 0 && next < 4096) {
+                tab[next].prefix = (unsigned short)prev;
+                tab[next].len = (unsigned short)(tab[prev].len + 1);
+                tab[next].first = tab[prev].first;
+                tab[next].last = tab[code].first;
+                next++;
+            }
+        } else if (code == next && prev >= 0 && next < 4096) {
+            tab[next].prefix = (unsigned short)prev;
+            tab[next].len = (unsigned short)(tab[prev].len + 1);
+            tab[next].first = tab[prev].first;
+            tab[next].last = tab[prev].first;
+            out = next++;
+        } else {
+            ok = false;
+            break;
+        }
+        size_t len = tab[out].len;
+        if (o + len > want) len = want - o;  // extra data at the end of a strip is ignored
+        // write the string backwards from its end
+        int k = out;
+        size_t skip = tab[out].len - len;
+        for (size_t q = 0; q < skip; q++) k = tab[k].prefix;
+        for (size_t q = len; q > 0; q--) {
+            dst[o + q - 1] = tab[k].last;
+            k = tab[k].prefix;
+        }
+        o += len;
+        prev = code;
+        if (next + 1 >= (1 << width) && width < 12) width++;
+        if (o >= want) break;
+    }
+    mem_free(c, tab);
+    return ok && o == want;
+}
+
+// A decoded texture: RGB floats, rows from the first row of the file.
+struct TexImage {
+    int w, h;
+    float *rgb;
+};
+
+pray_status tiff_decode(pray_ctx *c, const char *name, const unsigned char *p, size_t n, double max_bytes,
+                        TexImage *img) {
+    TiffIn in;
+    in.c = c;
+    in.name = name;
+    in.p = p;
+    in.n = n;
+    img->rgb = NULL;
+    if (n < 8) return in.err("not a TIFF file (too short)");
+    if (p[0] == 'I' && p[1] == 'I') in.big = 0;
+    else if (p[0] == 'M' && p[1] == 'M') in.big = 1;
+    else return in.err("not a TIFF file");
+    unsigned magic = in.u16(2);
+    if (magic == 43) return in.err("unsupported TIFF: BigTIFF");
+    if (magic != 42) return in.err("not a TIFF file");
+    unsigned long ifd = in.u32(4);
+    if (ifd < 8 || ifd + 2 > n) return in.err("the directory offset %lu is outside the file", ifd);
+    unsigned count = in.u16((size_t)ifd);
+    if ((size_t)ifd + 2 + (size_t)count * 12 > n) return in.err("the directory runs past the end of the file");
+    TiffTag tags[NTIFF_TAGS];
+    memset(tags, 0, sizeof tags);
+    for (unsigned e = 0; e < count; e++) {
+        size_t at = (size_t)ifd + 2 + (size_t)e * 12;
+        unsigned tag = in.u16(at);
+        for (int k = 0; k < NTIFF_TAGS; k++) {
+            if (TIFF_TAGS[k] != tag) continue;
+            TiffTag &t = tags[k];
+            t.type = in.u16(at + 2);
+            t.count = in.u32(at + 4);
+            t.at = at + 8;
+            t.value = in.u32(at + 8);
+            size_t sz = tiff_type_size(t.type);
+            if (!sz) return in.err("tag %u has an unknown type %u", tag, t.type);
+            if (t.count > n) return in.err("tag %u claims %lu values", tag, t.count);
+            if (t.count * sz > 4 && (t.value > n || t.count * sz > n - t.value))
+                return in.err("the values of tag %u lie outside the file", tag);
+            t.present = 1;
+        }
+    }
+    struct Idx {
+        static int of(unsigned x) {
+            for (int k = 0; k < NTIFF_TAGS; k++)
+                if (TIFF_TAGS[k] == x) return k;
+            return 0;
+        }
+    };
+    unsigned long width = 0, height = 0, spp = 1, bps = 1, comp = 1, photo = 9, planar = 1, pred = 1;
+    unsigned long fmt = 1;
+    if (!tiff_value(in, tags[Idx::of(TT_WIDTH)], 0, &width) || !tiff_value(in, tags[Idx::of(TT_LENGTH)], 0, &height))
+        return in.err("no image size");
+    tiff_value(in, tags[Idx::of(TT_SPP)], 0, &spp);
+    tiff_value(in, tags[Idx::of(TT_BPS)], 0, &bps);
+    tiff_value(in, tags[Idx::of(TT_COMPRESSION)], 0, &comp);
+    if (!tiff_value(in, tags[Idx::of(TT_PHOTOMETRIC)], 0, &photo)) return in.err("no photometric interpretation");
+    tiff_value(in, tags[Idx::of(TT_PLANAR)], 0, &planar);
+    tiff_value(in, tags[Idx::of(TT_PREDICTOR)], 0, &pred);
+    tiff_value(in, tags[Idx::of(TT_SAMPLEFORMAT)], 0, &fmt);
+    if (width < 1 || height < 1 || width > 65536 || height > 65536)
+        return in.err("image size %lu x %lu is out of range", width, height);
+    for (unsigned long i = 1; i < spp; i++) {
+        unsigned long b;
+        if (tiff_value(in, tags[Idx::of(TT_BPS)], i, &b) && b != bps)
+            return in.err("unsupported TIFF: samples of different sizes");
+    }
+    if (bps != 1 && bps != 4 && bps != 8 && bps != 16)
+        return in.err("unsupported TIFF: %lu bits per sample", bps);
+    if (fmt != 1) return in.err("unsupported TIFF: sample format %lu (only unsigned integers)", fmt);
+    if (comp != 1 && comp != 5 && comp != 32773) return in.err("unsupported TIFF: compression %lu", comp);
+    if (pred != 1 && pred != 2) return in.err("unsupported TIFF: predictor %lu", pred);
+    if (pred == 2 && bps != 8 && bps != 16) return in.err("unsupported TIFF: predictor with %lu bits", bps);
+    if (spp > 1 && planar != 1) return in.err("unsupported TIFF: separate colour planes");
+    unsigned long colors;  // samples that make the colour; the rest are extra (alpha)
+    if (photo == 0 || photo == 1) colors = 1;
+    else if (photo == 2) colors = 3;
+    else if (photo == 3) colors = 1;
+    else return in.err("unsupported TIFF: photometric interpretation %lu", photo);
+    if (spp < colors || spp > colors + 1) return in.err("unsupported TIFF: %lu samples per pixel", spp);
+    if (photo == 2 && bps < 8) return in.err("unsupported TIFF: RGB with %lu bits", bps);
+    if (photo == 3 && bps == 16) return in.err("unsupported TIFF: palette with 16 bits");
+    unsigned long maxv = (1ul << bps) - 1;
+    const TiffTag &cmap = tags[Idx::of(TT_COLORMAP)];
+    if (photo == 3 && (!cmap.present || cmap.count < 3 * (maxv + 1))) return in.err("palette image without a colour map");
+    if ((double)width * height * 3 * sizeof(float) > max_bytes)
+        return fail(c, PRAY_ERR_LIMIT, "%s: a %lu x %lu texture is over the texture memory limit (option texmem)", name,
+                    width, height);
+    // the blocks: strips or tiles
+    bool tiled = tags[Idx::of(TT_TILEWIDTH)].present;
+    unsigned long bw = width, bh = height;
+    const TiffTag *offs, *cnts;
+    if (tiled) {
+        if (!tiff_value(in, tags[Idx::of(TT_TILEWIDTH)], 0, &bw) || !tiff_value(in, tags[Idx::of(TT_TILELENGTH)], 0, &bh) ||
+            bw < 1 || bh < 1 || bw > 65536 || bh > 65536)
+            return in.err("bad tile size");
+        offs = &tags[Idx::of(TT_TILEOFFSETS)];
+        cnts = &tags[Idx::of(TT_TILEBYTES)];
+    } else {
+        unsigned long rps = height;
+        if (tiff_value(in, tags[Idx::of(TT_ROWSPERSTRIP)], 0, &rps) && rps < height && rps > 0) bh = rps;
+        offs = &tags[Idx::of(TT_STRIPOFFSETS)];
+        cnts = &tags[Idx::of(TT_STRIPBYTES)];
+    }
+    unsigned long across = (width + bw - 1) / bw, down = (height + bh - 1) / bh;
+    if (!offs->present || offs->count < across * down) return in.err("missing %s offsets", tiled ? "tile" : "strip");
+    size_t rowbytes = (size_t)((bw * spp * bps + 7) / 8);
+    size_t blockbytes = rowbytes * bh;
+    if ((double)blockbytes > max_bytes) return fail(c, PRAY_ERR_LIMIT, "%s: blocks too large", name);
+    unsigned char *block = (unsigned char *)mem_alloc(c, blockbytes ? blockbytes : 1);
+    float *rgb = (float *)mem_alloc(c, sizeof(float) * 3 * (size_t)width * (size_t)height);
+    if (!block || !rgb) {
+        mem_free(c, block);
+        mem_free(c, rgb);
+        return c->status;
+    }
+    pray_status st = PRAY_OK;
+    for (unsigned long by = 0; by < down && st == PRAY_OK; by++)
+        for (unsigned long bx = 0; bx < across && st == PRAY_OK; bx++) {
+            unsigned long k = by * across + bx, off, len;
+            if (!tiff_value(in, *offs, k, &off)) {
+                st = in.err("bad block offset");
+                break;
+            }
+            if (!cnts->present) len = comp == 1 ? (unsigned long)blockbytes : (unsigned long)(n > off ? n - off : 0);
+            else if (!tiff_value(in, *cnts, k, &len)) {
+                st = in.err("bad block size");
+                break;
+            }
+            if (off > n || len > n - off) {
+                st = in.err("block %lu lies outside the file (truncated?)", k);
+                break;
+            }
+            // strips at the bottom may be shorter
+            size_t rows = tiled ? bh : (by == down - 1 ? height - by * bh : bh);
+            size_t want = rowbytes * rows;
+            const unsigned char *src = p + off;
+            bool ok;
+            if (comp == 1) {
+                ok = len >= want;
+                if (ok) memcpy(block, src, want);
+            } else if (comp == 32773) ok = unpackbits(src, len, block, want);
+            else {
+                ok = unlzw(c, src, len, block, want);
+                if (!ok && c->status == PRAY_ERR_NOMEM) {
+                    st = c->status;
+                    break;
+                }
+            }
+            if (!ok) {
+                st = in.err("block %lu is truncated or corrupt", k);
+                break;
+            }
+            if (pred == 2)  // undo the horizontal differences, row by row
+                for (size_t r = 0; r < rows; r++) {
+                    unsigned char *row = block + r * rowbytes;
+                    if (bps == 8) {
+                        for (size_t i = spp; i < bw * spp; i++) row[i] = (unsigned char)(row[i] + row[i - spp]);
+                    } else {
+                        for (size_t i = spp; i < bw * spp; i++) {
+                            unsigned char *a = row + 2 * i, *b = row + 2 * (i - spp);
+                            unsigned v = in.big ? ((unsigned)a[0] << 8 | a[1]) + ((unsigned)b[0] << 8 | b[1])
+                                                : ((unsigned)a[1] << 8 | a[0]) + ((unsigned)b[1] << 8 | b[0]);
+                            a[in.big ? 0 : 1] = (unsigned char)(v >> 8 & 255);
+                            a[in.big ? 1 : 0] = (unsigned char)(v & 255);
+                        }
+                    }
+                }
+            for (size_t r = 0; r < rows; r++) {
+                unsigned long y = by * bh + r;
+                if (y >= height) break;
+                const unsigned char *row = block + r * rowbytes;
+                for (unsigned long x0 = 0; x0 < bw; x0++) {
+                    unsigned long x = bx * bw + x0;
+                    if (x >= width) break;
+                    unsigned long v[4] = {0, 0, 0, 0};
+                    for (unsigned long q = 0; q < colors; q++) {
+                        size_t bit = (size_t)(x0 * spp + q) * bps;
+                        if (bps == 16) {
+                            const unsigned char *a = row + bit / 8;
+                            v[q] = in.big ? ((unsigned long)a[0] << 8 | a[1]) : ((unsigned long)a[1] << 8 | a[0]);
+                        } else if (bps == 8) v[q] = row[bit / 8];
+                        else v[q] = (unsigned long)(row[bit / 8] >> (8 - bps - bit % 8)) & maxv;
+                    }
+                    float *o = rgb + ((size_t)y * width + x) * 3;
+                    if (photo == 3) {
+                        unsigned long r0 = 0, g0 = 0, b0 = 0;
+                        tiff_value(in, cmap, v[0], &r0);
+                        tiff_value(in, cmap, v[0] + maxv + 1, &g0);
+                        tiff_value(in, cmap, v[0] + 2 * (maxv + 1), &b0);
+                        o[0] = (float)(r0 / 65535.0);
+                        o[1] = (float)(g0 / 65535.0);
+                        o[2] = (float)(b0 / 65535.0);
+                    } else if (photo == 2) {
+                        for (int q = 0; q < 3; q++) o[q] = (float)((double)v[q] / maxv);
+                    } else {
+                        double g = (double)v[0] / maxv;
+                        if (photo == 0) g = 1 - g;  // white is zero
+                        o[0] = o[1] = o[2] = (float)g;
+                    }
+                }
+            }
+        }
+    mem_free(c, block);
+    if (st != PRAY_OK) {
+        mem_free(c, rgb);
+        return st;
+    }
+    img->w = (int)width;
+    img->h = (int)height;
+    img->rgb = rgb;
+    return PRAY_OK;
+}
+
+} // namespace
+
+namespace {
+
+// Read a whole file through the context's allocator; NULL on failure (message set).
+unsigned char *read_file(pray_ctx *c, const char *path, size_t *n, double max_bytes) {
+#if PRAY_HAS_STDIO
+    errno = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        fail(c, PRAY_ERR_IO, "cannot open '%s': %s", path, strerror(errno ? errno : ENOENT));
+        return NULL;
+    }
+    Text t;
+    t.init();
+    char buf[8192];
+    size_t got;
+    bool ok = true;
+    while (ok && (got = fread(buf, 1, sizeof buf, f)) > 0) {
+        if ((double)t.a.n + got > max_bytes) {
+            fail(c, PRAY_ERR_LIMIT, "'%s' is over the texture memory limit (option texmem)", path);
+            ok = false;
+        } else
+            ok = t.add(c, buf, got);
+    }
+    if (ok && ferror(f)) ok = fail(c, PRAY_ERR_IO, "cannot read '%s'", path) == PRAY_OK;
+    fclose(f);
+    if (!ok) {
+        t.a.release(c);
+        return NULL;
+    }
+    *n = (size_t)t.a.n;
+    return (unsigned char *)t.a.p;  // NUL-terminated Text storage; freed with mem_free
+#else
+    (void)path;
+    (void)n;
+    (void)max_bytes;
+    fail(c, PRAY_ERR_IO, "this build has no file access");
+    return NULL;
+#endif
+}
+
+pray_texture *texture_make(pray_ctx *c, const char *name, const unsigned char *data, size_t n) {
+    TexImage img;
+    double cap = c->cur.opt.v[OPT_TEXMEM] * 1048576.0;
+    if (tiff_decode(c, name, data, n, cap, &img)) return NULL;
+    pray_texture *t = (pray_texture *)handle_new(c, sizeof(pray_texture), H_TEXTURE);
+    char *nm = t ? mem_strdup(c, name, strlen(name)) : NULL;
+    if (!t || !nm) {
+        mem_free(c, t);
+        mem_free(c, img.rgb);
+        return NULL;
+    }
+    t->w = img.w;
+    t->hgt = img.h;
+    t->rgb = img.rgb;
+    t->name = nm;
+    return t;
+}
+
+// A texture file, decoded once per context run however often it is used.
+pray_texture *texture_file(pray_ctx *c, const char *path) {
+    for (pray_texture *t = c->textures; t; t = t->next)
+        if (strcmp(t->name, path) == 0) {
+            retain(t);
+            return t;
+        }
+    size_t n = 0;
+    unsigned char *data = read_file(c, path, &n, c->cur.opt.v[OPT_TEXMEM] * 1048576.0);
+    if (!data) return NULL;
+    pray_texture *t = texture_make(c, path, data, n);
+    mem_free(c, data);
+    if (!t) return NULL;
+    t->next = c->textures;  // the cache holds one reference
+    c->textures = t;
+    retain(t);
+    return t;
+}
+
+void texture_cache_clear(pray_ctx *c) {
+    while (c->textures) {
+        pray_texture *t = c->textures;
+        c->textures = t->next;
+        release_handle(c, t);
+    }
+}
+
+// Colour of the texture at (s, t): bilinear between texel centres, the image repeating.
+pray_rgb tex_lookup(const pray_texture *tx, double s, double t) {
+    double x = (s - floor(s)) * tx->w - 0.5, y = (t - floor(t)) * tx->hgt - 0.5;
+    double fx0 = floor(x), fy0 = floor(y);
+    double fx = x - fx0, fy = y - fy0;
+    int x0 = (int)fx0, y0 = (int)fy0;
+    int x1 = x0 + 1, y1 = y0 + 1;
+    if (x0 < 0) x0 += tx->w;
+    if (y0 < 0) y0 += tx->hgt;
+    if (x1 >= tx->w) x1 -= tx->w;
+    if (y1 >= tx->hgt) y1 -= tx->hgt;
+    const float *a = tx->rgb + ((size_t)y0 * tx->w + x0) * 3, *b = tx->rgb + ((size_t)y0 * tx->w + x1) * 3;
+    const float *cc = tx->rgb + ((size_t)y1 * tx->w + x0) * 3, *d = tx->rgb + ((size_t)y1 * tx->w + x1) * 3;
+    double v[3];
+    for (int i = 0; i < 3; i++)
+        v[i] = (a[i] * (1 - fx) + b[i] * fx) * (1 - fy) + (cc[i] * (1 - fx) + d[i] * fx) * fy;
+    return cmake(v[0], v[1], v[2]);
+}
+
+double tex_luminance(const pray_texture *tx, double s, double t) {
+    pray_rgb c = tex_lookup(tx, s, t);
+    return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b;
+}
+
+// The built-in font, drawn for pray (source: tools/font6x9.txt): printable ASCII, 5 x 9 ink
+// pixels in a 6 x 9 cell; rows 0-6 stand on the baseline, rows 7-8 hang below it. Bit 4 is the
+// leftmost column.
+/* generated by tools/font6x9.py from tools/font6x9.txt: ASCII 32..126, 5x9 ink in a 6x9 cell, */
+/* bit 4 = leftmost column, row 0 = top, rows 7..8 = descenders */
+static const unsigned char FONT6X9[95][9] = {
+    {0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00}, /*  32 ' ' */
+    {0x04, 0x04, 0x04, 0x04, 0x04, 0x00, 0x04, 0x00, 0x00}, /*  33 '!' */
+    {0x0a, 0x0a, 0x0a, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00}, /*  34 '"' */
+    {0x0a, 0x0a, 0x1f, 0x0a, 0x1f, 0x0a, 0x0a, 0x00, 0x00}, /*  35 '#' */
+    {0x04, 0x0f, 0x14, 0x0e, 0x05, 0x1e, 0x04, 0x00, 0x00}, /*  36 '$' */
+    {0x18, 0x19, 0x02, 0x04, 0x08, 0x13, 0x03, 0x00, 0x00}, /*  37 '%' */
+    {0x0c, 0x12, 0x14, 0x08, 0x15, 0x12, 0x0d, 0x00, 0x00}, /*  38 '&' */
+    {0x04, 0x04, 0x08, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00}, /*  39 ''' */
+    {0x02, 0x04, 0x08, 0x08, 0x08, 0x04, 0x02, 0x00, 0x00}, /*  40 '(' */
+    {0x08, 0x04, 0x02, 0x02, 0x02, 0x04, 0x08, 0x00, 0x00}, /*  41 ')' */
+    {0x00, 0x04, 0x15, 0x0e, 0x15, 0x04, 0x00, 0x00, 0x00}, /*  42 '*' */
+    {0x00, 0x04, 0x04, 0x1f, 0x04, 0x04, 0x00, 0x00, 0x00}, /*  43 '+' */
+    {0x00, 0x00, 0x00, 0x00, 0x00, 0x0c, 0x0c, 0x04, 0x00}, /*  44 ',' */
+    {0x00, 0x00, 0x00, 0x1f, 0x00, 0x00, 0x00, 0x00, 0x00}, /*  45 '-' */
+    {0x00, 0x00, 0x00, 0x00, 0x00, 0x0c, 0x0c, 0x00, 0x00}, /*  46 '.' */
+    {0x01, 0x01, 0x02, 0x04, 0x08, 0x10, 0x10, 0x00, 0x00}, /*  47 '/' */
+    {0x0e, 0x11, 0x13, 0x15, 0x19, 0x11, 0x0e, 0x00, 0x00}, /*  48 '0' */
+    {0x04, 0x0c, 0x14, 0x04, 0x04, 0x04, 0x1f, 0x00, 0x00}, /*  49 '1' */
+    {0x0e, 0x11, 0x01, 0x02, 0x04, 0x08, 0x1f, 0x00, 0x00}, /*  50 '2' */
+    {0x0e, 0x11, 0x01, 0x06, 0x01, 0x11, 0x0e, 0x00, 0x00}, /*  51 '3' */
+    {0x02, 0x06, 0x0a, 0x12, 0x1f, 0x02, 0x02, 0x00, 0x00}, /*  52 '4' */
+    {0x1f, 0x10, 0x1e, 0x01, 0x01, 0x11, 0x0e, 0x00, 0x00}, /*  53 '5' */
+    {0x06, 0x08, 0x10, 0x1e, 0x11, 0x11, 0x0e, 0x00, 0x00}, /*  54 '6' */
+    {0x1f, 0x01, 0x02, 0x04, 0x08, 0x08, 0x08, 0x00, 0x00}, /*  55 '7' */
+    {0x0e, 0x11, 0x11, 0x0e, 0x11, 0x11, 0x0e, 0x00, 0x00}, /*  56 '8' */
+    {0x0e, 0x11, 0x11, 0x0f, 0x01, 0x02, 0x0c, 0x00, 0x00}, /*  57 '9' */
+    {0x00, 0x00, 0x0c, 0x0c, 0x00, 0x0c, 0x0c, 0x00, 0x00}, /*  58 ':' */
+    {0x00, 0x00, 0x0c, 0x0c, 0x00, 0x0c, 0x0c, 0x04, 0x00}, /*  59 ';' */
+    {0x02, 0x04, 0x08, 0x10, 0x08, 0x04, 0x02, 0x00, 0x00}, /*  60 '<' */
+    {0x00, 0x00, 0x1f, 0x00, 0x1f, 0x00, 0x00, 0x00, 0x00}, /*  61 '=' */
+    {0x08, 0x04, 0x02, 0x01, 0x02, 0x04, 0x08, 0x00, 0x00}, /*  62 '>' */
+    {0x0e, 0x11, 0x01, 0x02, 0x04, 0x00, 0x04, 0x00, 0x00}, /*  63 '?' */
+    {0x0e, 0x11, 0x17, 0x15, 0x17, 0x10, 0x0f, 0x00, 0x00}, /*  64 '@' */
+    {0x0e, 0x11, 0x11, 0x1f, 0x11, 0x11, 0x11, 0x00, 0x00}, /*  65 'A' */
+    {0x1e, 0x11, 0x11, 0x1e, 0x11, 0x11, 0x1e, 0x00, 0x00}, /*  66 'B' */
+    {0x0e, 0x11, 0x10, 0x10, 0x10, 0x11, 0x0e, 0x00, 0x00}, /*  67 'C' */
+    {0x1e, 0x11, 0x11, 0x11, 0x11, 0x11, 0x1e, 0x00, 0x00}, /*  68 'D' */
+    {0x1f, 0x10, 0x10, 0x1e, 0x10, 0x10, 0x1f, 0x00, 0x00}, /*  69 'E' */
+    {0x1f, 0x10, 0x10, 0x1e, 0x10, 0x10, 0x10, 0x00, 0x00}, /*  70 'F' */
+    {0x0e, 0x11, 0x10, 0x17, 0x11, 0x11, 0x0f, 0x00, 0x00}, /*  71 'G' */
+    {0x11, 0x11, 0x11, 0x1f, 0x11, 0x11, 0x11, 0x00, 0x00}, /*  72 'H' */
+    {0x0e, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0e, 0x00, 0x00}, /*  73 'I' */
+    {0x07, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0c, 0x00, 0x00}, /*  74 'J' */
+    {0x11, 0x12, 0x14, 0x18, 0x14, 0x12, 0x11, 0x00, 0x00}, /*  75 'K' */
+    {0x10, 0x10, 0x10, 0x10, 0x10, 0x10, 0x1f, 0x00, 0x00}, /*  76 'L' */
+    {0x11, 0x1b, 0x15, 0x15, 0x11, 0x11, 0x11, 0x00, 0x00}, /*  77 'M' */
+    {0x11, 0x11, 0x19, 0x15, 0x13, 0x11, 0x11, 0x00, 0x00}, /*  78 'N' */
+    {0x0e, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0e, 0x00, 0x00}, /*  79 'O' */
+    {0x1e, 0x11, 0x11, 0x1e, 0x10, 0x10, 0x10, 0x00, 0x00}, /*  80 'P' */
+    {0x0e, 0x11, 0x11, 0x11, 0x15, 0x12, 0x0d, 0x00, 0x00}, /*  81 'Q' */
+    {0x1e, 0x11, 0x11, 0x1e, 0x14, 0x12, 0x11, 0x00, 0x00}, /*  82 'R' */
+    {0x0e, 0x11, 0x10, 0x0e, 0x01, 0x11, 0x0e, 0x00, 0x00}, /*  83 'S' */
+    {0x1f, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04, 0x00, 0x00}, /*  84 'T' */
+    {0x11, 0x11, 0x11, 0x11, 0x11, 0x11, 0x0e, 0x00, 0x00}, /*  85 'U' */
+    {0x11, 0x11, 0x11, 0x11, 0x11, 0x0a, 0x04, 0x00, 0x00}, /*  86 'V' */
+    {0x11, 0x11, 0x11, 0x15, 0x15, 0x15, 0x0a, 0x00, 0x00}, /*  87 'W' */
+    {0x11, 0x11, 0x0a, 0x04, 0x0a, 0x11, 0x11, 0x00, 0x00}, /*  88 'X' */
+    {0x11, 0x11, 0x0a, 0x04, 0x04, 0x04, 0x04, 0x00, 0x00}, /*  89 'Y' */
+    {0x1f, 0x01, 0x02, 0x04, 0x08, 0x10, 0x1f, 0x00, 0x00}, /*  90 'Z' */
+    {0x0e, 0x08, 0x08, 0x08, 0x08, 0x08, 0x0e, 0x00, 0x00}, /*  91 '[' */
+    {0x10, 0x10, 0x08, 0x04, 0x02, 0x01, 0x01, 0x00, 0x00}, /*  92 backslash */
+    {0x0e, 0x02, 0x02, 0x02, 0x02, 0x02, 0x0e, 0x00, 0x00}, /*  93 ']' */
+    {0x04, 0x0a, 0x11, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00}, /*  94 '^' */
+    {0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x1f, 0x00, 0x00}, /*  95 '_' */
+    {0x08, 0x04, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00, 0x00}, /*  96 '`' */
+    {0x00, 0x00, 0x0e, 0x01, 0x0f, 0x11, 0x0f, 0x00, 0x00}, /*  97 'a' */
+    {0x10, 0x10, 0x1e, 0x11, 0x11, 0x11, 0x1e, 0x00, 0x00}, /*  98 'b' */
+    {0x00, 0x00, 0x0e, 0x11, 0x10, 0x11, 0x0e, 0x00, 0x00}, /*  99 'c' */
+    {0x01, 0x01, 0x0f, 0x11, 0x11, 0x11, 0x0f, 0x00, 0x00}, /* 100 'd' */
+    {0x00, 0x00, 0x0e, 0x11, 0x1f, 0x10, 0x0e, 0x00, 0x00}, /* 101 'e' */
+    {0x06, 0x09, 0x1c, 0x08, 0x08, 0x08, 0x08, 0x00, 0x00}, /* 102 'f' */
+    {0x00, 0x00, 0x0f, 0x11, 0x11, 0x11, 0x0f, 0x01, 0x0e}, /* 103 'g' */
+    {0x10, 0x10, 0x16, 0x19, 0x11, 0x11, 0x11, 0x00, 0x00}, /* 104 'h' */
+    {0x04, 0x00, 0x0c, 0x04, 0x04, 0x04, 0x0e, 0x00, 0x00}, /* 105 'i' */
+    {0x02, 0x00, 0x06, 0x02, 0x02, 0x02, 0x02, 0x12, 0x0c}, /* 106 'j' */
+    {0x10, 0x10, 0x12, 0x14, 0x18, 0x14, 0x12, 0x00, 0x00}, /* 107 'k' */
+    {0x0c, 0x04, 0x04, 0x04, 0x04, 0x04, 0x0e, 0x00, 0x00}, /* 108 'l' */
+    {0x00, 0x00, 0x1a, 0x15, 0x15, 0x15, 0x15, 0x00, 0x00}, /* 109 'm' */
+    {0x00, 0x00, 0x16, 0x19, 0x11, 0x11, 0x11, 0x00, 0x00}, /* 110 'n' */
+    {0x00, 0x00, 0x0e, 0x11, 0x11, 0x11, 0x0e, 0x00, 0x00}, /* 111 'o' */
+    {0x00, 0x00, 0x1e, 0x11, 0x11, 0x11, 0x1e, 0x10, 0x10}, /* 112 'p' */
+    {0x00, 0x00, 0x0f, 0x11, 0x11, 0x11, 0x0f, 0x01, 0x01}, /* 113 'q' */
+    {0x00, 0x00, 0x16, 0x19, 0x10, 0x10, 0x10, 0x00, 0x00}, /* 114 'r' */
+    {0x00, 0x00, 0x0f, 0x10, 0x0e, 0x01, 0x1e, 0x00, 0x00}, /* 115 's' */
+    {0x00, 0x08, 0x1e, 0x08, 0x08, 0x09, 0x06, 0x00, 0x00}, /* 116 't' */
+    {0x00, 0x00, 0x11, 0x11, 0x11, 0x13, 0x0d, 0x00, 0x00}, /* 117 'u' */
+    {0x00, 0x00, 0x11, 0x11, 0x11, 0x0a, 0x04, 0x00, 0x00}, /* 118 'v' */
+    {0x00, 0x00, 0x11, 0x11, 0x15, 0x15, 0x0a, 0x00, 0x00}, /* 119 'w' */
+    {0x00, 0x00, 0x11, 0x0a, 0x04, 0x0a, 0x11, 0x00, 0x00}, /* 120 'x' */
+    {0x00, 0x00, 0x11, 0x11, 0x11, 0x11, 0x0f, 0x01, 0x0e}, /* 121 'y' */
+    {0x00, 0x00, 0x1f, 0x02, 0x04, 0x08, 0x1f, 0x00, 0x00}, /* 122 'z' */
+    {0x06, 0x08, 0x08, 0x10, 0x08, 0x08, 0x06, 0x00, 0x00}, /* 123 '{' */
+    {0x04, 0x04, 0x04, 0x04, 0x04, 0x04, 0x04, 0x00, 0x00}, /* 124 '|' */
+    {0x0c, 0x02, 0x02, 0x01, 0x02, 0x02, 0x0c, 0x00, 0x00}, /* 125 '}' */
+    {0x00, 0x00, 0x08, 0x15, 0x02, 0x00, 0x00, 0x00, 0x00}  /* 126 '~' */
+};
+
+} // namespace
+
+// =============================================================================================
 // [SECTION] 10 Whitted shading and the render driver
 // =============================================================================================
 struct Tracer {
@@ -2725,6 +3408,112 @@ struct Tracer {
     Scratch *w;
     pray_rgb bg;  // background of the current pixel's row
 };
+
+// ---- textured surfaces ----
+// Texture coordinates of point x on primitive q, and the unit directions in which s and t grow.
+void tex_coords(const Prim &q, R3 x, double *s, double *t, R3 *ds, R3 *dt) {
+    const double PI = 3.14159265358979323846;
+    *s = *t = 0;
+    *ds = *dt = r3(0, 0, 0);
+    if (q.map == MAP_PLANE) {
+        R3 d = x - q.p;
+        *s = (double)dot(d, q.mu) / (double)dot(q.mu, q.mu);
+        *t = (double)dot(d, q.mv) / (double)dot(q.mv, q.mv);
+        *ds = unit(q.mu - q.n * dot(q.mu, q.n));
+        *dt = unit(q.mv - q.n * dot(q.mv, q.n));
+    } else if (q.map == MAP_SPHERE) {
+        R3 nrm = unit(x - q.p), north = unit(q.mu);
+        R3 e0 = unit(q.mv - north * dot(q.mv, north)), third = cross(north, e0);
+        double lon = atan2((double)dot(nrm, third), (double)dot(nrm, e0));
+        if (lon < 0) lon += 2 * PI;
+        *s = lon / (2 * PI);
+        if (*s >= 1) *s = 0;
+        double c = -(double)dot(nrm, north);
+        *t = acos(c > 1 ? 1 : c < -1 ? -1 : c) / PI;
+        *ds = unit(cross(north, nrm));
+        *dt = unit(north - nrm * dot(north, nrm));
+    }
+}
+
+// A model's coefficients at texture coordinates (s, t), and the tilt of the normal its bump
+// maps ask for (along the directions of growing s and t).
+struct Shade {
+    pray_rgb diffuse, specular, ambient, emit, reflect, transmit;
+    double exponent, index, bs, bt;
+    int has_exponent, has_index;
+};
+
+void shade_blend(Shade *o, const Shade &a, const Shade &b, pray_rgb wa, pray_rgb wb) {
+    o->diffuse = cadd(cmul(a.diffuse, wa), cmul(b.diffuse, wb));
+    o->specular = cadd(cmul(a.specular, wa), cmul(b.specular, wb));
+    o->ambient = cadd(cmul(a.ambient, wa), cmul(b.ambient, wb));
+    o->emit = cadd(cmul(a.emit, wa), cmul(b.emit, wb));
+    o->reflect = cadd(cmul(a.reflect, wa), cmul(b.reflect, wb));
+    o->transmit = cadd(cmul(a.transmit, wa), cmul(b.transmit, wb));
+    o->has_exponent = a.has_exponent || b.has_exponent;
+    o->exponent = a.has_exponent ? a.exponent : b.exponent;
+    o->has_index = a.has_index || b.has_index;
+    o->index = a.has_index ? a.index : b.index;
+    o->bs = a.bs + b.bs;
+    o->bt = a.bt + b.bt;
+}
+
+void shade_of(const pray_model *m, double s, double t, Shade *o) {
+    switch (m->kind) {
+    case M_FLAT:
+        o->diffuse = m->diffuse;
+        o->specular = m->specular;
+        o->ambient = m->ambient;
+        o->emit = m->emit;
+        o->reflect = m->reflect;
+        o->transmit = m->transmit;
+        o->exponent = m->exponent;
+        o->index = m->index;
+        o->has_exponent = m->has_exponent;
+        o->has_index = m->has_index;
+        o->bs = o->bt = 0;
+        return;
+    case M_TEX: {
+        Shade a, b;
+        shade_of(m->a, s, t, &a);
+        shade_of(m->b, s, t, &b);
+        pray_rgb c = tex_lookup(m->tex, s, t);
+        shade_blend(o, a, b, cmake(1 - c.r, 1 - c.g, 1 - c.b), c);
+        return;
+    }
+    case M_BUMP: {
+        shade_of(m->a, s, t, o);
+        double es = 0.5 / m->tex->w, et = 0.5 / m->tex->hgt;  // half a texel
+        o->bs += m->amount * (tex_luminance(m->tex, s + es, t) - tex_luminance(m->tex, s - es, t)) / (2 * es);
+        o->bt += m->amount * (tex_luminance(m->tex, s, t + et) - tex_luminance(m->tex, s, t - et)) / (2 * et);
+        return;
+    }
+    case M_MOVE: shade_of(m->a, s + m->dx, t + m->dy, o); return;
+    case M_SUM: {
+        Shade a, b;
+        shade_of(m->a, s, t, &a);
+        shade_of(m->b, s, t, &b);
+        shade_blend(o, a, b, cmake(1, 1, 1), cmake(1, 1, 1));
+        return;
+    }
+    default: {  // M_SCALE
+        Shade a, zero;
+        shade_of(m->a, s, t, &a);
+        memset(&zero, 0, sizeof zero);
+        shade_blend(o, a, zero, m->factor, cmake(0, 0, 0));
+        return;
+    }
+    }
+}
+
+pray_rgb transmit_at(const Prim &q, R3 x) {
+    double s, t;
+    R3 ds, dt;
+    tex_coords(q, x, &s, &t, &ds, &dt);
+    Shade sh;
+    shade_of(q.mat, s, t, &sh);
+    return sh.transmit;
+}
 
 // The colour a ray brings back. `hit`, when given, receives the primitive it meets (-1: none).
 pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, int *hit = NULL) {
@@ -2738,9 +3527,21 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, int *h
     if (!fh.found) return tr.bg;
     const Hit &h = fh.h;
     const Prim &q = s->prims[h.prim];
-    const pray_model *m = q.mat;
     R3 x = ray.o + ray.d * h.t;
     R3 ng = prim_normal(q, x);
+    Shade sh;
+    const Shade *m = &sh;
+    if (q.mat->kind == M_FLAT) shade_of(q.mat, 0, 0, &sh);
+    else {
+        double ts, tt;
+        R3 ds, dt;
+        tex_coords(q, x, &ts, &tt, &ds, &dt);
+        shade_of(q.mat, ts, tt, &sh);
+        if (sh.bs != 0 || sh.bt != 0) {  // bump: tilt the normal, not the surface
+            R3 b = unit(ng - ds * (real)sh.bs - dt * (real)sh.bt);
+            if (dot(b, b) > 0) ng = b;
+        }
+    }
     R3 n = (h.prim_enter == h.root_enter) ? ng : ng * (real)-1;  // out of the whole solid
     if (dot(n, ray.d) > 0) n = n * (real)-1;                     // towards the viewer
     pray_rgb col = cadd(m->emit, m->ambient);
@@ -2763,11 +3564,12 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, int *h
         pray_rgb li = L.intensity;
         if (s->shadows) {
             ShadowHit sh;
-            sh.s = s;
-            sh.f = cmake(1, 1, 1);
             Ray sr;
             sr.o = x;
             sr.d = l;
+            sh.s = s;
+            sh.ray = &sr;
+            sh.f = cmake(1, 1, 1);
             tr.w->k.rays[RAY_SHADOW] += 1;
             find_hits(s, tr.w, sr, dist, h.prim, sh);
             if (czero(sh.f)) continue;
@@ -3116,8 +3918,6 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
 // =============================================================================================
 // [SECTION] 11 Image writers: TIFF, PPM, PNG; writing files safely
 // =============================================================================================
-#include <errno.h>
-
 namespace {
 
 struct Sink {
@@ -3292,6 +4092,7 @@ void file_put(void *ud, const void *p, size_t n) {
 #endif
 
 } // namespace
+
 
 // ---------------------------------------------------------------------------------------------
 // Public functions of sections 2 to 11
@@ -3532,6 +4333,195 @@ pray_object *pray_cylinder(pray_ctx *c, pray_model *m, pray_vec point, pray_vec 
 }
 
 pray_object *pray_one(pray_ctx *c, pray_model *m) { return m ? obj_new(c, O_ONE, m) : NULL; }
+
+namespace {
+bool bad_pair(pray_ctx *c, pray_vec u, pray_vec v, const char *what) {
+    if (bad_vec(c, u, what, true) || bad_vec(c, v, what, true)) return true;
+    if (vlen(vcross(u, v)) <= 1e-12 * vlen(u) * vlen(v)) {
+        fail(c, PRAY_ERR_ARG, "%s: the two vectors must not be parallel", what);
+        return true;
+    }
+    return false;
+}
+} // namespace
+
+pray_object *pray_planemap(pray_ctx *c, pray_model *m, pray_vec point, pray_vec normal, pray_vec u, pray_vec v) {
+    if (!m || bad_pair(c, u, v, "planemap")) return NULL;
+    pray_object *o = pray_plane(c, m, point, normal);
+    if (!o) return NULL;
+    o->map = MAP_PLANE;
+    o->mu = u;
+    o->mv = v;
+    return o;
+}
+
+pray_object *pray_spheremap(pray_ctx *c, pray_model *m, pray_vec centre, double r, pray_vec north, pray_vec zero) {
+    if (!m || bad_pair(c, north, zero, "spheremap")) return NULL;
+    pray_object *o = pray_sphere(c, m, centre, r);
+    if (!o) return NULL;
+    o->map = MAP_SPHERE;
+    o->mu = north;
+    o->mv = zero;
+    return o;
+}
+
+pray_texture *pray_texture_file(pray_ctx *c, const char *path) {
+    if (!c || !path || !*path) {
+        if (c) fail(c, PRAY_ERR_ARG, "no texture file name");
+        return NULL;
+    }
+    return texture_file(c, path);
+}
+
+pray_texture *pray_texture_tiff(pray_ctx *c, const void *data, size_t n, const char *name) {
+    if (!c || !data) return NULL;
+    return texture_make(c, name ? name : "texture", (const unsigned char *)data, n);
+}
+
+void pray_texture_size(const pray_texture *t, int *w, int *h) {
+    if (w) *w = t ? t->w : 0;
+    if (h) *h = t ? t->hgt : 0;
+}
+
+pray_rgb pray_texture_pixel(const pray_texture *t, int x, int y) {
+    if (!t || x < 0 || y < 0 || x >= t->w || y >= t->hgt) return cmake(0, 0, 0);
+    const float *p = t->rgb + ((size_t)y * t->w + x) * 3;
+    return cmake(p[0], p[1], p[2]);
+}
+
+pray_model *pray_tiff(pray_ctx *c, pray_model *m0, pray_model *m1, pray_texture *t) {
+    if (!m0 || !m1 || !t) return NULL;
+    pray_model *m = model_node(c, M_TEX, m0, m1);
+    if (m) {
+        m->tex = t;
+        retain(t);
+    }
+    return m;
+}
+
+pray_model *pray_tiffbump(pray_ctx *c, pray_model *a, double amount, pray_texture *t) {
+    if (!a || !t) return NULL;
+    if (!finite_num(amount)) {
+        fail(c, PRAY_ERR_ARG, "tiffbump: the amount is not finite");
+        return NULL;
+    }
+    pray_model *m = model_node(c, M_BUMP, a, NULL);
+    if (m) {
+        m->tex = t;
+        m->amount = amount;
+        retain(t);
+    }
+    return m;
+}
+
+pray_model *pray_move(pray_ctx *c, pray_model *a, double x, double y) {
+    if (!a) return NULL;
+    if (!finite_num(x) || !finite_num(y)) {
+        fail(c, PRAY_ERR_ARG, "move: the shift is not finite");
+        return NULL;
+    }
+    pray_model *m = model_node(c, M_MOVE, a, NULL);
+    if (m) {
+        m->dx = x;
+        m->dy = y;
+    }
+    return m;
+}
+
+namespace {
+// The half-space through q with outward normal n, as part of a glyph box.
+pray_object *glyph_face(pray_ctx *c, pray_model *m, pray_vec q, pray_vec n) { return pray_plane(c, m, q, n); }
+
+// Ink of a glyph pixel: the built-in font, or a 16 x 16 atlas texture (ink dark).
+bool glyph_ink(const pray_texture *font, int code, int row, int col, int cw, int ch) {
+    if (!font) return col < 5 && (FONT6X9[code - 32][row] >> (4 - col) & 1) != 0;
+    int x = (code % 16) * cw + col, y = (code / 16) * ch + row;
+    const float *p = font->rgb + ((size_t)y * font->w + x) * 3;
+    return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2] < 0.5;
+}
+} // namespace
+
+pray_object *pray_text(pray_ctx *c, pray_model *m, const char *text, pray_vec P, pray_vec X, pray_vec Y, double h,
+                       pray_texture *font, double spacing) {
+    if (!c || !m || !text) return NULL;
+    if (bad_vec(c, P, "text", false) || bad_pair(c, X, Y, "text")) return NULL;
+    if (!finite_num(h) || h <= 0) {
+        fail(c, PRAY_ERR_ARG, "text: the thickness must be a positive number, not %g", h);
+        return NULL;
+    }
+    if (!finite_num(spacing) || spacing <= 0) {
+        fail(c, PRAY_ERR_ARG, "text: the spacing must be a positive number, not %g", spacing);
+        return NULL;
+    }
+    int cw = 6, ch = 9, ref = 7;  // cell columns and rows; rows of the glyph height Y
+    if (font) {
+        cw = font->w / 16;
+        ch = font->hgt / 16;
+        ref = ch;
+        if (cw < 1 || ch < 1) {
+            fail(c, PRAY_ERR_ARG, "text: the font image %s is smaller than 16 x 16 cells", font->name);
+            return NULL;
+        }
+        if (cw > 64 || ch > 64) {
+            fail(c, PRAY_ERR_LIMIT, "text: the font's cells are over 64 pixels");
+            return NULL;
+        }
+    }
+    pray_vec n = vmul(vcross(X, Y), 1.0 / vlen(vcross(X, Y)));
+    pray_vec nx = vcross(Y, n), ny = vcross(n, X);
+    nx = vmul(nx, 1.0 / vlen(nx));
+    ny = vmul(ny, 1.0 / vlen(ny));
+    pray_vec back = vmul(n, -1), front = n, left = vmul(nx, -1), down = vmul(ny, -1);
+    pray_object *all = pray_nothing(c);
+    unsigned char used[64][64];
+    int k = 0;
+    for (const unsigned char *p = (const unsigned char *)text; all && *p; k++) {
+        int code = *p;
+        if (code < 0x80) p++;
+        else {  // one '?' for a multi-byte character
+            code = '?';
+            p++;
+            while ((*p & 0xC0) == 0x80) p++;
+        }
+        if (code < 32 || code > 126) code = '?';
+        if (code == ' ' && !font) continue;
+        pray_vec origin = vadd(P, vmul(X, k * spacing));
+        memset(used, 0, sizeof used);
+        for (int r = 0; all && r < ch; r++)
+            for (int col = 0; all && col < cw; col++) {
+                if (used[r][col] || !glyph_ink(font, code, r, col, cw, ch)) continue;
+                // the largest rectangle from here: right along the row, then down while full
+                int c1 = col;
+                while (c1 + 1 < cw && !used[r][c1 + 1] && glyph_ink(font, code, r, c1 + 1, cw, ch)) c1++;
+                int r1 = r;
+                for (bool full = true; full && r1 + 1 < ch;) {
+                    for (int q = col; q <= c1 && full; q++)
+                        full = !used[r1 + 1][q] && glyph_ink(font, code, r1 + 1, q, cw, ch);
+                    if (full) r1++;
+                }
+                for (int rr = r; rr <= r1; rr++)
+                    for (int q = col; q <= c1; q++) used[rr][q] = 1;
+                double x0 = (double)col / cw, x1 = (double)(c1 + 1) / cw;
+                double y0 = (double)(ref - 1 - r1) / ref, y1 = (double)(ref - r) / ref;
+                pray_vec a = vadd(origin, vadd(vmul(X, x0), vmul(Y, y0)));
+                pray_vec b = vadd(origin, vadd(vmul(X, x1), vmul(Y, y1)));
+                pray_object *box = glyph_face(c, m, a, left);
+                pray_object *parts[5] = {glyph_face(c, m, b, nx), glyph_face(c, m, a, down), glyph_face(c, m, b, ny),
+                                         glyph_face(c, m, a, back), glyph_face(c, m, vadd(a, vmul(n, h)), front)};
+                for (int i = 0; i < 5; i++) {
+                    pray_object *x = pray_csg(c, PRAY_INTERSECTION, box, parts[i]);
+                    release_handle(c, box);
+                    release_handle(c, parts[i]);
+                    box = x;
+                }
+                pray_object *u = pray_csg(c, PRAY_UNION, all, box);
+                release_handle(c, all);
+                release_handle(c, box);
+                all = u;
+            }
+    }
+    return all;
+}
 pray_object *pray_nothing(pray_ctx *c) { return obj_new(c, O_NOTHING, NULL); }
 
 pray_object *pray_csg(pray_ctx *c, pray_op op, pray_object *a, pray_object *b) {
@@ -5063,8 +6053,80 @@ pray_status bi_transparent(Interp &I, const Expr *call, Value *a, Value *out) {
     if (want(I, call, a, 0, V_INTENS) || want(I, call, a, 1, V_NUM)) return I.c->status;
     return made(I, call, V_MODEL, pray_transparent(I.c, rgb_of(a[0]), a[1].v[0]), out);
 }
-pray_status bi_later(Interp &I, const Expr *call, Value *, Value *) {
-    return rerr(I, call, PRAY_ERR_RUNTIME, "'%s' (textures and text) is not available in this version", call->s);
+pray_status bi_planemap(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_MODEL) || want(I, call, a, 1, V_POINT) || want(I, call, a, 2, V_VECTOR) ||
+        want(I, call, a, 3, V_VECTOR) || want(I, call, a, 4, V_VECTOR))
+        return I.c->status;
+    return made(I, call, V_OBJECT,
+                pray_planemap(I.c, (pray_model *)a[0].ref, vec_of(a[1]), vec_of(a[2]), vec_of(a[3]), vec_of(a[4])), out);
+}
+pray_status bi_spheremap(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_MODEL) || want(I, call, a, 1, V_POINT) || want(I, call, a, 2, V_NUM) ||
+        want(I, call, a, 3, V_VECTOR) || want(I, call, a, 4, V_VECTOR))
+        return I.c->status;
+    return made(I, call, V_OBJECT,
+                pray_spheremap(I.c, (pray_model *)a[0].ref, vec_of(a[1]), a[2].v[0], vec_of(a[3]), vec_of(a[4])), out);
+}
+
+// A texture named by the program: as written, else beside the program. Errors name the call.
+pray_texture *program_texture(Interp &I, const Expr *call, const Value &name) {
+    pray_ctx *c = I.c;
+    const char *path = ((const Str *)name.ref)->s;
+    pray_texture *t = pray_texture_file(c, path);
+    bool relative = path[0] && path[0] != '/' && path[0] != '\\' && !(path[0] && path[1] == ':');
+    if (!t && c->status == PRAY_ERR_IO && relative && c->run_dir[0]) {
+        char alt[1100];
+        snprintf(alt, sizeof alt, "%s%s", c->run_dir, path);
+        char msg[1024];
+        snprintf(msg, sizeof msg, "%s", c->msg);
+        t = pray_texture_file(c, alt);
+        if (!t && c->status == PRAY_ERR_IO) {  // report the name as the program wrote it
+            c->status = PRAY_ERR_IO;
+            snprintf(c->msg, sizeof c->msg, "%s", msg);
+        }
+    }
+    if (!t) {
+        pray_status s = api_err(I, call->line, call->col);
+        if (s == PRAY_ERR_IO) c->status = PRAY_ERR_RUNTIME;  // a wrong name in the program
+    }
+    return t;
+}
+
+pray_status bi_tiff(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_MODEL) || want(I, call, a, 1, V_MODEL) || want(I, call, a, 2, V_STRING))
+        return I.c->status;
+    pray_texture *t = program_texture(I, call, a[2]);
+    if (!t) return I.c->status;
+    pray_model *m = pray_tiff(I.c, (pray_model *)a[0].ref, (pray_model *)a[1].ref, t);
+    release_handle(I.c, t);
+    return made(I, call, V_MODEL, m, out);
+}
+pray_status bi_tiffbump(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_MODEL) || want(I, call, a, 1, V_NUM) || want(I, call, a, 2, V_STRING))
+        return I.c->status;
+    pray_texture *t = program_texture(I, call, a[2]);
+    if (!t) return I.c->status;
+    pray_model *m = pray_tiffbump(I.c, (pray_model *)a[0].ref, a[1].v[0], t);
+    release_handle(I.c, t);
+    return made(I, call, V_MODEL, m, out);
+}
+pray_status bi_move(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_MODEL) || want(I, call, a, 1, V_NUM) || want(I, call, a, 2, V_NUM)) return I.c->status;
+    return made(I, call, V_MODEL, pray_move(I.c, (pray_model *)a[0].ref, a[1].v[0], a[2].v[0]), out);
+}
+pray_status bi_text(Interp &I, const Expr *call, Value *a, Value *out) {
+    static const int types[8] = {V_MODEL, V_STRING, V_POINT, V_VECTOR, V_VECTOR, V_NUM, V_STRING, V_NUM};
+    for (int i = 0; i < 8; i++)
+        if (want(I, call, a, i, types[i])) return I.c->status;
+    pray_texture *font = NULL;
+    if (((const Str *)a[6].ref)->n > 0) {
+        font = program_texture(I, call, a[6]);
+        if (!font) return I.c->status;
+    }
+    pray_object *o = pray_text(I.c, (pray_model *)a[0].ref, ((const Str *)a[1].ref)->s, vec_of(a[2]), vec_of(a[3]),
+                               vec_of(a[4]), a[5].v[0], font, a[7].v[0]);
+    release_handle(I.c, font);
+    return made(I, call, V_OBJECT, o, out);
 }
 
 // Alphabetical, as in appendix A of the thesis.
@@ -5075,14 +6137,14 @@ const Builtin BUILTINS[] = {
     {"cos", 1, 1, bi_cos},           {"cylinder", 4, 4, bi_cylinder},
     {"directionlight", 2, 2, bi_dirlight}, {"dirlight", 2, 2, bi_dirlight},
     {"exp", 1, 1, bi_exp},           {"log", 1, 1, bi_log},
-    {"mirror", 1, 1, bi_mirror},     {"move", 3, 3, bi_later},
+    {"mirror", 1, 1, bi_mirror},     {"move", 3, 3, bi_move},
     {"norm", 1, 1, bi_norm},         {"one", 1, 1, bi_one},
     {"phong", 3, 4, bi_phong},       {"plane", 3, 3, bi_plane},
-    {"planemap", 5, 5, bi_later},    {"pointlight", 2, 2, bi_pointlight},
+    {"planemap", 5, 5, bi_planemap}, {"pointlight", 2, 2, bi_pointlight},
     {"sin", 1, 1, bi_sin},           {"sphere", 3, 3, bi_sphere},
-    {"spheremap", 5, 5, bi_later},   {"sqrt", 1, 1, bi_sqrt},
-    {"tan", 1, 1, bi_tan},           {"text", 8, 8, bi_later},
-    {"tiff", 3, 3, bi_later},        {"tiffbump", 3, 3, bi_later},
+    {"spheremap", 5, 5, bi_spheremap}, {"sqrt", 1, 1, bi_sqrt},
+    {"tan", 1, 1, bi_tan},           {"text", 8, 8, bi_text},
+    {"tiff", 3, 3, bi_tiff},         {"tiffbump", 3, 3, bi_tiffbump},
     {"transparent", 2, 2, bi_transparent},
 };
 const int NBUILTINS = (int)(sizeof BUILTINS / sizeof BUILTINS[0]);
@@ -5645,6 +6707,7 @@ namespace {
 // A run starts from what the host set (the defaults, unless it set more) and ends back there.
 void reset_run(pray_ctx *c) {
     c->cur = c->base;
+    texture_cache_clear(c);  // files are read again by the next run
     memset(&c->stats, 0, sizeof c->stats);
     c->frames = 0;
     c->status = PRAY_OK;
@@ -5687,7 +6750,18 @@ pray_status pray_run_file(pray_ctx *c, const char *path) {
     pray_status st;
     if (!ok) st = c->status;
     else if (bad) st = fail(c, PRAY_ERR_IO, "cannot read '%s'", path);
-    else st = pray_run_string(c, path, t.str(), (size_t)t.a.n);
+    else {
+        // texture files named by the program are also looked for beside it
+        const char *slash = NULL;
+        for (const char *q = path; *q; q++)
+            if (*q == '/' || *q == '\\' || *q == ':') slash = q;
+        size_t dl = slash ? (size_t)(slash - path + 1) : 0;
+        if (dl >= sizeof c->run_dir) dl = 0;
+        memcpy(c->run_dir, path, dl);
+        c->run_dir[dl] = 0;
+        st = pray_run_string(c, path, t.str(), (size_t)t.a.n);
+        c->run_dir[0] = 0;
+    }
     t.a.release(c);
     return st;
 #else

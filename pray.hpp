@@ -76,6 +76,7 @@ typedef struct pray_ctx pray_ctx;       /* one context per thread of use */
 typedef struct pray_object pray_object; /* a solid: a primitive or a CSG tree */
 typedef struct pray_model pray_model;   /* a lighting model (material) */
 typedef struct pray_light pray_light;   /* a set of light sources */
+typedef struct pray_texture pray_texture; /* a decoded TIFF image, for textures and fonts */
 
 /* Memory: like Lua's lua_Alloc. nsize == 0 frees ptr and returns NULL; otherwise returns a block
    of nsize bytes holding the first min(osize, nsize) bytes of ptr (ptr may be NULL), or NULL. */
@@ -160,12 +161,39 @@ pray_model *pray_color(pray_ctx *ctx, pray_rgb colour);
 pray_model *pray_model_add(pray_ctx *ctx, pray_model *a, pray_model *b);
 pray_model *pray_model_scale(pray_ctx *ctx, pray_model *m, pray_rgb factor);
 
+/* Textures: a TIFF file (decoded once per context run, however often it is asked for), or TIFF
+   data in memory. Baseline TIFF: bilevel, grey, palette, RGB(A); 1, 4, 8, 16 bits; strips or
+   tiles; no compression, PackBits or LZW (with the horizontal predictor). */
+pray_texture *pray_texture_file(pray_ctx *ctx, const char *path);
+pray_texture *pray_texture_tiff(pray_ctx *ctx, const void *data, size_t size, const char *name);
+/* Width and height of a texture in pixels, and its colour at texel (x, y) (rows from the top). */
+void pray_texture_size(const pray_texture *tex, int *width, int *height);
+pray_rgb pray_texture_pixel(const pray_texture *tex, int x, int y);
+/* Textured models: m0 where the texture is 0 blended per channel into m1 where it is 1; m with
+   its normal tilted by `amount` times the gradient of the texture's luminance; m with its texture
+   coordinates shifted by (x, y) images. */
+pray_model *pray_tiff(pray_ctx *ctx, pray_model *m0, pray_model *m1, pray_texture *tex);
+pray_model *pray_tiffbump(pray_ctx *ctx, pray_model *m, double amount, pray_texture *tex);
+pray_model *pray_move(pray_ctx *ctx, pray_model *m, double x, double y);
+
 /* Solids. */
 pray_object *pray_sphere(pray_ctx *ctx, pray_model *m, pray_vec centre, double radius);
 pray_object *pray_plane(pray_ctx *ctx, pray_model *m, pray_vec point, pray_vec normal);
 pray_object *pray_cylinder(pray_ctx *ctx, pray_model *m, pray_vec point, pray_vec axis,
                            double radius);
 pray_object *pray_one(pray_ctx *ctx, pray_model *m);
+/* A half-space and a ball with texture coordinates (see the language manual: planemap,
+   spheremap). */
+pray_object *pray_planemap(pray_ctx *ctx, pray_model *m, pray_vec point, pray_vec normal, pray_vec u,
+                           pray_vec v);
+pray_object *pray_spheremap(pray_ctx *ctx, pray_model *m, pray_vec centre, double radius, pray_vec north,
+                            pray_vec zero_longitude);
+/* The characters of a UTF-8 string as a solid: glyph cells from `point` (baseline, left) along
+   `advance` (one character), glyphs of height `up`, extruded by `thickness` along
+   unit(advance x up); `font` NULL for the built-in font, else a 16 x 16 atlas of glyph cells
+   in ASCII order (ink dark); `spacing` multiplies the advance (1 = the font's own). */
+pray_object *pray_text(pray_ctx *ctx, pray_model *m, const char *text, pray_vec point, pray_vec advance,
+                       pray_vec up, double thickness, pray_texture *font, double spacing);
 pray_object *pray_nothing(pray_ctx *ctx);
 
 typedef enum pray_op {
