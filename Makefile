@@ -4,6 +4,9 @@
 #   make check      build and run all tests (installs the test packages if missing)
 #   make matrix     compile pray.cpp under every configuration macro and language level
 #   make bench      the acceleration benchmarks (bench/run.sh), results in docs/benchmarks.md
+#   make check-bad  the catalogue of bad inputs (tests/bad/run.sh); the last step of check
+#   make sanitize   the tests and the bad inputs under AddressSanitizer and UBSan
+#   make fuzz       build the libFuzzer harness and fuzz for FUZZ_SECONDS (needs clang)
 #   make clean
 
 CXX      ?= c++
@@ -21,7 +24,7 @@ TESTS = tests/pray_tests$(EXE)
 TESTS_FLOAT = tests/pray_tests_float$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
-.PHONY: all examples check deps matrix clean embed bench
+.PHONY: all examples check deps matrix clean embed bench check-bad sanitize fuzz
 
 all: $(PRAY)
 
@@ -66,6 +69,39 @@ check: deps $(PRAY) $(TESTS) $(TESTS_FLOAT) tests/embed$(EXE)
 	$(RUN) ./$(TESTS_FLOAT)
 	@echo "== tests, PRAY_REAL=double"
 	$(RUN) ./$(TESTS)
+	@$(MAKE) --no-print-directory check-bad
+
+# Bad inputs: exact messages and exit statuses, nothing left behind (docs/testing.md).
+check-bad: $(PRAY)
+	@echo "== bad inputs (tests/bad)"
+	PRAY=./$(PRAY) tests/bad/run.sh
+
+# The doctest suite and ./pray built with AddressSanitizer and UBSan into build/sanitize/, then
+# the suite (whose command-line tests use the plain ./pray) and the bad inputs run with them.
+SANFLAGS = -fsanitize=address,undefined -fno-sanitize-recover=undefined -O1 -g
+sanitize: deps $(PRAY)
+	@mkdir -p build/sanitize
+	$(CXX) -std=c++98 $(SANFLAGS) $(WARN) -fno-exceptions -fno-rtti -DPRAY_MAIN pray.cpp -o build/sanitize/pray $(LDLIBS)
+	$(CXX) $(TESTFLAGS) $(SANFLAGS) $(TEST_SRC) -o build/sanitize/pray_tests $(LDLIBS) -lpthread
+	@echo "== tests under the sanitizers"
+	./build/sanitize/pray_tests
+	@echo "== bad inputs under the sanitizers"
+	PRAY=build/sanitize/pray tests/bad/run.sh
+
+# libFuzzer (clang; on Debian the runtime is in libclang-rt-14-dev): the harness runs fuzz inputs
+# as PRAY programs. New inputs go to build/fuzz/corpus, crashes to build/fuzz/artifacts/; the seeds
+# and the regression inputs of tests/fuzz/ are read, never written.
+FUZZ_CXX ?= clang++
+FUZZ_SECONDS ?= 60
+FUZZFLAGS = -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined
+build/fuzz/fuzz_program: tests/fuzz/fuzz_program.cpp pray.cpp pray.hpp
+	@mkdir -p build/fuzz
+	$(FUZZ_CXX) $(FUZZFLAGS) -I. tests/fuzz/fuzz_program.cpp pray.cpp -o $@
+fuzz: build/fuzz/fuzz_program
+	@mkdir -p build/fuzz/corpus build/fuzz/artifacts
+	build/fuzz/fuzz_program -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -timeout=10 \
+	  -dict=tests/fuzz/pray.dict -artifact_prefix=build/fuzz/artifacts/ \
+	  build/fuzz/corpus tests/fuzz/corpus tests/fuzz/crashes
 
 # Benchmarks print tables; they are never part of check.
 bench: $(PRAY)

@@ -1,21 +1,23 @@
 /* pray.cpp — the whole implementation of pray. MIT License, see LICENSE.
 
    Index (grep '\[SECTION\]'):
-   [SECTION] 1  Portability shims: configuration, real type, clock, terminal, file rename
+   [SECTION] 1  Portability shims: configuration, real type, clock, terminal, files, threads
    [SECTION] 2  Context: allocator with a cap, status and messages
    [SECTION] 3  Tiny containers on the context allocator
    [SECTION] 4  Vector math and the `.` transformations
    [SECTION] 5  Scene values: models, lights, solids (reference counted handles)
    [SECTION] 6  Options
-   [SECTION] 7  Prepared scene: flattened n-ary CSG tree, primitives in render precision
+   [SECTION] 7  Prepared scene: flattened n-ary CSG tree, boxes, simplification, snapping
    [SECTION] 8  Ray/primitive intersection
    [SECTION] 9  CSG status-tree sweep (the brute-force reference, thesis 3.4)
-   [SECTION] 10 Whitted shading and the render driver
-   [SECTION] 11 Image writers: TIFF, PPM, PNG; writing files safely
+   [SECTION] 9b Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
+   [SECTION] 9c TIFF reader and textures, the built-in font
+   [SECTION] 10 Whitted shading, textured surfaces, the render driver (threads, undersampling)
+   [SECTION] 11 Image writers: TIFF, PPM, PNG; writing files safely; public functions
    [SECTION] 12 PRAY lexer
    [SECTION] 13 PRAY parser
    [SECTION] 14 PRAY interpreter: values, operators, builtins, statements
-   [SECTION] 15 One-call helpers
+   [SECTION] 15 One-call helpers and the running of programs
    [SECTION] 16 Command-line program (PRAY_MAIN)
 */
 

@@ -628,7 +628,7 @@ TEST_CASE("phono is not a function but an ordinary name") {
 
 // Pending: the manual (docs/pray-language.md) says these arrive with the textures issue, and pray.cpp
 // still answers "not available in this version". Skipped until then; run with --no-skip.
-TEST_CASE("the texture and text makers of the specification are functions" * doctest::skip()) {
+TEST_CASE("the texture and text makers of the specification are functions") {
     const std::string m = "M = color({1})\n";
     CHECK_PRINTS(m + "print planemap(M, [0,0,0], <0,0,1>, <1,0,0>, <0,1,0>)\n", "object (1 primitive)\n");
     CHECK_PRINTS(m + "print spheremap(M, [0,0,0], 1, <0,0,1>, <1,0,0>)\n", "object (1 primitive)\n");
