@@ -4073,6 +4073,7 @@ int image_format(const char *path) {
     return FMT_NONE;
 }
 
+#if PRAY_HAS_STDIO
 pray_status write_format(pray_ctx *c, const pray_image *img, int fmt, int bits, Sink &out) {
     if (fmt == FMT_TIFF) return write_tiff(c, img, bits, out);
     if (fmt == FMT_PPM) return write_ppm(c, img, bits, out);
@@ -4081,6 +4082,7 @@ pray_status write_format(pray_ctx *c, const pray_image *img, int fmt, int bits, 
 #endif
     return fail(c, PRAY_ERR_ARG, "this build cannot write that format");
 }
+#endif
 
 #if PRAY_HAS_STDIO
 struct FileSink {
@@ -4578,6 +4580,22 @@ pray_light *pray_pointlight(pray_ctx *c, pray_rgb i, pray_vec p) {
 }
 pray_light *pray_light_add(pray_ctx *c, pray_light *a, pray_light *b) {
     return a && b ? light_union(c, a, b) : NULL;
+}
+pray_light *pray_light_scale(pray_ctx *c, pray_light *l, double s) {
+    if (!l) return NULL;
+    if (!finite_num(s) || s == 0) {
+        fail(c, PRAY_ERR_ARG, "scale factor must be a finite number other than 0, not %g", s);
+        return NULL;
+    }
+    return light_transform(c, l, xf_scale(s));
+}
+pray_light *pray_light_translate(pray_ctx *c, pray_light *l, pray_vec v) {
+    if (!l || bad_vec(c, v, "translation", false)) return NULL;
+    return light_transform(c, l, xf_translate(v));
+}
+pray_light *pray_light_rotate(pray_ctx *c, pray_light *l, pray_vec deg) {
+    if (!l || bad_vec(c, deg, "rotation", false)) return NULL;
+    return light_transform(c, l, xf_rotate(deg));
 }
 
 void pray_release(pray_ctx *c, void *h) {

@@ -216,6 +216,10 @@ int pray_object_primitives(const pray_object *a);
 pray_light *pray_dirlight(pray_ctx *ctx, pray_rgb intensity, pray_vec direction);
 pray_light *pray_pointlight(pray_ctx *ctx, pray_rgb intensity, pray_vec position);
 pray_light *pray_light_add(pray_ctx *ctx, pray_light *a, pray_light *b);
+/* The `.` transformations of lights: point lights move, directions turn. */
+pray_light *pray_light_scale(pray_ctx *ctx, pray_light *l, double s);
+pray_light *pray_light_translate(pray_ctx *ctx, pray_light *l, pray_vec offset);
+pray_light *pray_light_rotate(pray_ctx *ctx, pray_light *l, pray_vec degrees);
 
 /* Drop a reference (any of the three handle kinds; NULL is ignored). */
 void pray_release(pray_ctx *ctx, void *handle);
