@@ -1,9 +1,12 @@
 # pray — build, test and render. Plain make; no probing of the host.
 #   make            the command-line program ./pray
 #   make examples   render every examples/*.ray into out/
+#   make textures   the examples' TIFF textures, rendered by examples/maketex.ray into examples/tex/
+#   make gallery    render every example into docs/gallery/ and write docs/gallery.md (tools/gallery.sh)
 #   make check      build and run all tests (installs the test packages if missing)
 #   make matrix     compile pray.cpp under every configuration macro and language level
 #   make bench      the acceleration benchmarks (bench/run.sh), results in docs/benchmarks.md
+#   make ports      build, run and compare every port (ports/check; installs cross compilers, qemu, wine)
 #   make check-bad  the catalogue of bad inputs (tests/bad/run.sh); the last step of check
 #   make sanitize   the tests and the bad inputs under AddressSanitizer and UBSan
 #   make fuzz       build the libFuzzer harness and fuzz for FUZZ_SECONDS (needs clang)
@@ -24,7 +27,7 @@ TESTS = tests/pray_tests$(EXE)
 TESTS_FLOAT = tests/pray_tests_float$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
-.PHONY: all examples check deps matrix clean embed bench check-bad sanitize fuzz
+.PHONY: all examples check deps matrix clean embed bench check-bad sanitize fuzz textures gallery ports
 
 all: $(PRAY)
 
@@ -40,7 +43,7 @@ deps:
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $$missing >/dev/null; \
 	fi
 
-examples: $(PRAY)
+examples: $(PRAY) textures
 	@mkdir -p out
 	@for f in examples/*.ray; do \
 	  n=$$(basename $$f .ray); \
@@ -103,6 +106,15 @@ fuzz: build/fuzz/fuzz_program
 	  -dict=tests/fuzz/pray.dict -artifact_prefix=build/fuzz/artifacts/ \
 	  build/fuzz/corpus tests/fuzz/corpus tests/fuzz/crashes
 
+# The textures of the examples, made by pray itself.
+textures: $(PRAY)
+	@mkdir -p examples/tex
+	$(RUN) ./$(PRAY) --quiet examples/maketex.ray
+
+# The gallery: every example rendered at 256 x 256 with its statistics (docs/gallery.md).
+gallery: $(PRAY) textures
+	tools/gallery.sh
+
 # Benchmarks print tables; they are never part of check.
 bench: $(PRAY)
 	bench/run.sh
@@ -110,12 +122,17 @@ bench: $(PRAY)
 # Every configuration macro on its own, float and double, C++98/11/17, warnings as errors.
 MATRIX_STDS = -std=c++98 -std=c++11 -std=c++17
 MATRIX_DEFS = "" -DPRAY_REAL=float -DPRAY_NO_INTERP -DPRAY_NO_STDIO -DPRAY_NO_PNG -DPRAY_NO_THREADS \
-              -DPRAY_NO_DEFAULT_ALLOC "-DPRAY_MAX_ALLOC=1000000" "-DPRAY_MAIN" "-DPRAY_MAIN -DPRAY_REAL=float"
+              -DPRAY_NO_DEFAULT_ALLOC "-DPRAY_MAX_ALLOC=1000000" "-DPRAY_MAIN" "-DPRAY_MAIN -DPRAY_REAL=float" \
+              $(foreach h,$(wildcard ports/*/prayconf.h),'-DPRAY_MAIN -DPRAY_USER_CONFIG="$(h)"')
 matrix:
 	@for s in $(MATRIX_STDS); do for d in $(MATRIX_DEFS); do \
 	  printf '%-12s %-36s ' "$$s" "$$d"; \
 	  $(CXX) $$s $(OPT) $(WARN) -Werror -fno-exceptions -fno-rtti $$d -c pray.cpp -o /dev/null || exit 1; \
 	  echo ok; done; done
+
+# Every port built, run under qemu-user or wine, its images compared with ./pray's (ports/README.md).
+ports:
+	sh ports/check
 
 clean:
 	rm -rf $(PRAY) $(TESTS) $(TESTS_FLOAT) tests/embed$(EXE) tests/*.o tests/*.ppm out

@@ -5828,6 +5828,11 @@ struct Value {
     void *ref;  // light, model, object or string
 };
 
+struct NameCount {
+    char *name;
+    int frames;
+};
+
 struct Interp {
     pray_ctx *c;
     const char *name;
@@ -5836,6 +5841,7 @@ struct Interp {
     double steps;
     int quit;
     int frames;
+    Array<NameCount> names;  // output names used so far, and their frames
 };
 
 Value vnum(double x) {
@@ -6516,7 +6522,19 @@ pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
         int keep = ext ? (int)(ext - 1 - I.name) : (int)strlen(I.name);
         snprintf(base, sizeof base, "%.*s.tif", keep, I.name);
     }
-    frame_name(name, sizeof name, base, I.frames);
+    // frames are numbered per output name: a program that names each image gets those names
+    int slot = 0;
+    while (slot < I.names.n && strcmp(I.names[slot].name, base) != 0) slot++;
+    if (slot == I.names.n) {
+        NameCount nc;
+        nc.name = mem_strdup(c, base, strlen(base));
+        nc.frames = 0;
+        if (!nc.name || !I.names.push(c, nc)) {
+            mem_free(c, nc.name);
+            return api_err(I, s->line, s->col);
+        }
+    }
+    frame_name(name, sizeof name, base, I.names[slot].frames);
     pray_image img;
     pray_status st = pray_render(c, (pray_object *)a[0].ref, all, &img);
     release_handle(c, all);
@@ -6530,6 +6548,7 @@ pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
         api_err(I, s->line, s->col);
         return c->status = keep == PRAY_ERR_ARG ? PRAY_ERR_RUNTIME : keep;
     }
+    I.names[slot].frames++;
     I.frames++;
     c->frames = I.frames;
     return PRAY_OK;
@@ -6710,6 +6729,8 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
     }
     for (int i = 0; i < I.vals.n; i++) vrelease(I, I.vals[i]);
     I.vals.release(c);
+    for (int i = 0; i < I.names.n; i++) mem_free(c, I.names[i].name);
+    I.names.release(c);
     I.vars.release(c);
     prog.release(c);
     L.toks.release(c);
