@@ -483,11 +483,35 @@ double vdot(pray_vec a, pray_vec b) { return a.x * b.x + a.y * b.y + a.z * b.z; 
 pray_vec vcross(pray_vec a, pray_vec b) {
     return vmake(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
-double vlen(pray_vec a) { return sqrt(vdot(a, a)); }
+// Length and direction, scaled first so that neither overflows nor underflows in between.
+double vmaxabs(pray_vec a) {
+    double m = fabs(a.x);
+    if (fabs(a.y) > m) m = fabs(a.y);
+    if (fabs(a.z) > m) m = fabs(a.z);
+    return m;
+}
+double vlen(pray_vec a) {
+    double m = vmaxabs(a);
+    if (!(m > 0) || m - m != 0) return m;  // zero, or not finite
+    pray_vec b = {a.x / m, a.y / m, a.z / m};
+    return m * sqrt(b.x * b.x + b.y * b.y + b.z * b.z);
+}
+// The unit vector along a; the zero vector when a is zero or not finite.
+pray_vec vunit(pray_vec a) {
+    double m = vmaxabs(a);
+    pray_vec z = {0, 0, 0};
+    if (!(m > 0) || m - m != 0) return z;
+    pray_vec b = {a.x / m, a.y / m, a.z / m};
+    double l = sqrt(b.x * b.x + b.y * b.y + b.z * b.z);
+    pray_vec u = {b.x / l, b.y / l, b.z / l};
+    return u;
+}
 bool vfinite(pray_vec a) {
     return a.x - a.x == 0 && a.y - a.y == 0 && a.z - a.z == 0;  // false for NaN and infinity
 }
 bool finite_num(double x) { return x - x == 0; }
+// NaN without its sign, so that messages say "nan" on every C library.
+double nan_clean(double x) { return x != x ? fabs(x) : x; }
 
 pray_rgb cmake(double r, double g, double b) {
     pray_rgb c;
@@ -583,12 +607,9 @@ double xf_scale_of(const Xform &f) {
     double s = sqrt(f.m[0][0] * f.m[0][0] + f.m[1][0] * f.m[1][0] + f.m[2][0] * f.m[2][0]);
     return d < 0 ? -s : s;
 }
-// Normals transform with the inverse transpose; for s R that is R / s, so the direction is
-// m n times the sign of s.
-pray_vec xf_normal(const Xform &f, pray_vec n) {
-    pray_vec v = xf_dir(f, n);
-    return xf_scale_of(f) < 0 ? vmul(v, -1) : v;
-}
+// Normals transform with the inverse transpose; for s R that is R / s, which points the same way
+// as s R n: a reflection (s < 0) turns a half-space's outward normal along with the space.
+pray_vec xf_normal(const Xform &f, pray_vec n) { return xf_dir(f, n); }
 
 } // namespace
 
@@ -655,6 +676,7 @@ struct pray_object {
     double r;
     int map;         // MapKind: texture coordinates (planemap, spheremap)
     pray_vec mu, mv; // their U and V vectors
+    int mirrored;    // a spheremap reflected by a negative scale: longitudes run the other way
     Kids *kids;
     int nkids;
     long nprims;
@@ -868,6 +890,7 @@ pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
     default: break;
     }
     o->map = a->map;
+    o->mirrored = a->mirrored ^ (xf_scale_of(f) < 0);
     if (a->map) {  // texture coordinates go with the solid, scale included
         o->mu = xf_dir(f, a->mu);
         o->mv = xf_dir(f, a->mv);
@@ -1011,6 +1034,17 @@ int opt_find(const char *name) {
     return -1;
 }
 
+// A name as messages show it: long ones cut after 60 characters.
+struct Shown {
+    char buf[72];
+    explicit Shown(const char *name) {
+        size_t n = strlen(name);
+        if (n <= 60) snprintf(buf, sizeof buf, "%s", name);
+        else snprintf(buf, sizeof buf, "%.60s...", name);
+    }
+    const char *operator*() const { return buf; }
+};
+
 int levenshtein(const char *a, const char *b) {
     int la = (int)strlen(a), lb = (int)strlen(b);
     if (la > 64 || lb > 64) return 99;
@@ -1039,8 +1073,7 @@ struct Suggest {
     }
     void offer(const char *name) {
         int d = levenshtein(want, name);
-        int lim = (int)strlen(want) / 3 + 1;
-        if (lim > 2) lim = 2;
+        int lim = strlen(want) <= 3 ? 1 : 2;
         if (d <= lim && d < dist) {
             dist = d;
             best = name;
@@ -1053,7 +1086,7 @@ const char *opt_check(int i, double v) {
     const OptDef &d = OPTS[i];
     if (!finite_num(v) || v < d.lo || v > d.hi) return "out of range";
     if (d.integer && v != floor(v)) return "not a whole number";
-    if (i == OPT_BITS && v != 8 && v != 16) return "must be 8 or 16";
+    if (i == OPT_BITS && v != 8 && v != 16) return "not 8 or 16";
     return NULL;
 }
 
@@ -1125,6 +1158,7 @@ struct Prim {
     const pray_model *mat;
     int map;            // MapKind; texture coordinates from p (origin) and mu, mv
     R3 mu, mv;
+    int mirrored;       // longitudes of a spheremap run the other way
     int id;             // position among the declared primitives, left to right
     int parent;         // node index, -1 for the root
     unsigned char first;  // first child of a difference
@@ -1159,6 +1193,7 @@ struct Scene {
     Array<Light> lights;
     int parallel;
     R3 eye, point, cx, cy, dir;
+    R3 keye, kpoint, kcx, kcy;  // the perspective camera scaled by a power of two near 1/size
     int width, height, depth, shadows, antialias;
     pray_rgb bg_top, bg_bottom;
 };
@@ -1387,13 +1422,14 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
         q.map = o->map;
         q.mu = r3of(o->mu);
         q.mv = r3of(o->mv);
+        q.mirrored = o->mirrored;
         if (o->kind == O_SPHERE) {
             q.r = (real)o->r;
         } else if (o->kind == O_PLANE) {
-            q.n = r3of(vmul(o->v, 1.0 / vlen(o->v)));
+            q.n = r3of(vunit(o->v));
             q.d = dot(q.n, q.p);
         } else {
-            q.n = r3of(vmul(o->v, 1.0 / vlen(o->v)));
+            q.n = r3of(vunit(o->v));
             q.r = (real)o->r;
         }
         q.r2 = q.r * q.r;
@@ -3039,10 +3075,17 @@ pray_status tiff_decode(pray_ctx *c, const char *name, const unsigned char *p, s
         if (tiff_value(in, tags[Idx::of(TT_BPS)], i, &b) && b != bps)
             return in.err("unsupported TIFF: samples of different sizes");
     }
+    if (fmt == 3) return in.err("unsupported TIFF: floating-point samples");
+    if (fmt == 2) return in.err("unsupported TIFF: signed integer samples");
+    if (fmt != 1) return in.err("unsupported TIFF: sample format %lu (only unsigned integers)", fmt);
     if (bps != 1 && bps != 4 && bps != 8 && bps != 16)
         return in.err("unsupported TIFF: %lu bits per sample", bps);
-    if (fmt != 1) return in.err("unsupported TIFF: sample format %lu (only unsigned integers)", fmt);
-    if (comp != 1 && comp != 5 && comp != 32773) return in.err("unsupported TIFF: compression %lu", comp);
+    if (comp != 1 && comp != 5 && comp != 32773) {
+        const char *what = comp == 2 || comp == 3 || comp == 4 ? "CCITT fax" : comp == 6 || comp == 7 ? "JPEG"
+                           : comp == 8 || comp == 32946 ? "Deflate" : comp == 34925 ? "LZMA"
+                           : comp == 50000 ? "Zstandard" : comp == 50001 ? "WebP" : "an unknown method";
+        return in.err("unsupported TIFF: %s compression (%lu)", what, comp);
+    }
     if (pred != 1 && pred != 2) return in.err("unsupported TIFF: predictor %lu", pred);
     if (pred == 2 && bps != 8 && bps != 16) return in.err("unsupported TIFF: predictor with %lu bits", bps);
     if (spp > 1 && planar != 1) return in.err("unsupported TIFF: separate colour planes");
@@ -3427,12 +3470,13 @@ void tex_coords(const Prim &q, R3 x, double *s, double *t, R3 *ds, R3 *dt) {
         R3 nrm = unit(x - q.p), north = unit(q.mu);
         R3 e0 = unit(q.mv - north * dot(q.mv, north)), third = cross(north, e0);
         double lon = atan2((double)dot(nrm, third), (double)dot(nrm, e0));
+        if (q.mirrored) lon = -lon;
         if (lon < 0) lon += 2 * PI;
         *s = lon / (2 * PI);
         if (*s >= 1) *s = 0;
         double c = -(double)dot(nrm, north);
         *t = acos(c > 1 ? 1 : c < -1 ? -1 : c) / PI;
-        *ds = unit(cross(north, nrm));
+        *ds = unit(cross(north, nrm)) * (real)(q.mirrored ? -1 : 1);
         *dt = unit(north - nrm * dot(north, nrm));
     }
 }
@@ -3616,7 +3660,7 @@ Ray camera_ray(const Scene *s, real u, real v) {
         r.d = s->dir;
     } else {
         r.o = s->eye;
-        r.d = unit(s->point + s->cx * u + s->cy * v - s->eye);
+        r.d = unit(s->kpoint + s->kcx * u + s->kcy * v - s->keye);
     }
     return r;
 }
@@ -3639,7 +3683,7 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
         Light L;
         L.point = src.point;
         L.intensity = src.intensity;
-        L.v = src.point ? r3of(src.v) : r3of(vmul(src.v, -1.0 / vlen(src.v)));
+        L.v = src.point ? r3of(src.v) : r3of(vmul(vunit(src.v), -1.0));
         if (!s->lights.push(c, L)) return c->status;
     }
     s->parallel = c->cur.parallel;
@@ -3647,7 +3691,20 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     s->point = r3of(c->cur.cam_point);
     s->cx = r3of(c->cur.cam_x);
     s->cy = r3of(c->cur.cam_y);
-    s->dir = unit(s->point - s->eye);
+    s->dir = r3of(vunit(vsub(c->cur.cam_point, c->cur.cam_eye)));
+    // Directions are the same for the camera scaled by any factor; a power of two keeps them
+    // exact, and brings vectors of 1e-200 or 1e200 into range (of floats, too).
+    double big = vmaxabs(c->cur.cam_point);
+    const pray_vec *cv[3] = {&c->cur.cam_eye, &c->cur.cam_x, &c->cur.cam_y};
+    for (int i = 0; i < 3; i++)
+        if (vmaxabs(*cv[i]) > big) big = vmaxabs(*cv[i]);
+    int e = 0;
+    frexp(big, &e);
+    double k = ldexp(1.0, -e);
+    s->keye = r3of(vmul(c->cur.cam_eye, k));
+    s->kpoint = r3of(vmul(c->cur.cam_point, k));
+    s->kcx = r3of(vmul(c->cur.cam_x, k));
+    s->kcy = r3of(vmul(c->cur.cam_y, k));
     s->width = opt_int(c, OPT_WIDTH);
     s->height = opt_int(c, OPT_HEIGHT);
     s->depth = opt_int(c, OPT_DEPTH);
@@ -4187,8 +4244,12 @@ pray_status pray_option(pray_ctx *c, const char *name, double value) {
     if (i < 0) return opt_unknown(c, name ? name : "");
     if (i == OPT_OUTPUT) return fail(c, PRAY_ERR_ARG, "option 'output' takes a string");
     const char *why = opt_check(i, value);
-    if (why) return fail(c, PRAY_ERR_ARG, "option '%s': %g is %s", name, value, why);
-    if (!(c->fixed & (1u << i))) c->cur.opt.v[i] = value;
+    if (why) return fail(c, PRAY_ERR_ARG, "option '%s': %g is %s", name, nan_clean(value), why);
+    if (c->fixed & (1u << i)) return PRAY_OK;
+    double w = i == OPT_WIDTH ? value : c->cur.opt.v[OPT_WIDTH], h = i == OPT_HEIGHT ? value : c->cur.opt.v[OPT_HEIGHT];
+    if (w * h > MAX_IMAGE_PIXELS)
+        return fail(c, PRAY_ERR_ARG, "image of %.0f x %.0f pixels is too large", w, h);
+    c->cur.opt.v[i] = value;
     if (!c->running) c->base = c->cur;
     return PRAY_OK;
 }
@@ -4200,6 +4261,10 @@ pray_status pray_option_string(pray_ctx *c, const char *name, const char *value)
     if (!value || !*value) return fail(c, PRAY_ERR_ARG, "option 'output': empty file name");
     if (strlen(value) >= sizeof c->cur.opt.output)
         return fail(c, PRAY_ERR_ARG, "option 'output': file name too long");
+    int fmt = image_format(value);
+    if (fmt == FMT_NONE || (fmt == FMT_PNG && !PRAY_HAS_PNG))
+        return fail(c, PRAY_ERR_ARG, "option 'output': cannot tell the image format of '%s' (use .tif, .ppm%s)", value,
+                    PRAY_HAS_PNG ? " or .png" : "");
     if (!(c->fixed & (1u << i))) strcpy(c->cur.opt.output, value);
     if (!c->running) c->base = c->cur;
     return PRAY_OK;
@@ -4247,7 +4312,7 @@ bool bad_vec(pray_ctx *c, pray_vec v, const char *what, bool nonzero) {
 }
 bool bad_radius(pray_ctx *c, double r, const char *what) {
     if (finite_num(r) && r > 0) return false;
-    fail(c, PRAY_ERR_ARG, "%s: radius must be a positive number, not %g", what, r);
+    fail(c, PRAY_ERR_ARG, "%s: radius must be a positive number, not %g", what, nan_clean(r));
     return true;
 }
 } // namespace
@@ -4341,7 +4406,7 @@ pray_object *pray_one(pray_ctx *c, pray_model *m) { return m ? obj_new(c, O_ONE,
 namespace {
 bool bad_pair(pray_ctx *c, pray_vec u, pray_vec v, const char *what) {
     if (bad_vec(c, u, what, true) || bad_vec(c, v, what, true)) return true;
-    if (vlen(vcross(u, v)) <= 1e-12 * vlen(u) * vlen(v)) {
+    if (vlen(vcross(vunit(u), vunit(v))) <= 1e-12) {
         fail(c, PRAY_ERR_ARG, "%s: the two vectors must not be parallel", what);
         return true;
     }
@@ -4471,10 +4536,8 @@ pray_object *pray_text(pray_ctx *c, pray_model *m, const char *text, pray_vec P,
             return NULL;
         }
     }
-    pray_vec n = vmul(vcross(X, Y), 1.0 / vlen(vcross(X, Y)));
-    pray_vec nx = vcross(Y, n), ny = vcross(n, X);
-    nx = vmul(nx, 1.0 / vlen(nx));
-    ny = vmul(ny, 1.0 / vlen(ny));
+    pray_vec n = vunit(vcross(vunit(X), vunit(Y)));
+    pray_vec nx = vunit(vcross(vunit(Y), n)), ny = vunit(vcross(n, vunit(X)));
     pray_vec back = vmul(n, -1), front = n, left = vmul(nx, -1), down = vmul(ny, -1);
     pray_object *all = pray_nothing(c);
     unsigned char used[64][64];
@@ -4606,12 +4669,12 @@ namespace {
 // What is wrong with a camera, or NULL.
 const char *camera_problem(bool parallel, pray_vec x, pray_vec y, pray_vec e, pray_vec p) {
     if (!vfinite(x) || !vfinite(y) || !vfinite(e) || !vfinite(p)) return "coordinates are not finite";
-    if (vlen(x) == 0 || vlen(y) == 0) return "X and Y must not be zero vectors";
-    pray_vec cr = vcross(x, y);
-    if (vlen(cr) <= 1e-12 * vlen(x) * vlen(y)) return "X and Y must not be parallel";
+    if (vmaxabs(x) == 0 || vmaxabs(y) == 0) return "X and Y must not be zero vectors";
+    pray_vec cr = vcross(vunit(x), vunit(y));
+    if (vlen(cr) <= 1e-12) return "X and Y must not be parallel";
     pray_vec v = vsub(p, e);
-    if (vlen(v) == 0) return "the eye and the point looked at must differ";
-    if (parallel && fabs(vdot(cr, v)) <= 1e-12 * vlen(cr) * vlen(v))
+    if (vmaxabs(v) == 0) return "the eye and the point looked at must differ";
+    if (parallel && fabs(vdot(vunit(cr), vunit(v))) <= 1e-12)
         return "the view direction must not lie in the plane of X and Y";
     return NULL;
 }
@@ -5000,7 +5063,11 @@ pray_status lex_string(Lexer &L) {
     t.init();
     pray_status st = PRAY_OK;
     for (;;) {
-        if (at_line_end(L, L.p) || *L.p == '\r') {
+        if (*L.p == '\r' && !at_line_end(L, L.p)) {
+            st = lex_err(L, "carriage return without a line feed%s", "");
+            break;
+        }
+        if (at_line_end(L, L.p)) {
             st = perr(L.c, L.name, line, col, PRAY_ERR_SYNTAX, "unterminated string");
             break;
         }
@@ -5131,7 +5198,12 @@ pray_status lex(Lexer &L) {
         what[n] = 0;
         if (ch == '!') return lex_err(L, "unexpected character '%s' (PRAY writes 'not equal' as '#')", what);
         if (ch == ';') return lex_err(L, "unexpected character '%s' (one statement per line, no ';')", what);
-        return lex_err(L, "unexpected character '%s'", what);
+        if (n == 1) return lex_err(L, "unexpected character '%s'", what);
+        unsigned long cp = L.p[0] & (0x7F >> n);
+        for (int i = 1; i < n; i++) cp = cp << 6 | (L.p[i] & 0x3F);
+        char msg[64];
+        snprintf(msg, sizeof msg, "unexpected character '%s' (U+%04lX)", what, cp);
+        return lex_err(L, "%s", msg);
     }
     (void)last_line;
     if (!push_tok(L, T_NL, 0, L.line, L.col) || !push_tok(L, T_EOF, 0, L.line, L.col)) return L.c->status;
@@ -5194,7 +5266,8 @@ struct Parser {
     const char *name;
     Tok *t;
     int pos;
-    int depth;
+    int depth;   // nesting of parentheses, literals, calls, unary operators, powers
+    int blocks;  // nesting of if and while
     Arena *arena;
     Array<Var> *vars;
     Array<int> hash;  // open addressing: slot + 1, 0 = empty; size a power of two
@@ -5312,8 +5385,11 @@ Expr **freeze_list(Parser &P, Array<Expr *> &a) {
 }
 
 // literal -> '[' add ',' add ',' add ']' | '<' add ',' add ',' add '>' | '{' add [',' add ',' add] '}'
+bool enter(Parser &P, const Tok *at = NULL);
+
 Expr *parse_literal(Parser &P, int kind, int close, const char *what) {
     Tok &open = cur(P);
+    if (!enter(P)) return NULL;
     P.pos++;
     Expr *e = new_expr(P, kind, open);
     if (!e) return NULL;
@@ -5356,6 +5432,7 @@ Expr *parse_literal(Parser &P, int kind, int close, const char *what) {
     e->a = x[0];
     e->b = n == 3 ? x[1] : x[0];
     e->c = n == 3 ? x[2] : x[0];
+    P.depth--;
     return e;
 }
 
@@ -5393,6 +5470,7 @@ Expr *parse_primary(Parser &P) {
                 syn(P, t, "'%s' is a function: write it with its arguments in parentheses", t.s);
                 return NULL;
             }
+            if (!enter(P, &t)) return NULL;
             P.pos++;
             Expr *e = new_expr(P, EX_CALL, t);
             if (!e) return NULL;
@@ -5419,6 +5497,7 @@ Expr *parse_primary(Parser &P) {
                 ok = e->args != NULL;
             }
             args.release(P.c);
+            P.depth--;
             return ok ? e : NULL;
         }
         if (is_reserved(t.s)) {
@@ -5430,8 +5509,8 @@ Expr *parse_primary(Parser &P) {
             sg.init(t.s);
             for (int i = 0; i < builtin_count(); i++) sg.offer(builtin_name(i));
             char msg[200];
-            if (sg.best) snprintf(msg, sizeof msg, "unknown function '%s'; did you mean '%s'?", t.s, sg.best);
-            else snprintf(msg, sizeof msg, "unknown function '%s'", t.s);
+            if (sg.best) snprintf(msg, sizeof msg, "unknown function '%s'; did you mean '%s'?", *Shown(t.s), sg.best);
+            else snprintf(msg, sizeof msg, "unknown function '%s'", *Shown(t.s));
             syn(P, t, "%s", msg);
             return NULL;
         }
@@ -5442,9 +5521,11 @@ Expr *parse_primary(Parser &P) {
         return e->n < 0 ? NULL : e;
     }
     if (is_op(t, '(')) {
+        if (!enter(P)) return NULL;
         P.pos++;
         Expr *e = parse_expr(P);
         if (!e || expect_op(P, ')', "')'")) return NULL;
+        P.depth--;
         return e;
     }
     if (is_op(t, '[')) return parse_literal(P, EX_POINT, ']', "a point");
@@ -5454,11 +5535,12 @@ Expr *parse_primary(Parser &P) {
     return NULL;
 }
 
-bool enter(Parser &P) {
+// One level deeper, at token `at` (default: the current token).
+bool enter(Parser &P, const Tok *at) {
     if (++P.depth > MAX_NESTING) {
         char msg[80];
         snprintf(msg, sizeof msg, "expression nested deeper than %d levels", MAX_NESTING);
-        syn(P, cur(P), "%s", msg);
+        syn(P, at ? *at : cur(P), "%s", msg);
         return false;
     }
     return true;
@@ -5476,12 +5558,13 @@ Expr *binary(Parser &P, const Tok &op, Expr *a, Expr *b) {
 
 // unary -> ('+' | '-') unary | primary
 Expr *parse_unary(Parser &P) {
-    if (!enter(P)) return NULL;
     Expr *r;
     Tok &t = cur(P);
     if (is_op(t, '+') || is_op(t, '-')) {
+        if (!enter(P)) return NULL;
         P.pos++;
         Expr *a = parse_unary(P);
+        P.depth--;
         r = a ? new_expr(P, EX_UNARY, t) : NULL;
         if (r) {
             r->op = t.op;
@@ -5495,7 +5578,6 @@ Expr *parse_unary(Parser &P) {
             r = NULL;
         }
     }
-    P.depth--;
     return r;
 }
 
@@ -5512,14 +5594,14 @@ Expr *parse_transform(Parser &P) {
 
 // power -> transform [ '^' power ]   (right-associative)
 Expr *parse_power(Parser &P) {
-    if (!enter(P)) return NULL;
     Expr *a = parse_transform(P);
     if (a && is_op(cur(P), '^')) {
+        if (!enter(P)) return NULL;
         Tok &op = cur(P);
         P.pos++;
         a = binary(P, op, a, parse_power(P));
+        P.depth--;
     }
-    P.depth--;
     return a;
 }
 
@@ -5574,14 +5656,12 @@ Expr *parse_and(Parser &P) {
 
 // expr -> and { ('|' | '\' | '¥') and }
 Expr *parse_expr(Parser &P) {
-    if (!enter(P)) return NULL;
     Expr *a = parse_and(P);
     while (a && (is_op(cur(P), '|') || is_op(cur(P), '\\'))) {
         Tok &op = cur(P);
         P.pos++;
         a = binary(P, op, a, parse_and(P));
     }
-    P.depth--;
     return a;
 }
 
@@ -5613,7 +5693,9 @@ bool stmt_args(Parser &P, Stmt *s, const Tok &word, int lo, int hi) {
     if (cur(P).kind == T_NL) {
         if (lo > 0) {
             char msg[120];
-            snprintf(msg, sizeof msg, "'%s' needs %d argument%s", word.s, lo, lo == 1 ? "" : "s");
+            if (hi > 1000) snprintf(msg, sizeof msg, "'%s' needs at least %d argument%s", word.s, lo, lo == 1 ? "" : "s");
+            else if (hi > lo) snprintf(msg, sizeof msg, "'%s' needs %d or %d arguments", word.s, lo, hi);
+            else snprintf(msg, sizeof msg, "'%s' needs %d argument%s", word.s, lo, lo == 1 ? "" : "s");
             syn(P, cur(P), "%s", msg);
             ok = false;
         }
@@ -5714,7 +5796,7 @@ Stmt *parse_statement(Parser &P) {
         s->nargs = 1;
         if (is_if && is_word(cur(P), "then")) P.pos++;
         if (end_of_line(P)) return NULL;
-        if (++P.depth > MAX_NESTING) {
+        if (++P.blocks > MAX_NESTING) {
             syn(P, t, "blocks nested too deeply");
             return NULL;
         }
@@ -5756,11 +5838,11 @@ Stmt *parse_statement(Parser &P) {
             return NULL;
         }
         P.pos++;
-        P.depth--;
+        P.blocks--;
         return end_of_line(P) ? NULL : s;
     }
     if (is_word(t, "else") || is_word(t, "endif") || is_word(t, "endwhile")) {
-        syn(P, t, "'%s' without a matching 'if' or 'while'", t.s);
+        syn(P, t, "'%s' without a matching '%s'", t.s, is_word(t, "endwhile") ? "while" : "if");
         return NULL;
     }
     if (is_word(t, "then")) {
@@ -5768,9 +5850,9 @@ Stmt *parse_statement(Parser &P) {
         return NULL;
     }
     if (P.t[P.pos + 1].kind == T_NL && !is_reserved(t.s)) {
-        char msg[200];
-        snprintf(msg, sizeof msg, "'%.60s' alone is not a statement (did you mean an assignment '%.60s = ...'?)",
-                 t.s, t.s);
+        char msg[320];
+        snprintf(msg, sizeof msg, "'%s' alone is not a statement (did you mean an assignment '%s = ...'?)",
+                 *Shown(t.s), *Shown(t.s));
         syn(P, t, "%s", msg);
         return NULL;
     }
@@ -5980,7 +6062,7 @@ pray_status math1(Interp &I, const Expr *call, Value *a, Value *out, double (*f)
     if (want(I, call, a, 0, V_NUM)) return I.c->status;
     double r = f(a[0].v[0]);
     if (!finite_num(r) && finite_num(a[0].v[0]))
-        return rerr(I, call, PRAY_ERR_RUNTIME, "%s(%g) is not defined", call->s, a[0].v[0]);
+        return rerr(I, call, PRAY_ERR_RUNTIME, "%s(%g) is not a finite number", call->s, a[0].v[0]);
     *out = vnum(r);
     return PRAY_OK;
 }
@@ -6036,10 +6118,10 @@ pray_status bi_mirror(Interp &I, const Expr *call, Value *a, Value *out) {
 }
 pray_status bi_norm(Interp &I, const Expr *call, Value *a, Value *out) {
     if (want(I, call, a, 0, V_VECTOR)) return I.c->status;
-    double l = vlen(vec_of(a[0]));
-    if (l == 0) return rerr(I, call, PRAY_ERR_RUNTIME, "norm of a zero vector");
-    if (!finite_num(l)) return rerr(I, call, PRAY_ERR_RUNTIME, "norm of a vector that is not finite");
-    *out = of_vec(V_VECTOR, vmul(vec_of(a[0]), 1.0 / l));
+    double m = vmaxabs(vec_of(a[0]));
+    if (m == 0) return rerr(I, call, PRAY_ERR_RUNTIME, "norm of a zero vector");
+    if (!finite_num(m)) return rerr(I, call, PRAY_ERR_RUNTIME, "norm of a vector that is not finite");
+    *out = of_vec(V_VECTOR, vunit(vec_of(a[0])));
     return PRAY_OK;
 }
 pray_status bi_one(Interp &I, const Expr *call, Value *a, Value *out) {
@@ -6390,8 +6472,9 @@ pray_status undefined_var(Interp &I, const Expr *e) {
     sg.init(e->s);
     for (int i = 0; i < I.vars.n; i++)
         if (I.vals[i].t != V_NONE) sg.offer(I.vars[i].name);
-    if (sg.best) return rerr(I, e, PRAY_ERR_RUNTIME, "undefined variable '%s'; did you mean '%s'?", e->s, sg.best);
-    return rerr(I, e, PRAY_ERR_RUNTIME, "undefined variable '%s'", e->s);
+    if (sg.best)
+        return rerr(I, e, PRAY_ERR_RUNTIME, "undefined variable '%s'; did you mean '%s'?", *Shown(e->s), sg.best);
+    return rerr(I, e, PRAY_ERR_RUNTIME, "undefined variable '%s'", *Shown(e->s));
 }
 
 pray_status eval(Interp &I, const Expr *e, Value *out) {
@@ -6712,12 +6795,14 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
         P.t = L.toks.p;
         P.pos = 0;
         P.depth = 0;
+        P.blocks = 0;
         P.arena = &arena;
         P.vars = &I.vars;
         P.hash.init();
         const char *stop = NULL;
         if (!parse_block(P, &prog, &stop)) st = c->status;
-        else if (stop) st = syn(P, cur(P), "'%s' without a matching 'if' or 'while'", stop);
+        else if (stop)
+            st = syn(P, cur(P), "'%s' without a matching '%s'", stop, strcmp(stop, "endwhile") == 0 ? "while" : "if");
         P.hash.release(c);
     }
     if (st == PRAY_OK && I.vars.n && !I.vals.reserve(c, I.vars.n)) st = c->status;

@@ -117,10 +117,11 @@ void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
 /* ---------------------------------------------------------------------------------------------
    Options: the same names as the PRAY `option` statement: width, height (pixels, default 256),
    depth (ray depth, 5), antialias (samples per pixel side, 1), adaptive (0), grid (-1 =
-   automatic), freeze, merge, bounds, shadows (1/0, default 1), brute (1 = the brute-force
-   reference renderer, 0), threads (0 = automatic), maxsteps (statements a program may execute,
-   10000000; 0 = no limit), bits (8 or 16 per sample in TIFF/PPM files), and the string option
-   output (file name of `rendertiff`).
+   automatic), gridmem (MiB for the grid, 64), freeze, merge, bounds, shadows (1/0, default 1),
+   brute (1 = the brute-force reference renderer, 0), threads (0 = automatic), maxsteps
+   (statements a program may execute, 10000000; 0 = no limit), texmem (MiB for textures, 256),
+   bits (8 or 16 per sample in TIFF/PPM files), and the string option output (file name of
+   `rendertiff`; its extension picks the format).
 
    What the host sets here (options, camera, background) is where every program run starts;
    what a program sets lasts until the end of its run.

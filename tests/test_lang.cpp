@@ -626,8 +626,6 @@ TEST_CASE("phono is not a function but an ordinary name") {
     CHECK_ERROR_HAS("directionlight = 1\n", 1, 1, "reserved");  // the alias is predefined
 }
 
-// Pending: the manual (docs/pray-language.md) says these arrive with the textures issue, and pray.cpp
-// still answers "not available in this version". Skipped until then; run with --no-skip.
 TEST_CASE("the texture and text makers of the specification are functions") {
     const std::string m = "M = color({1})\n";
     CHECK_PRINTS(m + "print planemap(M, [0,0,0], <0,0,1>, <1,0,0>, <0,1,0>)\n", "object (1 primitive)\n");
