@@ -10,6 +10,7 @@
 #   make check-bad  the catalogue of bad inputs (tests/bad/run.sh); the last step of check
 #   make sanitize   the tests and the bad inputs under AddressSanitizer and UBSan
 #   make fuzz       build the libFuzzer harness and fuzz for FUZZ_SECONDS (needs clang)
+#   make fuzz-tiff  the same for the TIFF reader (textures and font atlases)
 #   make clean
 
 CXX      ?= c++
@@ -27,7 +28,7 @@ TESTS = tests/pray_tests$(EXE)
 TESTS_FLOAT = tests/pray_tests_float$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
-.PHONY: all examples check deps matrix clean embed bench check-bad sanitize fuzz textures gallery ports
+.PHONY: all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff textures gallery ports
 
 all: $(PRAY)
 
@@ -81,7 +82,8 @@ check-bad: $(PRAY)
 
 # The doctest suite and ./pray built with AddressSanitizer and UBSan into build/sanitize/, then
 # the suite (whose command-line tests use the plain ./pray) and the bad inputs run with them.
-SANFLAGS = -fsanitize=address,undefined -fno-sanitize-recover=undefined -O1 -g
+# float-cast-overflow: part of clang's "undefined" but not of GCC's.
+SANFLAGS = -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=undefined,float-cast-overflow -O1 -g
 sanitize: deps $(PRAY)
 	@mkdir -p build/sanitize
 	$(CXX) -std=c++98 $(SANFLAGS) $(WARN) -fno-exceptions -fno-rtti -DPRAY_MAIN pray.cpp -o build/sanitize/pray $(LDLIBS)
@@ -105,6 +107,13 @@ fuzz: build/fuzz/fuzz_program
 	build/fuzz/fuzz_program -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -timeout=10 \
 	  -dict=tests/fuzz/pray.dict -artifact_prefix=build/fuzz/artifacts/ \
 	  build/fuzz/corpus tests/fuzz/corpus tests/fuzz/crashes
+build/fuzz/fuzz_tiff: tests/fuzz/fuzz_tiff.cpp pray.cpp pray.hpp
+	@mkdir -p build/fuzz
+	$(FUZZ_CXX) $(FUZZFLAGS) -I. tests/fuzz/fuzz_tiff.cpp pray.cpp -o $@
+fuzz-tiff: build/fuzz/fuzz_tiff
+	@mkdir -p build/fuzz/corpus_tiff build/fuzz/artifacts
+	build/fuzz/fuzz_tiff -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -timeout=10 \
+	  -artifact_prefix=build/fuzz/artifacts/tiff- build/fuzz/corpus_tiff tests/fuzz/corpus_tiff tests/fuzz/crashes
 
 # The textures of the examples, made by pray itself.
 textures: $(PRAY)

@@ -270,6 +270,7 @@ int cpu_count() {
 // Limits of one run (the robustness issue makes more of them options).
 const int MAX_NESTING = 256;        // blocks and parentheses
 const int MAX_TREE_DEPTH = 2000;    // CSG nodes along one path from the root
+const long MAX_PRIMITIVES = 16777216; // primitives an object stands for (shared parts counted each time)
 const int MAX_IMAGE_SIDE = 65536;   // pixels
 const double MAX_IMAGE_PIXELS = 268435456.0;
 
@@ -798,6 +799,11 @@ pray_object *csg_make(pray_ctx *c, int op, pray_object *a, pray_object *b) {
     }
     if (na > INT_MAX / 4 - nb) {
         fail_nomem(c);
+        return NULL;
+    }
+    // a tree may use one part many times over; what it stands for must stay renderable
+    if (a->nprims + b->nprims > MAX_PRIMITIVES) {
+        fail(c, PRAY_ERR_LIMIT, "object of more than %ld primitives", MAX_PRIMITIVES);
         return NULL;
     }
     pray_object *o = obj_new(c, op, NULL);
@@ -2793,8 +2799,8 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
     real next[3], delta[3];
     for (int l = 0; l < 3; l++) {
         real dd = comp(ray.d, l);
-        int i = (int)floor((double)((comp(p, l) - A->org[l]) / A->h));
-        ix[l] = i < 0 ? 0 : i >= A->n[l] ? A->n[l] - 1 : i;
+        double g = floor((double)((comp(p, l) - A->org[l]) / A->h));  // clamped before the cast
+        ix[l] = !(g > 0) ? 0 : g >= A->n[l] ? A->n[l] - 1 : (int)g;
         if (dd > 0) {
             step[l] = 1;
             next[l] = (A->org[l] + (real)(ix[l] + 1) * A->h - comp(ray.o, l)) / dd;
@@ -5063,12 +5069,12 @@ pray_status lex_string(Lexer &L) {
     t.init();
     pray_status st = PRAY_OK;
     for (;;) {
-        if (*L.p == '\r' && !at_line_end(L, L.p)) {
-            st = lex_err(L, "carriage return without a line feed%s", "");
-            break;
-        }
         if (at_line_end(L, L.p)) {
             st = perr(L.c, L.name, line, col, PRAY_ERR_SYNTAX, "unterminated string");
+            break;
+        }
+        if (*L.p == '\r') {
+            st = lex_err(L, "carriage return without a line feed%s", "");
             break;
         }
         if (*L.p == '"') {
@@ -6808,7 +6814,7 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
     if (st == PRAY_OK && I.vars.n && !I.vals.reserve(c, I.vars.n)) st = c->status;
     c->stats.time_parse += clock_seconds() - t0;
     if (st == PRAY_OK) {
-        memset(I.vals.p, 0, sizeof(Value) * (size_t)I.vars.n);
+        if (I.vars.n) memset(I.vals.p, 0, sizeof(Value) * (size_t)I.vars.n);
         I.vals.n = I.vars.n;
         st = exec_block(I, prog.p, prog.n);
     }

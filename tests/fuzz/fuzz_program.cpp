@@ -1,0 +1,100 @@
+// libFuzzer harness: run the fuzz input as a PRAY program, through the public API only.
+//
+//   make fuzz                      build it and run it over tests/fuzz/corpus (FUZZ_SECONDS)
+//   clang++ -g -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined \
+//       -I. tests/fuzz/fuzz_program.cpp pray.cpp -o build/fuzz/fuzz_program
+//   build/fuzz/fuzz_program tests/fuzz/crashes/FILE   replay one input
+//
+// Every run gets small caps, fixed so that the program's own `option` statements cannot raise
+// them: 8 x 8 pixels, ray depth 3, 20000 statements, one thread, 64 MiB of memory. `print` output is
+// discarded and frames go to a callback, which encodes them as TIFF and PPM into memory: nothing
+// is written to files.
+//
+// Besides the sanitizers, the harness checks what the API promises about failures: a failing
+// run returns a known status and leaves a message; a message of a program error starts with
+// "fuzz.ray:LINE:COL: error: ". A broken promise aborts, so libFuzzer reports it as a crash.
+#include "../../pray.hpp"
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+namespace {
+
+void byte_sink(void *ud, const void *data, size_t n) {
+    const unsigned char *p = static_cast<const unsigned char *>(data);
+    unsigned long *sum = static_cast<unsigned long *>(ud);
+    for (size_t i = 0; i < n; i++) *sum += p[i];
+}
+
+pray_status frame_sink(void *ud, const pray_image *img, const char *name) {
+    // Touch the image, so that a bad frame is found here by the sanitizers, and encode it (any
+    // pixel values a program can make: huge, infinite, NaN) with the writers, into a byte sink.
+    long *count = static_cast<long *>(ud);
+    if (!img || !name || img->width != 8 || img->height != 8 || !img->pixels) abort();
+    volatile float sum = 0;
+    for (int i = 0; i < img->width * img->height * 3; i++) sum = sum + img->pixels[i];
+    pray_ctx *w = pray_new();
+    if (w) {
+        unsigned long bytes = 0;
+        int bits = *count % 2 ? 16 : 8;
+        if (pray_write_tiff(w, img, bits, byte_sink, &bytes) != PRAY_OK ||
+            pray_write_ppm(w, img, bits, byte_sink, &bytes) != PRAY_OK) {
+            fprintf(stderr, "fuzz_program: writing a rendered frame failed: %s\n", pray_error(w));
+            abort();
+        }
+        pray_free(w);
+    }
+    ++*count;
+    return PRAY_OK;
+}
+
+void broken(const char *what, pray_status st, const char *msg) {
+    fprintf(stderr, "fuzz_program: %s (status %d, message \"%s\")\n", what, (int)st, msg ? msg : "(null)");
+    abort();
+}
+
+// "fuzz.ray:" digits ":" digits ": error: "
+bool has_place(const char *m) {
+    const char *p = "fuzz.ray:";
+    if (strncmp(m, p, strlen(p)) != 0) return false;
+    m += strlen(p);
+    for (int part = 0; part < 2; part++) {
+        if (*m < '0' || *m > '9') return false;
+        while (*m >= '0' && *m <= '9') m++;
+        if (*m++ != ':') return false;
+    }
+    return strncmp(m, " error: ", 8) == 0 && m[8] != 0;
+}
+
+} // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+    pray_ctx *c = pray_new();
+    if (!c) return 0;
+    pray_set_memory_limit(c, (size_t)64 << 20);
+    pray_set_print(c, NULL, NULL);
+    long frames = 0;
+    pray_set_frame(c, frame_sink, &frames);
+    static const char *const caps[][2] = {
+        {"maxsteps", "20000"}, {"width", "8"}, {"height", "8"}, {"depth", "3"}, {"threads", "1"},
+    };
+    for (size_t i = 0; i < sizeof caps / sizeof caps[0]; i++)
+        if (pray_option_fix(c, caps[i][0], caps[i][1]) != PRAY_OK) broken("a cap was refused", pray_last_status(c), pray_error(c));
+
+    pray_status st = pray_run_string(c, "fuzz.ray", (const char *)data, size);
+    const char *msg = pray_error(c);
+    if (!msg) broken("pray_error returned NULL", st, msg);
+    if (st != PRAY_OK) {
+        if (st < PRAY_ERR_NOMEM || st > PRAY_ERR_ARG) broken("unknown status", st, msg);
+        if (!msg[0]) broken("a failure without a message", st, msg);
+        if (!strstr(msg, "error: ")) broken("a message without 'error: '", st, msg);
+        // Syntax and runtime errors are errors of the program: they name the place.
+        if ((st == PRAY_ERR_SYNTAX || st == PRAY_ERR_RUNTIME) && !has_place(msg))
+            broken("a program error without fuzz.ray:line:col", st, msg);
+    }
+    if (pray_frames(c) < 0) broken("negative frame count", st, msg);
+    pray_free(c);
+    return 0;
+}
