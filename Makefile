@@ -67,7 +67,7 @@ tests/embed$(EXE): examples/embed.c pray.cpp pray.hpp
 	$(CXX) tests/embed.o tests/pray.o -o $@ $(LDLIBS)
 embed: tests/embed$(EXE)
 
-check: deps $(PRAY) $(TESTS) $(TESTS_FLOAT) tests/embed$(EXE)
+check: deps $(PRAY) textures $(TESTS) $(TESTS_FLOAT) tests/embed$(EXE)
 	$(RUN) ./tests/embed$(EXE) tests/embed.ppm
 	@echo "== tests, PRAY_REAL=float"
 	$(RUN) ./$(TESTS_FLOAT)
