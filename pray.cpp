@@ -32,6 +32,14 @@
 
 #include "pray.hpp"
 
+// No fused multiply-add behind our back: the same bits on every target (ports/README.md).
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#elif defined(__GNUC__)
+#pragma GCC push_options
+#pragma GCC optimize("fp-contract=off")
+#endif
+
 #include <errno.h>
 #include <float.h>
 #include <limits.h>
@@ -106,6 +114,13 @@
 #elif defined(__unix__) || defined(__APPLE__) || defined(__DJGPP__)
 #include <unistd.h>
 #define PRAY_HAS_UNISTD 1
+#endif
+
+#if defined(PRAY_MAIN) && defined(__DJGPP__)
+// CSG trees are walked recursively; DJGPP's default stack of 512 KB is too small for the deepest
+// trees pray accepts.
+#include <crt0.h>
+unsigned _stklen = 4u * 1024 * 1024;
 #endif
 
 // Threads: Win32 or POSIX, or none (PRAY_NO_THREADS, and wherever neither is there: DOS).
@@ -3994,7 +4009,7 @@ struct Sink {
 inline unsigned quantize(float v, unsigned maxval) {
     if (!(v > 0)) return 0;  // also NaN
     if (v >= 1) return maxval;
-    return (unsigned)(v * (float)maxval + 0.5f);
+    return (unsigned)((double)v * maxval + 0.5);  // in double: the same on x87 and SSE
 }
 
 // Little-endian ("II") byte layout, written byte by byte so every host writes the same file.
@@ -4840,6 +4855,9 @@ pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *pat
     if (fmt == FMT_PNG && bits != 8) return fail(c, PRAY_ERR_ARG, "PNG output has 8 bits only");
 #if PRAY_HAS_STDIO
     size_t n = strlen(path);
+#ifdef PRAY_8_3_NAMES
+    n = (size_t)(file_ext(path) - 1 - path);  // the suffix replaces the extension: CSG.$$$
+#endif
     char *tmp = (char *)mem_alloc(c, n + sizeof PRAY_TEMP_SUFFIX);
     if (!tmp) return c->status;
     memcpy(tmp, path, n);
@@ -6582,8 +6600,16 @@ void frame_name(char *out, size_t n, const char *base, int frame) {
         return;
     }
     const char *ext = file_ext(base);
-    if (ext) snprintf(out, n, "%.*s_%04d.%s", (int)(ext - 1 - base), base, frame, ext);
-    else snprintf(out, n, "%s_%04d", base, frame);
+    int keep = ext ? (int)(ext - 1 - base) : (int)strlen(base);
+#ifdef PRAY_8_3_NAMES
+    // NAME_NNNN stays within 8 characters: the name is cut to 3 after its directory
+    const char *dir = base;
+    for (const char *q = base; q < base + keep; q++)
+        if (*q == '/' || *q == '\\' || *q == ':') dir = q + 1;
+    if (keep - (int)(dir - base) > 3) keep = (int)(dir - base) + 3;
+#endif
+    if (ext) snprintf(out, n, "%.*s_%04d.%s", keep, base, frame, ext);
+    else snprintf(out, n, "%.*s_%04d", keep, base, frame);
 }
 
 pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
@@ -7115,3 +7141,7 @@ int main(int argc, char **argv) {
     return rc;
 }
 #endif // PRAY_MAIN
+
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC pop_options
+#endif
