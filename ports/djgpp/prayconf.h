@@ -14,8 +14,7 @@
    PRAY_TEMP_SUFFIX to the file name (CSG.TIF -> CSG.TIF.$$$), which only a DOS with long file
    names (LFN=y: Windows 9x/XP DOS boxes, DOSLFN) can hold; and frames after the first are named
    NAME_0001.TIF, which is 8.3 only for names of 3 characters. PRAY_8_3_NAMES asks for
-   CSG.$$$ (the suffix replaces the extension) and FRA_0001.TIF (the name shortened). pray.cpp
-   does not read PRAY_8_3_NAMES yet: see ports/djgpp/README.md, "8.3 names". */
+   CSG.$$$ (the suffix replaces the extension) and FRA_0001.TIF (the name shortened). */
 #define PRAY_TEMP_SUFFIX ".$$$"
 #define PRAY_8_3_NAMES
 
