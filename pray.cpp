@@ -3281,6 +3281,7 @@ unsigned char *read_file(pray_ctx *c, const char *path, size_t *n, double max_by
         t.a.release(c);
         return NULL;
     }
+    if (!t.a.p && !t.add(c, "", 0)) return NULL;  // an empty file: still a (NUL-terminated) buffer
     *n = (size_t)t.a.n;
     return (unsigned char *)t.a.p;  // NUL-terminated Text storage; freed with mem_free
 #else
