@@ -84,7 +84,7 @@ check-bad: $(PRAY)
 # the suite (whose command-line tests use the plain ./pray) and the bad inputs run with them.
 # float-cast-overflow: part of clang's "undefined" but not of GCC's.
 SANFLAGS = -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=undefined,float-cast-overflow -O1 -g
-sanitize: deps $(PRAY)
+sanitize: deps $(PRAY) textures
 	@mkdir -p build/sanitize
 	$(CXX) -std=c++98 $(SANFLAGS) $(WARN) -fno-exceptions -fno-rtti -DPRAY_MAIN pray.cpp -o build/sanitize/pray $(LDLIBS)
 	$(CXX) $(TESTFLAGS) $(SANFLAGS) $(TEST_SRC) -o build/sanitize/pray_tests $(LDLIBS) -lpthread
