@@ -28,6 +28,12 @@
 #ifndef _POSIX_C_SOURCE
 #define _POSIX_C_SOURCE 200112L
 #endif
+#ifndef _XOPEN_SOURCE
+#define _XOPEN_SOURCE 600  // realpath
+#endif
+#define PRAY_HAS_REALPATH 1
+#else
+#define PRAY_HAS_REALPATH 0
 #endif
 
 #include "pray.hpp"
@@ -283,9 +289,9 @@ int cpu_count() {
 }
 
 // Limits of one run (the robustness issue makes more of them options).
-const int MAX_NESTING = 256;        // blocks and parentheses
+const int MAX_NESTING = 1024;       // blocks and parentheses: the highest value of option maxnest
 const int MAX_TREE_DEPTH = 2000;    // CSG nodes along one path from the root
-const long MAX_PRIMITIVES = 16777216; // primitives an object stands for (shared parts counted each time)
+const long MAX_PRIMITIVES = 16777216; // the highest value of option maxprims
 const int MAX_IMAGE_SIDE = 65536;   // pixels
 const double MAX_IMAGE_PIXELS = 268435456.0;
 
@@ -305,8 +311,9 @@ struct Block {
 // Options by index; the table in section 6 has their names, defaults and ranges.
 enum {
     OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_DEPTH, OPT_FREEZE,
-    OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_MAXSTEPS, OPT_MERGE, OPT_OUTPUT, OPT_SHADOWS, OPT_TEXMEM,
-    OPT_THREADS, OPT_WIDTH, OPT_COUNT
+    OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_MAXLINE, OPT_MAXMEM, OPT_MAXNEST, OPT_MAXPIXELS, OPT_MAXPRIMS,
+    OPT_MAXSTEPS, OPT_MAXSTRING, OPT_MERGE, OPT_OUTPUT, OPT_SHADOWS, OPT_TEXMEM, OPT_THREADS, OPT_WIDTH,
+    OPT_COUNT
 };
 
 struct Options {
@@ -325,7 +332,9 @@ struct Setup {
 struct pray_ctx {
     pray_alloc_fn alloc;
     void *alloc_ud;
-    size_t used, limit;
+    size_t used, limit;  // limit: the smaller of the host's cap and option maxmem (0 = none)
+    size_t host_limit;   // what pray_set_memory_limit set
+    int untrusted;       // pray_set_untrusted: limits have ceilings, files stay beside the program
     Block blocks;  // sentinel of the list of live blocks
     pray_status status;
     char msg[1024];
@@ -373,6 +382,17 @@ pray_status fail(pray_ctx *c, pray_status s, const char *fmt, ...) {
 
 pray_status fail_nomem(pray_ctx *c) {
     return fail(c, PRAY_ERR_NOMEM, "out of memory");
+}
+
+// The context's cap: the host's, lowered by option maxmem (MiB) when that is set.
+void apply_memory_cap(pray_ctx *c) {
+    size_t cap = c->host_limit;
+    double mib = c->cur.opt.v[OPT_MAXMEM];
+    if (mib > 0 && mib * 1048576.0 < (double)((size_t)-1 / 2)) {
+        size_t b = (size_t)(mib * 1048576.0);
+        if (cap == 0 || b < cap) cap = b;
+    }
+    c->limit = cap;
 }
 
 void *mem_alloc(pray_ctx *c, size_t n) {
@@ -817,8 +837,9 @@ pray_object *csg_make(pray_ctx *c, int op, pray_object *a, pray_object *b) {
         return NULL;
     }
     // a tree may use one part many times over; what it stands for must stay renderable
-    if (a->nprims + b->nprims > MAX_PRIMITIVES) {
-        fail(c, PRAY_ERR_LIMIT, "object of more than %ld primitives", MAX_PRIMITIVES);
+    double lim = c->cur.opt.v[OPT_MAXPRIMS];
+    if ((double)a->nprims + (double)b->nprims > lim) {
+        fail(c, PRAY_ERR_LIMIT, "object of more than %.0f primitives (option maxprims)", lim);
         return NULL;
     }
     pray_object *o = obj_new(c, op, NULL);
@@ -1037,16 +1058,34 @@ struct OptDef {
     const char *name;
     double def, lo, hi;
     int integer;
+    double untrusted;  // the highest value allowed in untrusted mode (0: no ceiling)
 };
-// Alphabetical, in the order of the OPT_ enumeration. grid -1 means "automatic".
+// Alphabetical, in the order of the OPT_ enumeration. grid -1 means "automatic". The max* options
+// and depth, gridmem and texmem are the limits of a run (pray.hpp, "Limits").
 const OptDef OPTS[OPT_COUNT] = {
-    {"adaptive", 0, 0, 1e9, 0},   {"antialias", 1, 1, 64, 1}, {"bits", 8, 8, 16, 1},
-    {"bounds", 1, 0, 1, 1},       {"brute", 0, 0, 1, 1},      {"depth", 5, 1, 64, 1},
-    {"freeze", 1, 0, 1, 1},       {"grid", -1, -1, 4096, 1},  {"gridmem", 64, 1, 65536, 1},
-    {"height", 256, 1, MAX_IMAGE_SIDE, 1},
-    {"maxsteps", 1e7, 0, 1e15, 1}, {"merge", 1, 0, 1, 1},     {"output", 0, 0, 0, 0},
-    {"shadows", 1, 0, 1, 1},      {"texmem", 256, 1, 65536, 1},
-    {"threads", 0, 0, 1024, 1},   {"width", 256, 1, MAX_IMAGE_SIDE, 1},
+    {"adaptive", 0, 0, 1e9, 0, 0},
+    {"antialias", 1, 1, 64, 1, 0},
+    {"bits", 8, 8, 16, 1, 0},
+    {"bounds", 1, 0, 1, 1, 0},
+    {"brute", 0, 0, 1, 1, 0},
+    {"depth", 5, 1, 64, 1, 16},
+    {"freeze", 1, 0, 1, 1, 0},
+    {"grid", -1, -1, 4096, 1, 0},
+    {"gridmem", 64, 1, 65536, 1, 64},
+    {"height", 256, 1, MAX_IMAGE_SIDE, 1, 0},
+    {"maxline", 65536, 1, 1e9, 1, 4096},
+    {"maxmem", 0, 0, 1e9, 1, 1024},
+    {"maxnest", 256, 1, MAX_NESTING, 1, 64},
+    {"maxpixels", 1073741824.0, 1, 1e15, 1, 16777216.0},
+    {"maxprims", MAX_PRIMITIVES, 1, MAX_PRIMITIVES, 1, 1048576},
+    {"maxsteps", 1e7, 0, 1e15, 1, 1e6},
+    {"maxstring", 65536, 1, 16777216, 1, 4096},
+    {"merge", 1, 0, 1, 1, 0},
+    {"output", 0, 0, 0, 0, 0},
+    {"shadows", 1, 0, 1, 1, 0},
+    {"texmem", 256, 1, 65536, 1, 64},
+    {"threads", 0, 0, 1024, 1, 0},
+    {"width", 256, 1, MAX_IMAGE_SIDE, 1, 0},
 };
 
 int opt_find(const char *name) {
@@ -3254,6 +3293,46 @@ pray_status tiff_decode(pray_ctx *c, const char *name, const unsigned char *p, s
 
 namespace {
 
+// Where an untrusted program may name a file: a relative path without ".." or drive, read only
+// beside the program. NULL when `path` is fine, else why not.
+const char *untrusted_path_problem(const char *path) {
+    if (!path[0]) return "an empty name";
+    if (path[0] == '/' || path[0] == '\\' || strchr(path, ':')) return "not a relative name";
+    for (const char *q = path; *q;) {
+        const char *e = q;
+        while (*e && *e != '/' && *e != '\\') e++;
+        if (e - q == 2 && q[0] == '.' && q[1] == '.') return "a name with '..'";
+        q = *e ? e + 1 : e;
+    }
+    return NULL;
+}
+
+bool file_exists(const char *path) {
+#if PRAY_HAS_STDIO
+    FILE *f = fopen(path, "rb");
+    if (f) fclose(f);
+    return f != NULL;
+#else
+    (void)path;
+    return false;
+#endif
+}
+
+// On POSIX systems: does `file` (which exists) resolve to a place inside directory `dir`
+// ("" = the current one)? Catches symbolic links that lead out.
+bool inside_dir(const char *dir, const char *file) {
+#if PRAY_HAS_REALPATH
+    char d[PATH_MAX], f[PATH_MAX];
+    if (!realpath(dir[0] ? dir : ".", d) || !realpath(file, f)) return false;
+    size_t n = strlen(d);
+    return strncmp(d, f, n) == 0 && (f[n] == '/' || (n == 1 && d[0] == '/'));
+#else
+    (void)dir;
+    (void)file;
+    return true;
+#endif
+}
+
 // Read a whole file through the context's allocator; NULL on failure (message set).
 unsigned char *read_file(pray_ctx *c, const char *path, size_t *n, double max_bytes) {
 #if PRAY_HAS_STDIO
@@ -4246,7 +4325,20 @@ void pray_clear_error(pray_ctx *c) {
     c->status = PRAY_OK;
     c->msg[0] = 0;
 }
-void pray_set_memory_limit(pray_ctx *c, size_t bytes) { c->limit = bytes; }
+void pray_set_memory_limit(pray_ctx *c, size_t bytes) {
+    c->host_limit = bytes;
+    apply_memory_cap(c);
+}
+
+void pray_set_untrusted(pray_ctx *c) {
+    c->untrusted = 1;
+    for (int i = 0; i < OPT_COUNT; i++) {
+        double top = OPTS[i].untrusted;
+        if (top > 0 && (c->base.opt.v[i] == 0 || c->base.opt.v[i] > top)) c->base.opt.v[i] = top;
+    }
+    if (!c->running) c->cur = c->base;
+    apply_memory_cap(c);
+}
 void pray_set_print(pray_ctx *c, pray_write_fn fn, void *ud) {
     c->print_fn = fn;
     c->print_ud = ud;
@@ -4267,12 +4359,17 @@ pray_status pray_option(pray_ctx *c, const char *name, double value) {
     if (i == OPT_OUTPUT) return fail(c, PRAY_ERR_ARG, "option 'output' takes a string");
     const char *why = opt_check(i, value);
     if (why) return fail(c, PRAY_ERR_ARG, "option '%s': %g is %s", name, nan_clean(value), why);
+    double top = OPTS[i].untrusted;
+    if (c->untrusted && top > 0 && (value == 0 || value > top))
+        return fail(c, PRAY_ERR_ARG, "option '%s': %.15g%s is above %.15g, the ceiling in untrusted mode", name, value,
+                    value == 0 ? " (no limit)" : "", top);
     if (c->fixed & (1u << i)) return PRAY_OK;
     double w = i == OPT_WIDTH ? value : c->cur.opt.v[OPT_WIDTH], h = i == OPT_HEIGHT ? value : c->cur.opt.v[OPT_HEIGHT];
     if (w * h > MAX_IMAGE_PIXELS)
         return fail(c, PRAY_ERR_ARG, "image of %.0f x %.0f pixels is too large", w, h);
     c->cur.opt.v[i] = value;
     if (!c->running) c->base = c->cur;
+    if (i == OPT_MAXMEM) apply_memory_cap(c);
     return PRAY_OK;
 }
 
@@ -4287,6 +4384,9 @@ pray_status pray_option_string(pray_ctx *c, const char *name, const char *value)
     if (fmt == FMT_NONE || (fmt == FMT_PNG && !PRAY_HAS_PNG))
         return fail(c, PRAY_ERR_ARG, "option 'output': cannot tell the image format of '%s' (use .tif, .ppm%s)", value,
                     PRAY_HAS_PNG ? " or .png" : "");
+    if (c->untrusted && c->running && (untrusted_path_problem(value) || strchr(value, '/') || strchr(value, '\\')))
+        return fail(c, PRAY_ERR_ARG, "option 'output': an untrusted program may name a file, not a directory ('%s')",
+                    value);
     if (!(c->fixed & (1u << i))) strcpy(c->cur.opt.output, value);
     if (!c->running) c->base = c->cur;
     return PRAY_OK;
@@ -4736,6 +4836,13 @@ pray_status pray_render(pray_ctx *c, pray_object *root, pray_light *lights, pray
     int W = opt_int(c, OPT_WIDTH), H = opt_int(c, OPT_HEIGHT);
     if ((double)W * H > MAX_IMAGE_PIXELS)
         return fail(c, PRAY_ERR_LIMIT, "image of %d x %d pixels is too large", W, H);
+    double aa = c->cur.opt.v[OPT_ANTIALIAS], lim = c->cur.opt.v[OPT_MAXPIXELS];
+    if ((double)W * H * aa * aa > lim) {
+        char how[40] = "";
+        if (aa > 1) snprintf(how, sizeof how, " with antialias %.0f", aa);
+        return fail(c, PRAY_ERR_LIMIT, "image of %d x %d pixels%s is over the limit of %.0f samples (option maxpixels)",
+                    W, H, how, lim);
+    }
     double t0 = clock_seconds();
     Scene s;
     pray_status st = scene_build(c, &s, root, lights);
@@ -5112,6 +5219,11 @@ pray_status lex_string(Lexer &L) {
         int n;
         st = lex_text_char(L, &n);
         if (st) break;
+        if ((double)t.a.n + n > L.c->cur.opt.v[OPT_MAXSTRING]) {
+            st = perr(L.c, L.name, line, col, PRAY_ERR_LIMIT, "string longer than %.0f bytes (option maxstring)",
+                      L.c->cur.opt.v[OPT_MAXSTRING]);
+            break;
+        }
         if (!t.add(L.c, (const char *)L.p, (size_t)n)) {
             st = L.c->status;
             break;
@@ -5138,8 +5250,27 @@ bool is_continuation(const Lexer &L, int marklen) {
     return at_line_end(L, q) || (q + 1 < L.end && q[0] == '/' && q[1] == '/');
 }
 
+// Option maxline: a program with a longer line is refused before it is read, at the first
+// character past the limit (characters counted as the lexer's columns count them).
+pray_status check_line_lengths(Lexer &L) {
+    double lim = L.c->cur.opt.v[OPT_MAXLINE];
+    int line = 1;
+    double col = 0;
+    for (const unsigned char *q = L.p; q < L.end; q++) {
+        if (*q == '\n') {
+            line++;
+            col = 0;
+        } else if ((*q & 0xC0) != 0x80 && ++col > lim) {
+            return perr(L.c, L.name, line, (int)col, PRAY_ERR_LIMIT, "line longer than %.0f characters (option maxline)",
+                        lim);
+        }
+    }
+    return PRAY_OK;
+}
+
 pray_status lex(Lexer &L) {
     int last_line = 1;
+    if (check_line_lengths(L)) return L.c->status;
     while (L.p < L.end) {
         unsigned ch = *L.p;
         if (ch == ' ' || ch == '\t') {
@@ -5562,9 +5693,10 @@ Expr *parse_primary(Parser &P) {
 
 // One level deeper, at token `at` (default: the current token).
 bool enter(Parser &P, const Tok *at) {
-    if (++P.depth > MAX_NESTING) {
+    if (++P.depth > P.c->cur.opt.v[OPT_MAXNEST]) {
         char msg[80];
-        snprintf(msg, sizeof msg, "expression nested deeper than %d levels", MAX_NESTING);
+        snprintf(msg, sizeof msg, "expression nested deeper than %.0f levels (option maxnest)",
+                 P.c->cur.opt.v[OPT_MAXNEST]);
         syn(P, at ? *at : cur(P), "%s", msg);
         return false;
     }
@@ -5821,8 +5953,8 @@ Stmt *parse_statement(Parser &P) {
         s->nargs = 1;
         if (is_if && is_word(cur(P), "then")) P.pos++;
         if (end_of_line(P)) return NULL;
-        if (++P.blocks > MAX_NESTING) {
-            syn(P, t, "blocks nested too deeply");
+        if (++P.blocks > P.c->cur.opt.v[OPT_MAXNEST]) {
+            syn(P, t, "blocks nested deeper than %.0f levels (option maxnest)", P.c->cur.opt.v[OPT_MAXNEST]);
             return NULL;
         }
         Array<Stmt *> body;
@@ -6201,27 +6333,33 @@ pray_status bi_spheremap(Interp &I, const Expr *call, Value *a, Value *out) {
                 pray_spheremap(I.c, (pray_model *)a[0].ref, vec_of(a[1]), a[2].v[0], vec_of(a[3]), vec_of(a[4])), out);
 }
 
-// A texture named by the program: as written, else beside the program. Errors name the call.
+// A texture named by the program: as written, else beside the program. An untrusted program's
+// files are read beside it only. Errors name the call.
 pray_texture *program_texture(Interp &I, const Expr *call, const Value &name) {
     pray_ctx *c = I.c;
     const char *path = ((const Str *)name.ref)->s;
-    pray_texture *t = pray_texture_file(c, path);
-    bool relative = path[0] && path[0] != '/' && path[0] != '\\' && !(path[0] && path[1] == ':');
-    if (!t && c->status == PRAY_ERR_IO && relative && c->run_dir[0]) {
-        char alt[1100];
-        snprintf(alt, sizeof alt, "%s%s", c->run_dir, path);
-        char msg[1024];
-        snprintf(msg, sizeof msg, "%s", c->msg);
-        t = pray_texture_file(c, alt);
-        if (!t && c->status == PRAY_ERR_IO) {  // report the name as the program wrote it
-            c->status = PRAY_ERR_IO;
-            snprintf(c->msg, sizeof c->msg, "%s", msg);
+    if (c->untrusted) {
+        const char *why = untrusted_path_problem(path);
+        char full[1100];
+        snprintf(full, sizeof full, "%s%s", c->run_dir, path);
+        if (!why && file_exists(full) && !inside_dir(c->run_dir, full))
+            why = "a link that leads out of the program's directory";
+        if (why) {
+            rerr(I, call, PRAY_ERR_RUNTIME, "untrusted program: '%s' is %s; files are read from the program's "
+                 "directory only", *Shown(path), why);
+            return NULL;
         }
+        pray_texture *t = pray_texture_file(c, full);
+        if (!t && api_err(I, call->line, call->col) == PRAY_ERR_IO) c->status = PRAY_ERR_RUNTIME;
+        return t;
     }
-    if (!t) {
-        pray_status s = api_err(I, call->line, call->col);
-        if (s == PRAY_ERR_IO) c->status = PRAY_ERR_RUNTIME;  // a wrong name in the program
-    }
+    // as written, else beside the program; when neither opens, the message names it as written
+    bool relative = path[0] && path[0] != '/' && path[0] != '\\' && !(path[0] && path[1] == ':');
+    char alt[1100];
+    snprintf(alt, sizeof alt, "%s%s", c->run_dir, path);
+    bool beside = relative && c->run_dir[0] && !file_exists(path) && file_exists(alt);
+    pray_texture *t = pray_texture_file(c, beside ? alt : path);
+    if (!t && api_err(I, call->line, call->col) == PRAY_ERR_IO) c->status = PRAY_ERR_RUNTIME;
     return t;
 }
 
@@ -6372,6 +6510,11 @@ pray_status concat(Interp &I, const Expr *e, const Value &a, const Value &b, Val
     Text t;
     t.init();
     bool ok = value_text(I.c, a, &t) && value_text(I.c, b, &t);
+    double lim = I.c->cur.opt.v[OPT_MAXSTRING];
+    if (ok && t.a.n > lim) {
+        t.a.release(I.c);
+        return rerr(I, e, PRAY_ERR_LIMIT, "string longer than %.0f bytes (option maxstring)", lim);
+    }
     Str *s = ok ? str_new(I.c, t.str(), (size_t)t.a.n) : NULL;
     t.a.release(I.c);
     if (!s) return api_err(I, e->line, e->col);
@@ -6883,6 +7026,7 @@ pray_status pray_run_string(pray_ctx *c, const char *name, const char *text, siz
     pray_status st = run_program(c, name && *name ? name : "pray", text, len);
     c->running = 0;
     c->cur = c->base;
+    apply_memory_cap(c);
     return st;
 #else
     (void)name;
@@ -6974,6 +7118,7 @@ const char *const USAGE =
     "  --stats          print statistics of the rendering to standard error\n"
     "  --brute          the brute-force reference renderer (no acceleration)\n"
     "  --threads N      threads to render with (0 = automatic)\n"
+    "  --untrusted      tighter limits; the program reads files beside it only\n"
     "  --quiet          no progress bar\n"
     "  --version        print the version and the features compiled in\n"
     "  --help           print this text\n"
@@ -7075,6 +7220,7 @@ int main(int argc, char **argv) {
         } else if (strcmp(a, "--stats") == 0) stats = 1;
         else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) quiet = 1;
         else if (strcmp(a, "--brute") == 0) st = pray_option_fix(c, "brute", "1");
+        else if (strcmp(a, "--untrusted") == 0) pray_set_untrusted(c);
         else if (strcmp(a, "-o") == 0 || strcmp(a, "--threads") == 0 || strcmp(a, "-s") == 0 ||
                  strcmp(a, "-D") == 0) {
             if (!next) {

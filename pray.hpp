@@ -105,8 +105,15 @@ const char *pray_error(const pray_ctx *ctx);
 pray_status pray_last_status(const pray_ctx *ctx);
 void pray_clear_error(pray_ctx *ctx);
 /* Cap the bytes a context may hold at once (0 = no cap). Over the cap, calls fail with
-   PRAY_ERR_NOMEM. */
+   PRAY_ERR_NOMEM. Option maxmem (MiB) can lower the cap further, never raise it. */
 void pray_set_memory_limit(pray_ctx *ctx, size_t bytes);
+/* Untrusted mode, for programs from elsewhere; it cannot be turned off. Every limit option gets a
+   ceiling (lowered to it now; a higher value, or 0 where 0 means "no limit", is refused later):
+   depth 16, gridmem 64, maxline 4096, maxmem 1024, maxnest 64, maxpixels 16777216, maxprims
+   1048576, maxsteps 1000000, maxstring 4096, texmem 64. Texture and font files named by a
+   program are read only from the program's directory (relative names without "..", no links
+   out of it); an `output` set by a program must be a plain file name. */
+void pray_set_untrusted(pray_ctx *ctx);
 /* Where `print` writes (default: standard output; NULL fn discards). */
 void pray_set_print(pray_ctx *ctx, pray_write_fn fn, void *ud);
 /* Progress callback for renders (default none). */
@@ -122,6 +129,14 @@ void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
    (statements a program may execute, 10000000; 0 = no limit), texmem (MiB for textures, 256),
    bits (8 or 16 per sample in TIFF/PPM files), and the string option output (file name of
    `rendertiff`; its extension picks the format).
+
+   Limits (each refuses with a message naming the option; see "Limits" in the manual below):
+   maxsteps, depth, gridmem, texmem as above; maxline (characters on one line of a program,
+   65536), maxnest (nesting of blocks and of expressions, 256, at most 1024), maxstring (bytes
+   of a string, literal or built, 65536), maxprims (primitives one object stands for, 16777216),
+   maxpixels (samples of one image: width x height x antialias^2, 1073741824), maxmem (MiB a
+   context may hold, 0 = no cap). maxline and maxnest apply when a program is read, so only the
+   host or the command line can change them for that program.
 
    What the host sets here (options, camera, background) is where every program run starts;
    what a program sets lasts until the end of its run.
@@ -355,10 +370,24 @@ pray_status pray_render_file(const char *program, const char *const *options, in
    = == # < > <= >=, &, | \ (objects: union and difference; numbers: bitwise).
 
    8. Limits
-   Images up to 65536 pixels a side and 2^28 pixels; CSG trees up to 2000 levels deep; program
-   blocks and expressions nested up to 256 levels; strings up to 16 MiB; programs stop after
-   option maxsteps statements (10 million by default). A context's memory may be capped with
-   pray_set_memory_limit; going over it is an error (PRAY_ERR_NOMEM), never an abort.
+   Every limit of a run is an option with a default (the command line sets it with -D):
+       option     limits                                        default      untrusted
+       maxsteps   statements a program executes (0 = none)      10000000     1000000
+       maxnest    nesting of blocks and of expressions           256          64
+       maxline    characters on one line of a program            65536        4096
+       maxstring  bytes of one string (literal or built by +)    65536        4096
+       maxprims   primitives one object stands for               16777216     1048576
+       maxpixels  samples of an image (width*height*antialias^2) 1073741824   16777216
+       depth      ray recursion depth                            5 (at most 64)  16
+       gridmem    MiB for the grid's tables                      64           64
+       texmem     MiB for the textures of a run                  256          64
+       maxmem     MiB the context may hold (0 = no cap)          0            1024
+   maxline and maxnest are read when a program is read. Fixed limits besides: images up to
+   65536 pixels a side and 2^28 pixels, CSG trees up to 2000 levels, models up to 256.
+   pray_set_memory_limit caps a context's bytes as maxmem does; over a cap, calls fail with
+   PRAY_ERR_NOMEM ("out of memory"), never abort, and leave the context usable.
+   pray_set_untrusted (--untrusted) turns the last column into ceilings and keeps a program's
+   files in its own directory.
 
    9. Status codes
    PRAY_OK 0, PRAY_ERR_NOMEM 1, PRAY_ERR_IO 2, PRAY_ERR_SYNTAX 3, PRAY_ERR_RUNTIME 4,
