@@ -1,0 +1,447 @@
+// Limits and failures: every limit option at its value and one past it, untrusted mode, and the
+// N-th allocation failing for every N until a program and a render complete.
+#include <doctest/doctest.h>
+
+#include "testkit.hpp"
+
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#if defined(__unix__) || defined(__APPLE__)
+#include <unistd.h>
+#define HAVE_SYMLINK 1
+#endif
+
+using testkit::Result;
+
+namespace {
+
+std::string repeat(const std::string &s, int n) {
+    std::string r;
+    for (int i = 0; i < n; i++) r += s;
+    return r;
+}
+
+std::string opt(const char *name, double v) {
+    std::ostringstream o;
+    o.precision(17);
+    o << name << "=" << v;
+    return o.str();
+}
+
+// Runs `prog` with option `name` at `limit` and at `limit - 1` (the program needs exactly
+// `limit`): the first must succeed, the second fail with `message` somewhere in its error.
+void at_and_past(const char *name, double limit, const std::string &prog, const std::string &message,
+                 std::vector<std::string> more = {}) {
+    std::string shown = name;
+    CAPTURE(shown);
+    CAPTURE(limit);
+    std::vector<std::string> o = more;
+    o.push_back(opt(name, limit));
+    Result at = testkit::run(prog, o);
+    CHECK_MESSAGE(at.status == PRAY_OK, at.error);
+    o.back() = opt(name, limit - 1);
+    Result past = testkit::run(prog, o);
+    CHECK(past.status != PRAY_OK);
+    CHECK_MESSAGE(past.error.find(message) != std::string::npos, past.error);
+    CHECK(past.error.find(std::string("option ") + name) != std::string::npos);
+}
+
+const char *const TINY = "option \"width\", 2\noption \"height\", 2\n";
+
+} // namespace
+
+TEST_CASE("limit maxsteps: a program of N statements runs with maxsteps N, stops at N - 1") {
+    std::string prog = "I = 0\nwhile I < 10\n  I = I + 1\nendwhile\n";  // 1 + 11 tests + 10 bodies
+    at_and_past("maxsteps", 22, prog, "error: the program was stopped after 21 statements");
+    CHECK(testkit::run(prog, {"maxsteps=0"}).status == PRAY_OK);  // 0: no limit
+}
+
+TEST_CASE("limit maxnest: parentheses, calls and blocks at the depth allowed and one deeper") {
+    for (int n : {2, 7, 256, 1024}) {
+        CAPTURE(n);
+        std::string paren = "X = " + repeat("(", n) + "1" + repeat(")", n) + "\nprint X\n";
+        at_and_past("maxnest", n, paren, "expression nested deeper than " + std::to_string(n - 1) + " levels");
+        std::string ifs = repeat("if 1 then\n", n) + "print 2\n" + repeat("endif\n", n);
+        at_and_past("maxnest", n, ifs, "blocks nested deeper than " + std::to_string(n - 1) + " levels");
+        std::string whiles = repeat("while 0\n", n) + repeat("endwhile\n", n);
+        at_and_past("maxnest", n, whiles, "blocks nested deeper");
+    }
+    // the highest value the option takes is safe for the stack; one more is refused
+    pray_ctx *c = pray_new();
+    CHECK(pray_option(c, "maxnest", 1024) == PRAY_OK);
+    CHECK(pray_option(c, "maxnest", 1025) == PRAY_ERR_ARG);
+    pray_free(c);
+    std::string sq = "X = " + repeat("sqrt(", 1024) + "1" + repeat(")", 1024) + "\nprint X\n";
+    CHECK(testkit::run(sq, {"maxnest=1024"}).printed == "1\n");
+}
+
+TEST_CASE("limit maxline: a line of exactly maxline characters, and one more") {
+    for (int n : {10, 100, 5000}) {
+        std::string line = "print \"" + repeat("a", n - 8) + "\"";  // n characters
+        REQUIRE(line.size() == (size_t)n);
+        at_and_past("maxline", n, line + "\n", "1:" + std::to_string(n) + ": error: line longer than");
+        // characters are counted, not bytes: e with acute accent is two bytes, one column
+        std::string wide = "print \"" + repeat("\xc3\xa9", n - 8) + "\"";
+        at_and_past("maxline", n, wide + "\n", "error: line longer than");
+    }
+    // the default takes 65536 characters
+    std::string longest = "X = 1" + repeat(" ", 65531) + "\nprint X\n";
+    CHECK(testkit::run(longest).printed == "1\n");
+    CHECK(testkit::run(" " + longest).error == "test.ray:1:65537: error: line longer than 65536 characters (option maxline)");
+}
+
+TEST_CASE("limit maxstring: literals and strings built by +") {
+    at_and_past("maxstring", 5, "print \"abcde\"\n", "1:7: error: string longer than 4 bytes");
+    at_and_past("maxstring", 6, "print \"abc\" + \"def\"\n", "1:13: error: string longer than 5 bytes");
+    at_and_past("maxstring", 3, "print \"a\" + 12\n", "error: string longer than 2 bytes");  // a number as %g
+    // doubling stops at the limit with the message, not out of memory
+    Result r = testkit::run("S = \"x\"\nwhile 1\n  S = S + S\nendwhile\n", {"maxstring=1000"});
+    CHECK(r.error == "test.ray:3:9: error: string longer than 1000 bytes (option maxstring)");
+    pray_ctx *c = pray_new();
+    CHECK(pray_option(c, "maxstring", 16777216) == PRAY_OK);
+    CHECK(pray_option(c, "maxstring", 16777217) == PRAY_ERR_ARG);
+    pray_free(c);
+}
+
+TEST_CASE("limit maxprims: an object standing for N primitives") {
+    std::string prog = std::string(TINY) + "M = color({1})\nO = sphere(M, [0, 0, 0], 1)\n"
+                                           "I = 1\nwhile I < 12\n  O = O | sphere(M, [I, 0, 0], 1)\n  I = I + 1\nendwhile\n"
+                                           "rendertiff O\n";
+    at_and_past("maxprims", 12, prog, "error: object of more than 11 primitives");
+    // shared parts count each time they are used
+    std::string shared = "M = color({1})\nS = sphere(M, [0, 0, 0], 1)\nT = S | S\nU = T | T\nV = U & U\n";
+    at_and_past("maxprims", 8, shared, "5:7: error: object of more than 7 primitives");
+}
+
+TEST_CASE("limit maxpixels: samples of an image, antialias counted") {
+    std::string prog = "option \"width\", 10\noption \"height\", 7\nrendertiff sphere(color({1}), [0, 0, 0], 1)\n";
+    at_and_past("maxpixels", 70, prog, "error: image of 10 x 7 pixels is over the limit of 69 samples");
+    at_and_past("maxpixels", 630, prog, "error: image of 10 x 7 pixels with antialias 3 is over the limit of 629 samples",
+                {"antialias=3"});
+    // the API gets the same answer from pray_render
+    pray_ctx *c = pray_new();
+    pray_option(c, "width", 4);
+    pray_option(c, "height", 4);
+    pray_option(c, "maxpixels", 15);
+    pray_object *s = pray_sphere(c, pray_color(c, pray_rgb{1, 1, 1}), pray_vec{0, 0, 0}, 1);
+    pray_image img;
+    CHECK(pray_render(c, s, NULL, &img) == PRAY_ERR_LIMIT);
+    pray_option(c, "maxpixels", 16);
+    REQUIRE(pray_render(c, s, NULL, &img) == PRAY_OK);
+    pray_image_free(c, &img);
+    pray_release(c, s);
+    pray_free(c);
+}
+
+TEST_CASE("limit depth: rays between two mirrors stop at the depth, and 64 is the most") {
+    // the camera stands between two parallel mirrors, looking at one of them: every primary ray
+    // is reflected depth - 1 times
+    std::string prog = "option \"width\", 1\noption \"height\", 1\nparallel <0.1, 0, 0>, <0, 0, -0.1>, [0, 0, 0], [0, 1, 0]\n"
+                       "M = mirror({1})\nA = plane(M, [0, 1, 0], <0, 1, 0>) & plane(M, [0, -1, 0], <0, -1, 0>)\n"
+                       "rendertiff -A\n";
+    for (int d : {1, 2, 5, 64}) {
+        CAPTURE(d);
+        pray_ctx *c = pray_new();
+        pray_set_frame(c, [](void *, const pray_image *, const char *) { return PRAY_OK; }, NULL);
+        REQUIRE(pray_option(c, "depth", d) == PRAY_OK);
+        REQUIRE(pray_run_string(c, "m.ray", prog.data(), prog.size()) == PRAY_OK);
+        pray_stats st;
+        pray_stats_get(c, &st);
+        CHECK(st.rays_primary == 1);
+        CHECK(st.rays_reflected == d - 1);
+        pray_free(c);
+    }
+    CHECK(testkit::run("option \"depth\", 65\n").error == "test.ray:1:1: error: option 'depth': 65 is out of range");
+}
+
+TEST_CASE("limit gridmem: the grid's tables stay within the budget") {
+    std::string prog = "option \"width\", 8\noption \"height\", 8\nM = color({1})\nO = sphere(M, [0, 0, 0], 0.01)\n"
+                       "I = 1\nwhile I < 400\n  O = O | sphere(M, [sin(I), cos(I * 1.3), sin(I * 0.7)], 0.01)\n  I = I + 1\n"
+                       "endwhile\nrendertiff O\n";
+    for (int mib : {1, 2, 8}) {
+        CAPTURE(mib);
+        pray_ctx *c = pray_new();
+        pray_set_frame(c, [](void *, const pray_image *, const char *) { return PRAY_OK; }, NULL);
+        pray_option(c, "gridmem", mib);
+        pray_option(c, "grid", 4096);  // asks for far more than the budget
+        REQUIRE(pray_run_string(c, "g.ray", prog.data(), prog.size()) == PRAY_OK);
+        pray_stats st;
+        pray_stats_get(c, &st);
+        CHECK(st.memory > 0);
+        CHECK(st.memory <= (double)mib * 1048576.0);
+        pray_free(c);
+    }
+}
+
+TEST_CASE("limit texmem and maxmem: a texture over the budget, a context over its memory") {
+    // a 640 x 640 8-bit RGB TIFF: 1.2 MB, over texmem 1; decoded it needs less than 16 MiB
+    pray_ctx *c = pray_new();
+    pray_option(c, "width", 640);
+    pray_option(c, "height", 640);
+    pray_object *s = pray_sphere(c, pray_color(c, pray_rgb{1, 0.5, 0.25}), pray_vec{0, 0, 0}, 1);
+    pray_image img;
+    REQUIRE(pray_render(c, s, NULL, &img) == PRAY_OK);
+    REQUIRE(pray_write_image(c, &img, "limits_big.tif", 8) == PRAY_OK);
+    pray_image_free(c, &img);
+    pray_release(c, s);
+    pray_free(c);
+    std::string prog = std::string(TINY) + "M = color({1})\nT = tiff(M, M, \"limits_big.tif\")\n"
+                                           "rendertiff planemap(T, [0, 0, 0], <1, 0, 0>, <0, 1, 0>, <0, 0, 1>)\n";
+    Result r = testkit::run(prog, {"texmem=1"});
+    CHECK(r.error == "test.ray:4:5: error: 'limits_big.tif' is over the texture memory limit (option texmem)");
+    CHECK(testkit::run(prog, {"texmem=16"}).status == PRAY_OK);
+    // maxmem: 2 MiB do not hold the decoded texture
+    r = testkit::run(prog, {"maxmem=2", "texmem=16"});
+    CHECK(r.status == PRAY_ERR_NOMEM);
+    CHECK(r.error.find("out of memory") != std::string::npos);
+    CHECK(testkit::run(prog, {"maxmem=64", "texmem=16"}).status == PRAY_OK);
+    std::remove("limits_big.tif");
+    // maxmem lowers the host's cap, never raises it
+    c = pray_new();
+    pray_set_memory_limit(c, 100000);
+    pray_option(c, "maxmem", 64);
+    pray_option(c, "width", 256);
+    pray_option(c, "height", 256);
+    s = pray_sphere(c, pray_color(c, pray_rgb{1, 1, 1}), pray_vec{0, 0, 0}, 1);
+    CHECK(pray_render(c, s, NULL, &img) == PRAY_ERR_NOMEM);
+    pray_set_memory_limit(c, 0);
+    REQUIRE(pray_render(c, s, NULL, &img) == PRAY_OK);
+    pray_image_free(c, &img);
+    pray_option(c, "maxmem", 1);
+    pray_option(c, "width", 512);
+    CHECK(pray_render(c, s, NULL, &img) == PRAY_ERR_NOMEM);  // 512 x 256 floats: 1.5 MiB
+    pray_release(c, s);
+    pray_free(c);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Untrusted mode
+// ---------------------------------------------------------------------------------------------
+namespace {
+void write_text(const std::string &path, const std::string &text) {
+    std::ofstream f(path.c_str(), std::ios::binary);
+    f << text;
+}
+} // namespace
+
+TEST_CASE("untrusted mode: every limit gets its ceiling; higher values and 'no limit' are refused") {
+    const struct {
+        const char *name;
+        double ceiling;
+    } ceilings[] = {{"depth", 16},         {"gridmem", 64},           {"maxline", 4096},
+                    {"maxmem", 1024},      {"maxnest", 64},           {"maxpixels", 16777216},
+                    {"maxprims", 1048576}, {"maxsteps", 1000000},     {"maxstring", 4096},
+                    {"texmem", 64}};
+    pray_ctx *c = pray_new();
+    pray_option(c, "maxsteps", 0);
+    pray_option(c, "depth", 3);
+    pray_set_untrusted(c);
+    CHECK(pray_option_get(c, "depth") == 3);  // already below its ceiling: kept
+    for (const auto &k : ceilings) {
+        CAPTURE(k.name);
+        if (strcmp(k.name, "depth") != 0) CHECK(pray_option_get(c, k.name) <= k.ceiling);
+        CHECK(pray_option(c, k.name, k.ceiling) == PRAY_OK);
+        CHECK(pray_option(c, k.name, k.ceiling + 1) == PRAY_ERR_ARG);
+        CHECK(std::string(pray_error(c)).find("ceiling in untrusted mode") != std::string::npos);
+        CHECK(pray_option_get(c, k.name) == k.ceiling);
+    }
+    CHECK(pray_option_get(c, "maxsteps") == 1000000);
+    CHECK(pray_option(c, "maxsteps", 0) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: option 'maxsteps': 0 (no limit) is above 1000000, the ceiling in untrusted mode");
+    CHECK(pray_option(c, "maxmem", 0) == PRAY_ERR_ARG);
+    // a program meets the same ceilings
+    const char *prog = "option \"maxsteps\", 2000000\n";
+    CHECK(pray_run_string(c, "u.ray", prog, strlen(prog)) != PRAY_OK);
+    CHECK(std::string(pray_error(c)).find("u.ray:1:1: error: option 'maxsteps'") == 0);
+    prog = "option \"maxsteps\", 10\nI = 0\nwhile 1\n  I = I + 1\nendwhile\n";  // lower is fine
+    CHECK(pray_run_string(c, "u.ray", prog, strlen(prog)) == PRAY_ERR_LIMIT);
+    CHECK(std::string(pray_error(c)).find("stopped after 10 statements") != std::string::npos);
+    pray_free(c);
+}
+
+TEST_CASE("untrusted mode: files only from the program's directory") {
+    // a directory with a program, a texture beside it, one in a subdirectory, one outside
+    const std::string dir = "limits_untrusted";
+    std::string clean = "rm -rf " + dir;
+    REQUIRE(std::system(clean.c_str()) == 0);
+    REQUIRE(std::system(("mkdir -p " + dir + "/sub").c_str()) == 0);
+    pray_ctx *c = pray_new();
+    pray_option(c, "width", 4);
+    pray_option(c, "height", 4);
+    pray_object *s = pray_sphere(c, pray_color(c, pray_rgb{1, 0, 0}), pray_vec{0, 0, 0}, 9);
+    pray_image img;
+    REQUIRE(pray_render(c, s, NULL, &img) == PRAY_OK);
+    REQUIRE(pray_write_image(c, &img, (dir + "/red.tif").c_str(), 8) == PRAY_OK);
+    REQUIRE(pray_write_image(c, &img, (dir + "/sub/red.tif").c_str(), 8) == PRAY_OK);
+    REQUIRE(pray_write_image(c, &img, "limits_outside.tif", 8) == PRAY_OK);
+    pray_image_free(c, &img);
+    pray_release(c, s);
+    pray_free(c);
+#ifdef HAVE_SYMLINK
+    REQUIRE(symlink("../limits_outside.tif", (dir + "/link.tif").c_str()) == 0);
+#endif
+    auto run = [&](const std::string &file, bool untrusted, const std::string &output = "") {
+        std::string prog = std::string(TINY) + "M = color({1})\nT = tiff(M, M, \"" + file + "\")\n";
+        if (!output.empty()) prog += "option \"output\", \"" + output + "\"\n";
+        write_text(dir + "/p.ray", prog);
+        pray_ctx *k = pray_new();
+        pray_set_frame(k, [](void *, const pray_image *, const char *) { return PRAY_OK; }, NULL);
+        if (untrusted) pray_set_untrusted(k);
+        pray_status st = pray_run_file(k, (dir + "/p.ray").c_str());
+        std::string e = st == PRAY_OK ? "" : pray_error(k);
+        pray_free(k);
+        return e;
+    };
+    const std::string where = dir + "/p.ray:4:5: error: untrusted program: '";
+    CHECK(run("red.tif", true) == "");
+    CHECK(run("sub/red.tif", true) == "");
+    CHECK(run("../limits_outside.tif", true) == where + "../limits_outside.tif' is a name with '..'; files are read from the program's directory only");
+    CHECK(run("sub/../../limits_outside.tif", true).find("is a name with '..'") != std::string::npos);
+    CHECK(run("/etc/passwd", true) == where + "/etc/passwd' is not a relative name; files are read from the program's directory only");
+    CHECK(run("C:/x.tif", true).find("is not a relative name") != std::string::npos);
+    CHECK(run("", true).find("is an empty name") != std::string::npos);
+#ifdef HAVE_SYMLINK
+    CHECK(run("link.tif", true) == where + "link.tif' is a link that leads out of the program's directory; files are read from the program's directory only");
+    CHECK(run("link.tif", false) == "");  // trusted: read wherever the link leads
+#endif
+    CHECK(run("../limits_outside.tif", false) == "");
+    // a file in the current directory is not looked for when untrusted
+    CHECK(run("limits_outside.tif", true).find("cannot open") != std::string::npos);
+    CHECK(run("limits_outside.tif", false) == "");
+    // outputs: a plain name only
+    CHECK(run("red.tif", true, "x.tif") == "");
+    CHECK(run("red.tif", true, "sub/x.tif").find("option 'output': an untrusted program may name a file, not a directory") != std::string::npos);
+    CHECK(run("red.tif", true, "../x.tif").find("not a directory") != std::string::npos);
+    CHECK(run("red.tif", false, "sub/x.tif") == "");
+    REQUIRE(std::system(clean.c_str()) == 0);
+    std::remove("limits_outside.tif");
+}
+
+// ---------------------------------------------------------------------------------------------
+// The N-th allocation fails
+// ---------------------------------------------------------------------------------------------
+namespace {
+struct Failing {
+    long countdown = 0;  // the allocation that fails (1 = the next one); 0 = none
+    long made = 0;       // allocations and growths asked for
+    long live = 0;       // blocks held
+    bool failed = false;
+    std::map<void *, size_t> sizes;
+};
+
+void *failing_alloc(void *ud, void *ptr, size_t, size_t nsize) {
+    Failing *f = static_cast<Failing *>(ud);
+    if (nsize == 0) {
+        if (ptr && f->sizes.erase(ptr)) f->live--;
+        std::free(ptr);
+        return NULL;
+    }
+    f->made++;
+    if (f->countdown && --f->countdown == 0) {
+        f->failed = true;
+        return NULL;
+    }
+    void *p = std::realloc(ptr, nsize);
+    if (!p) return NULL;
+    if (ptr && f->sizes.erase(ptr)) f->live--;
+    f->sizes[p] = nsize;
+    f->live++;
+    return p;
+}
+
+void no_print(void *, const void *, size_t) {}
+
+// One program and one API render under an allocator failing at allocation n (0: never).
+// Returns the status of the first failing step, OK when everything completed.
+pray_status exercise(Failing &f, const std::string &prog, int threads) {
+    pray_ctx *c = pray_new_with(failing_alloc, &f);
+    if (!c) return PRAY_ERR_NOMEM;
+    pray_set_print(c, no_print, NULL);
+    pray_set_frame(c, [](void *, const pray_image *, const char *) { return PRAY_OK; }, NULL);
+    pray_option(c, "threads", threads);
+    pray_status st = pray_run_string(c, "alloc.ray", prog.data(), prog.size());
+    if (st == PRAY_OK) {
+        // the API: objects, a render with antialias and undersampling, both writers
+        pray_model *m = pray_phong(c, pray_rgb{0.8f, 0.2f, 0.2f}, pray_rgb{0.3f, 0.3f, 0.3f}, pray_rgb{0.1f, 0.1f, 0.1f}, 5);
+        pray_object *a = pray_sphere(c, m, pray_vec{0, 0, 0}, 1);
+        pray_object *b = pray_cylinder(c, m, pray_vec{0, 0, 0}, pray_vec{0, 0, 1}, 0.3);
+        pray_object *d = a && b ? pray_csg(c, PRAY_DIFFERENCE, a, b) : NULL;
+        pray_light *l = pray_dirlight(c, pray_rgb{1, 1, 1}, pray_vec{1, -1, 1});
+        pray_image img;
+        img.pixels = NULL;
+        if (!d || !l) st = pray_last_status(c);
+        else if ((st = pray_option(c, "antialias", 2)) == PRAY_OK && (st = pray_option(c, "adaptive", 0.1)) == PRAY_OK)
+            st = pray_render(c, d, l, &img);
+        if (st == PRAY_OK) st = pray_write_tiff(c, &img, 8, no_print, NULL);
+        if (st == PRAY_OK) st = pray_write_ppm(c, &img, 16, no_print, NULL);
+        pray_image_free(c, &img);
+        pray_release(c, m);
+        pray_release(c, a);
+        pray_release(c, b);
+        pray_release(c, d);
+        pray_release(c, l);
+    }
+    if (st != PRAY_OK && st != PRAY_ERR_NOMEM) MESSAGE("status ", (int)st, ": ", pray_error(c));
+    if (st == PRAY_ERR_NOMEM) CHECK(std::string(pray_error(c)).find("out of memory") != std::string::npos);
+    pray_free(c);
+    return st;
+}
+} // namespace
+
+TEST_CASE("the N-th allocation fails, for every N: out of memory, no leak, until everything completes") {
+    // a program touching every kind of value, CSG, text, textures, lights, strings, a render
+    std::string prog = std::string("option \"width\", 6\noption \"height\", 5\noption \"antialias\", 2\n") +
+                       "S = \"name\" + 7\nprint S, [1, 2, 3], <1, 0, 0>, {0.5}\n"
+                       "M = phong({0.8, 0.2, 0.2}, {0.3}, {0.1}, 5) + mirror({0.2})\n"
+                       "G = transparent({0.5}, 1.5)\n"
+                       "O = sphere(M, [0, 0, 0], 1) - cylinder(G, [0, 0, 0], <0, 0, 1>, 0.3)\n"
+                       "O = O | plane(color({0.2}), [0, 0, -1], <0, 0, 1>) & -sphere(M, [2, 0, 0], 0.5)\n"
+                       "T = text(M, \"Hi\", [-1, 0, 1], <0.2, 0, 0>, <0, 0, 0.3>, 0.05, \"\", 1)\n"
+                       "O = (O | T).<1, 1, 1>.[0.1, 0, 0]\n"
+                       "L = dirlight({1}, <1, -1, 1>) + pointlight({0.5}, [0, -3, 2])\n"
+                       "I = 0\nwhile I < 2\n  rendertiff O, L\n  I = I + 1\nendwhile\n";
+    for (int threads : {1, 2}) {
+        CAPTURE(threads);
+        Failing whole;
+        REQUIRE(exercise(whole, prog, threads) == PRAY_OK);
+        REQUIRE(whole.live == 0);
+        long total = whole.made;
+        MESSAGE("allocations in one complete run with ", threads, " thread(s): ", total);
+        int ok = 0, nomem = 0, other = 0, leaks = 0, not_failed = 0;
+        // with one thread every N; with two (allocation order varies) a spread of N
+        // every N with one thread; with two (the order of allocations varies) every 7th, and
+        // one N far enough past the end to complete
+        std::vector<long> ns;
+        for (long n = 1; n <= total + 1; n += threads == 1 ? 1 : 7) ns.push_back(n);
+        if (threads > 1) ns.push_back(total + 200);
+        for (long n : ns) {
+            Failing f;
+            f.countdown = n;
+            pray_status st = exercise(f, prog, threads);
+            if (f.live != 0) {
+                leaks++;
+                MESSAGE("N = ", n, ": ", f.live, " blocks not freed");
+            }
+            if (st == PRAY_OK) {
+                ok++;
+                if (f.failed) not_failed++;  // a failed allocation must not go unnoticed
+            } else if (st == PRAY_ERR_NOMEM) nomem++;
+            else {
+                other++;
+                MESSAGE("N = ", n, ": status ", (int)st);
+            }
+        }
+        CHECK(leaks == 0);
+        CHECK(other == 0);
+        CHECK(not_failed == 0);
+        CHECK(nomem >= (threads == 1 ? total : total / 7) - 1);
+        CHECK(ok >= 1);
+    }
+}
