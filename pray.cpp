@@ -396,8 +396,14 @@ void apply_memory_cap(pray_ctx *c) {
 }
 
 void *mem_alloc(pray_ctx *c, size_t n) {
-    if (n > (size_t)-1 / 2 || (c->limit && (c->used + n + sizeof(Block) > c->limit))) {
+    if (n > (size_t)-1 / 2) {
         fail_nomem(c);
+        return NULL;
+    }
+    if (c->limit && c->used + n + sizeof(Block) > c->limit) {
+        if (c->limit != c->host_limit)
+            fail(c, PRAY_ERR_NOMEM, "out of memory: over the cap of %.0f MiB (option maxmem)", c->cur.opt.v[OPT_MAXMEM]);
+        else fail(c, PRAY_ERR_NOMEM, "out of memory: over the context's cap of %lu bytes", (unsigned long)c->limit);
         return NULL;
     }
     Block *b = (Block *)c->alloc(c->alloc_ud, NULL, 0, sizeof(Block) + n);
@@ -5695,8 +5701,8 @@ Expr *parse_primary(Parser &P) {
 bool enter(Parser &P, const Tok *at) {
     if (++P.depth > P.c->cur.opt.v[OPT_MAXNEST]) {
         char msg[80];
-        snprintf(msg, sizeof msg, "expression nested deeper than %.0f levels (option maxnest)",
-                 P.c->cur.opt.v[OPT_MAXNEST]);
+        double lim = P.c->cur.opt.v[OPT_MAXNEST];
+        snprintf(msg, sizeof msg, "expression nested deeper than %.0f level%s (option maxnest)", lim, lim == 1 ? "" : "s");
         syn(P, at ? *at : cur(P), "%s", msg);
         return false;
     }
@@ -5954,7 +5960,8 @@ Stmt *parse_statement(Parser &P) {
         if (is_if && is_word(cur(P), "then")) P.pos++;
         if (end_of_line(P)) return NULL;
         if (++P.blocks > P.c->cur.opt.v[OPT_MAXNEST]) {
-            syn(P, t, "blocks nested deeper than %.0f levels (option maxnest)", P.c->cur.opt.v[OPT_MAXNEST]);
+            double lim = P.c->cur.opt.v[OPT_MAXNEST];
+            syn(P, t, "blocks nested deeper than %.0f level%s (option maxnest)", lim, lim == 1 ? "" : "s");
             return NULL;
         }
         Array<Stmt *> body;
