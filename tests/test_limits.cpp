@@ -67,9 +67,9 @@ TEST_CASE("limit maxnest: parentheses, calls and blocks at the depth allowed and
     for (int n : {2, 7, 256, 1024}) {
         CAPTURE(n);
         std::string paren = "X = " + repeat("(", n) + "1" + repeat(")", n) + "\nprint X\n";
-        at_and_past("maxnest", n, paren, "expression nested deeper than " + std::to_string(n - 1) + " levels");
+        at_and_past("maxnest", n, paren, "expression nested deeper than " + std::to_string(n - 1) + (n == 2 ? " level " : " levels "));
         std::string ifs = repeat("if 1 then\n", n) + "print 2\n" + repeat("endif\n", n);
-        at_and_past("maxnest", n, ifs, "blocks nested deeper than " + std::to_string(n - 1) + " levels");
+        at_and_past("maxnest", n, ifs, "blocks nested deeper than " + std::to_string(n - 1) + (n == 2 ? " level " : " levels "));
         std::string whiles = repeat("while 0\n", n) + repeat("endwhile\n", n);
         at_and_past("maxnest", n, whiles, "blocks nested deeper");
     }
