@@ -1937,6 +1937,20 @@ int cross_cmp(const void *pa, const void *pb) {
     return b->enter - a->enter;
 }
 
+// Sort crossings by cross_cmp: insertion sort for the few crossings of most sweeps.
+void sort_crossings(Cross *x, int n) {
+    if (n > 16) {
+        qsort(x, (size_t)n, sizeof(Cross), cross_cmp);
+        return;
+    }
+    for (int i = 1; i < n; i++) {
+        Cross v = x[i];
+        int j = i;
+        for (; j > 0 && cross_cmp(&v, &x[j - 1]) < 0; j--) x[j] = x[j - 1];
+        x[j] = v;
+    }
+}
+
 struct Hit {
     real t;
     int prim;
@@ -1993,7 +2007,7 @@ int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit
         }
     }
     bool root = e_is_node(s->root) ? w->nstat[e_index(s->root)] != 0 : w->pstat[e_index(s->root)] != 0;
-    if (nc > 1) qsort(w->cross, (size_t)nc, sizeof(Cross), cross_cmp);
+    if (nc > 1) sort_crossings(w->cross, nc);
     int hits = 0;
     for (int i = 0; i < nc;) {
         real t = w->cross[i].t;
@@ -2750,7 +2764,7 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
         if (st) bump(s, w, 2 * j + 1);
     }
     bool root = e_is_node(s->root) ? w->nstat[e_index(s->root)] != 0 : w->pstat[e_index(s->root)] != 0;
-    if (nc > 1) qsort(w->cross, (size_t)nc, sizeof(Cross), cross_cmp);
+    if (nc > 1) sort_crossings(w->cross, nc);
     for (int i = 0; i < nc;) {
         real t = w->cross[i].t;
         bool before = root;
@@ -2877,15 +2891,33 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
     }
     int run = -1;  // the list of the area being crossed
     real run_a = t;
+    const int *cell = A->voxel + ((long)ix[2] * A->n[1] + ix[1]) * A->n[0] + ix[0];
+    long stride[3];  // a step along each axis, in cells
+    stride[0] = step[0];
+    stride[1] = (long)step[1] * A->n[0];
+    stride[2] = (long)step[2] * A->n[0] * A->n[1];
+    bool merge = A->merge != 0;
+    long steps = 0, moves = 0;  // counted here, added to the counters once per ray
+    bool stopped = false;
     for (;;) {
-        int L = A->voxel[((long)ix[2] * A->n[1] + ix[1]) * A->n[0] + ix[0]];
-        int ax = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
-        real exit = next[ax] < tend ? next[ax] : tend;
-        w->k.steps += 1;
-        if (L == run && A->merge) {
-            w->k.moves += 1;  // same list: a move, no evaluation
+        int L = *cell;
+        // the axis of the nearest boundary, ties to the later axis; without branches, as the
+        // choice is a coin toss for the branch predictor
+        // the axis of the nearest boundary, ties to the later axis (selects, not branches: the
+        // choice is a coin toss for a branch predictor)
+        int ax = 0;
+        real near = next[0];
+        if (next[1] <= near) ax = 1, near = next[1];
+        if (next[2] <= near) ax = 2, near = next[2];
+        real exit = near < tend ? near : tend;
+        steps++;
+        if (L == run && merge) {
+            moves++;  // same list: a move, no evaluation
         } else {
-            if (run >= 0 && eval_list(s, A, w, ray, run, run_a, t, tmax, self, visit)) return;
+            if (run >= 0 && eval_list(s, A, w, ray, run, run_a, t, tmax, self, visit)) {
+                stopped = true;
+                break;
+            }
             run = L;
             run_a = t;
         }
@@ -2893,8 +2925,12 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
         if (exit >= tend) break;
         ix[ax] += step[ax];
         if (ix[ax] < 0 || ix[ax] >= A->n[ax]) break;
+        cell += stride[ax];
         next[ax] += delta[ax];
     }
+    w->k.steps += (double)steps;
+    w->k.moves += (double)moves;
+    if (stopped) return;
     // the last stretch ends where the ray leaves the grid's box, whatever rounding the stepping
     // gathered, so that it meets the stretch after the grid without a gap
     if (run >= 0 && eval_list(s, A, w, ray, run, run_a, tend, tmax, self, visit)) return;
