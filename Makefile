@@ -6,6 +6,7 @@
 #   make check      build and run all tests (installs the test packages if missing)
 #   make matrix     compile pray.cpp under every configuration macro and language level
 #   make bench      the acceleration benchmarks (bench/run.sh), results in docs/benchmarks.md
+#   make pov        pray against POV-Ray 3.7 (bench/pov.sh; installs povray)
 #   make ports      build, run and compare every port (ports/check; installs cross compilers, qemu, wine)
 #   make check-bad  the catalogue of bad inputs (tests/bad/run.sh); the last step of check
 #   make sanitize   the tests and the bad inputs under AddressSanitizer and UBSan
@@ -28,7 +29,7 @@ TESTS = tests/pray_tests$(EXE)
 TESTS_FLOAT = tests/pray_tests_float$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
-.PHONY: all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff textures gallery ports
+.PHONY: all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff textures gallery ports pov
 
 all: $(PRAY)
 
@@ -127,6 +128,9 @@ gallery: $(PRAY) textures
 # Benchmarks print tables; they are never part of check.
 bench: $(PRAY)
 	bench/run.sh
+
+pov: $(PRAY)
+	bench/pov.sh
 
 # Every configuration macro on its own, float and double, C++98/11/17, warnings as errors.
 MATRIX_STDS = -std=c++98 -std=c++11 -std=c++17
