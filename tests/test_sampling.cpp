@@ -84,3 +84,21 @@ TEST_CASE("undersampling: off by default, fewer primary rays when on, exact wher
     CHECK(frames[1].at(63, 63, 2) == frames[0].at(63, 63, 2));
     pray_free(c);
 }
+
+TEST_CASE("undersampling with threshold 0 is full sampling: the same image, every primary ray") {
+    for (const char *file : {"examples/csg.ray", "examples/glass.ray", "examples/holes.ray"}) {
+        CAPTURE(file);
+        std::string prog = file_text(file);
+        for (const char *aa : {"antialias=1", "antialias=3"}) {
+            CAPTURE(aa);
+            testkit::Result plain = testkit::run(prog, {"width=40", "height=30", aa});
+            testkit::Result zero = testkit::run(prog, {"width=40", "height=30", aa, "adaptive=0"});
+            testkit::Result on = testkit::run(prog, {"width=40", "height=30", aa, "adaptive=0.02"});
+            REQUIRE(plain.frames.size() == 1);
+            REQUIRE(zero.frames.size() == 1);
+            REQUIRE(on.frames.size() == 1);
+            CHECK(zero.frames[0].pixels == plain.frames[0].pixels);
+            CHECK(on.frames[0].pixels != plain.frames[0].pixels);  // so the comparison can fail
+        }
+    }
+}
