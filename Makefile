@@ -7,6 +7,7 @@
 #   make matrix     compile pray.cpp under every configuration macro and language level
 #   make bench      the acceleration benchmarks (bench/run.sh), results in docs/benchmarks.md
 #   make pov        pray against POV-Ray 3.7 (bench/pov.sh; installs povray)
+#   make charts     speed against accuracy and the benchmarks, drawn (bench/charts.sh), docs/images/bench-*.png
 #   make ports      build, run and compare every port (ports/check; installs cross compilers, qemu, wine)
 #   make check-bad  the catalogue of bad inputs (tests/bad/run.sh); the last step of check
 #   make sanitize   the tests and the bad inputs under AddressSanitizer and UBSan
@@ -29,7 +30,7 @@ TESTS = tests/pray_tests$(EXE)
 TESTS_FLOAT = tests/pray_tests_float$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
-.PHONY: all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff textures gallery ports pov
+.PHONY: all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff textures gallery ports pov charts
 
 all: $(PRAY)
 
@@ -131,6 +132,10 @@ bench: $(PRAY)
 
 pov: $(PRAY)
 	bench/pov.sh
+
+# Time against error (undersampling, antialias, grid, float), threads, Table 3.6.1 and scaling, drawn.
+charts: $(PRAY) textures
+	bench/charts.sh
 
 # Every configuration macro on its own, float and double, C++98/11/17, warnings as errors.
 MATRIX_STDS = -std=c++98 -std=c++11 -std=c++17
