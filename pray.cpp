@@ -1226,6 +1226,7 @@ struct Prim {
     R3 mu, mv;
     int mirrored;       // longitudes of a spheremap run the other way
     int id;             // position among the declared primitives, left to right
+    int surf;           // the first primitive of the scene with exactly this surface (twins)
     int parent;         // node index, -1 for the root
     unsigned char first;  // first child of a difference
     unsigned char settles;  // 1: being outside for good decides the parent, 2: inside (3.5)
@@ -1263,6 +1264,11 @@ struct Scene {
     int width, height, depth, shadows, antialias;
     pray_rgb bg_top, bg_bottom;
 };
+
+// Does primitive p have the surface of primitive `self` (the one a secondary ray starts on)?
+inline bool twin(const Scene *s, int p, int self) {
+    return self >= 0 && s->prims[p].surf == s->prims[self].surf;
+}
 
 void accel_release(pray_ctx *c, Accel *a);
 
@@ -1371,7 +1377,17 @@ void polyhedron_box(const Scene *s, const int *kids, int n, Box *b) {
         D[m++] = q.d;
     }
     if (m < 2 || m >= 40) return;
-    const double BIG = 1e30;
+    // unbounded sides stand in at a distance far beyond everything else in sight (vertices of
+    // nearly parallel planes reach |D| / 1e-12); a scene too large for that keeps its plain box
+    double big = 0;
+    for (int i = 0; i < m; i++)
+        if (fabs(D[i]) > big) big = fabs(D[i]);
+    for (int i = 0; i < 3; i++) {
+        if (b->hi[i] < REAL_BIG && fabs((double)b->hi[i]) > big) big = fabs((double)b->hi[i]);
+        if (b->lo[i] > -REAL_BIG && fabs((double)b->lo[i]) > big) big = fabs((double)b->lo[i]);
+    }
+    if (big > 1e250) return;
+    const double BIG = big * 1e16 > 1e30 ? big * 1e16 : 1e30;
     for (int i = 0; i < 3; i++) {  // the box sides, infinite ones at a huge distance
         N[m][0] = N[m][1] = N[m][2] = 0;
         N[m][i] = 1;
@@ -1412,8 +1428,10 @@ void polyhedron_box(const Scene *s, const int *kids, int n, Box *b) {
     const double rel = sizeof(real) == sizeof(float) ? 64 * FLT_EPSILON : 1e-9;
     for (int l = 0; l < 3; l++) {
         double pad = rel * (fabs(lo[l]) + fabs(hi[l]) + 1);
-        if (lo[l] > -BIG / 2 && lo[l] - pad > (double)b->lo[l]) b->lo[l] = (real)(lo[l] - pad);
-        if (hi[l] < BIG / 2 && hi[l] + pad < (double)b->hi[l]) b->hi[l] = (real)(hi[l] + pad);
+        // (a float build keeps a side that float cannot hold)
+        double top = sizeof(real) == sizeof(float) ? FLT_MAX : DBL_MAX;
+        if (lo[l] > -BIG / 2 && lo[l] - pad > (double)b->lo[l] && lo[l] - pad > -top) b->lo[l] = (real)(lo[l] - pad);
+        if (hi[l] < BIG / 2 && hi[l] + pad < (double)b->hi[l] && hi[l] + pad < top) b->hi[l] = (real)(hi[l] + pad);
     }
 }
 
@@ -1563,12 +1581,12 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
 struct SnapKey {
     int prim;
     int sign;     // +1, or -1 when the normal was flipped to its canonical orientation
-    double v[7];  // kind, then the canonical parameters
+    double v[8];  // kind, then the canonical parameters
 };
 
 int snap_cmp(const void *pa, const void *pb) {
     const SnapKey *a = (const SnapKey *)pa, *b = (const SnapKey *)pb;
-    for (int i = 0; i < 7; i++) {
+    for (int i = 0; i < 8; i++) {
         if (a->v[i] < b->v[i]) return -1;
         if (a->v[i] > b->v[i]) return 1;
     }
@@ -1579,10 +1597,10 @@ void snap_key(const Prim &q, SnapKey *k) {
     double n[3] = {q.n.x, q.n.y, q.n.z}, p[3] = {q.p.x, q.p.y, q.p.z};
     k->sign = 1;
     k->v[0] = q.kind;
+    k->v[5] = k->v[6] = k->v[7] = 0;
     if (q.kind == O_SPHERE) {
         for (int i = 0; i < 3; i++) k->v[1 + i] = p[i];
         k->v[4] = q.r;
-        k->v[5] = k->v[6] = 0;
         return;
     }
     int big = 0;  // canonical orientation: the largest component positive
@@ -1592,12 +1610,10 @@ void snap_key(const Prim &q, SnapKey *k) {
     for (int i = 0; i < 3; i++) k->v[1 + i] = n[i] * k->sign;
     if (q.kind == O_PLANE) {
         k->v[4] = q.d * k->sign;
-        k->v[5] = k->v[6] = 0;
     } else {  // cylinder: the radius, then the point of the axis nearest the origin
         double t = p[0] * n[0] + p[1] * n[1] + p[2] * n[2];
         k->v[4] = q.r;
-        k->v[5] = p[0] - t * n[0];
-        k->v[6] = p[1] - t * n[1];
+        for (int i = 0; i < 3; i++) k->v[5 + i] = p[i] - t * n[i];
     }
 }
 
@@ -1627,9 +1643,102 @@ bool snap_close(const Prim &a, const Prim &b, int sa, int sb) {
            fabs((double)perp.z) <= tol;
 }
 
+// The largest magnitude among a primitive's parameters: the scale of its rounding.
+double prim_scale(const Prim &q) {
+    double v[5] = {(double)q.p.x, (double)q.p.y, (double)q.p.z, (double)q.r, (double)q.d}, m = 0;
+    for (int i = 0; i < 5; i++)
+        if (fabs(v[i]) > m) m = fabs(v[i]);
+    return m;
+}
+
+// One key component of one primitive, for sorting the components one at a time.
+struct SnapComp {
+    double kind, v;
+    int prim;
+};
+int snap_comp_cmp(const void *pa, const void *pb) {
+    const SnapComp *a = (const SnapComp *)pa, *b = (const SnapComp *)pb;
+    if (a->kind != b->kind) return a->kind < b->kind ? -1 : 1;
+    if (a->v != b->v) return a->v < b->v ? -1 : 1;
+    return a->prim - b->prim;
+}
+
+bool same_key(const SnapKey &a, const SnapKey &b) {
+    for (int i = 0; i < 8; i++)
+        if (a.v[i] != b.v[i]) return false;
+    return true;
+}
+
+// Coincident surfaces that differ by rounding get identical parameters. Sorting whole keys is
+// not enough: two planes one unit in the last place apart in x may sort far from each other when
+// other planes share one of their x values. So each key component is first rounded to a
+// representative (values within tolerance of a run's first value take that value); then keys
+// that became equal are neighbours, and the parameters of each group are snapped to its first.
 pray_status snap_coincident(pray_ctx *c, Scene *s) {
     int n = s->prims.n;
     if (n < 2) return PRAY_OK;
+    SnapKey *k = (SnapKey *)mem_alloc(c, sizeof(SnapKey) * (size_t)n);
+    SnapComp *o = (SnapComp *)mem_alloc(c, sizeof(SnapComp) * (size_t)n);
+    double *scale = (double *)mem_alloc(c, sizeof(double) * (size_t)n);
+    if (!k || !o || !scale) {
+        mem_free(c, k);
+        mem_free(c, o);
+        mem_free(c, scale);
+        return c->status;
+    }
+    const double eps = sizeof(real) == sizeof(float) ? FLT_EPSILON : DBL_EPSILON;
+    for (int i = 0; i < n; i++) {
+        k[i].prim = i;
+        snap_key(s->prims[i], &k[i]);
+        scale[i] = prim_scale(s->prims[i]);
+    }
+    for (int comp = 1; comp < 8; comp++) {
+        for (int i = 0; i < n; i++) {
+            o[i].kind = k[i].v[0];
+            o[i].v = k[i].v[comp];
+            o[i].prim = i;
+        }
+        qsort(o, (size_t)n, sizeof(SnapComp), snap_comp_cmp);
+        for (int i = 0; i < n;) {
+            const SnapComp &a = o[i];
+            int j = i + 1;
+            for (; j < n && o[j].kind == a.kind; j++) {
+                // normals and axes are unit vectors: absolute; positions relative to their scale
+                bool unit = a.kind != O_SPHERE && comp <= 3;
+                double m = scale[a.prim] > scale[o[j].prim] ? scale[a.prim] : scale[o[j].prim];
+                if (o[j].v - a.v > (unit ? 8 * eps : 8 * eps * m)) break;
+                k[o[j].prim].v[comp] = a.v;
+            }
+            i = j;
+        }
+    }
+    qsort(k, (size_t)n, sizeof(SnapKey), snap_cmp);
+    for (int i = 0; i < n;) {
+        const Prim &a = s->prims[k[i].prim];
+        int j = i + 1;
+        for (; j < n && same_key(k[i], k[j]); j++) {
+            Prim &b = s->prims[k[j].prim];
+            if (!snap_close(a, b, k[i].sign, k[j].sign)) continue;
+            int f = k[i].sign * k[j].sign;  // +1 same orientation, -1 opposite
+            if (a.kind != O_PLANE) b.p = a.p;  // a plane's point is its texture origin only
+            b.r = a.r;
+            b.r2 = a.r2;
+            b.n = a.n * (real)f;
+            b.d = a.d * (real)f;
+        }
+        i = j;
+    }
+    mem_free(c, k);
+    mem_free(c, o);
+    mem_free(c, scale);
+    return PRAY_OK;
+}
+
+// Twins: primitives with exactly the same surface (after snapping), whatever their orientation.
+// A secondary ray that starts on one starts on all of them.
+pray_status mark_twins(pray_ctx *c, Scene *s) {
+    int n = s->prims.n;
+    if (n == 0) return PRAY_OK;
     SnapKey *k = (SnapKey *)mem_alloc(c, sizeof(SnapKey) * (size_t)n);
     if (!k) return c->status;
     for (int i = 0; i < n; i++) {
@@ -1638,18 +1747,8 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
     }
     qsort(k, (size_t)n, sizeof(SnapKey), snap_cmp);
     for (int i = 0; i < n;) {
-        const Prim &a = s->prims[k[i].prim];
-        int j = i + 1;
-        for (; j < n && k[j].v[0] == k[i].v[0]; j++) {
-            Prim &b = s->prims[k[j].prim];
-            if (!snap_close(a, b, k[i].sign, k[j].sign)) break;
-            int f = k[i].sign * k[j].sign;  // +1 same orientation, -1 opposite
-            if (a.kind != O_PLANE) b.p = a.p;  // a plane's point is its texture origin only
-            b.r = a.r;
-            b.r2 = a.r2;
-            b.n = a.n * (real)f;
-            b.d = a.d * (real)f;
-        }
+        int j = i;
+        for (; j < n && same_key(k[i], k[j]); j++) s->prims[k[j].prim].surf = k[i].prim;
         i = j;
     }
     mem_free(c, k);
@@ -1973,7 +2072,7 @@ int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit
         const Prim &q = s->prims[i];
         real t0 = 0, t1 = 0;
         w->k.tests += 1;
-        int k = prim_span(q, ray, i == self, &t0, &t1);
+        int k = prim_span(q, ray, twin(s, i, self), &t0, &t1);
         bool in = false;
         if (k == SPAN_ALL) in = true;
         else if (k == SPAN) {
@@ -2637,7 +2736,7 @@ inline const Span &span_get(const Scene *s, Scratch *w, const Ray &ray, int p, i
     if (sp.stamp != w->ray) {
         sp.stamp = w->ray;
         w->k.tests += 1;
-        sp.kind = prim_span(s->prims[p], ray, p == self, &sp.t0, &sp.t1);
+        sp.kind = prim_span(s->prims[p], ray, twin(s, p, self), &sp.t0, &sp.t1);
     }
     return sp;
 }
@@ -3818,7 +3917,7 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     s->root = flatten(c, s, root);
     // snapped before compaction, over every primitive flattened, so that the reference and the
     // simplified scene give the same surviving primitives the same numbers
-    if (s->root == -3 || snap_coincident(c, s) || scene_compact(c, s)) return c->status;
+    if (s->root == -3 || snap_coincident(c, s) || scene_compact(c, s) || mark_twins(c, s)) return c->status;
     c->stats.primitives_declared = root->nprims;
     if (!opt_int(c, OPT_BRUTE) && accel_build(c, s)) return c->status;
     for (int i = 0; lights && i < lights->n; i++) {

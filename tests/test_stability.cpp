@@ -884,13 +884,12 @@ TEST_CASE("stability: coincident faces (A \\ B, A & B, touching boxes, cubes of 
     CHECK_MESSAGE(c.speckles == 0, speckle_text(c));
 }
 
-// Defect S1 (docs/testing.md, reported): snapping compares only neighbours in the lexicographic
+// Defect S1 (docs/testing.md; fixed: key components are rounded to representatives first): snapping compared only neighbours in the lexicographic
 // order of (normal, offset), so two coincident faces whose normals differ in the last bit are
 // kept apart by a parallel face at another offset that sorts between them (the opposite face of
 // B), and are never snapped: A \ B and A & B with B turned in two steps speckle all over the
-// shared faces (double build; in float the normals round to the same numbers). Remove may_fail
-// when pray.cpp is fixed.
-TEST_CASE("stability: coincident faces of boxes turned separately (B's turn in two steps) show no speckle" * doctest::may_fail()) {
+// shared faces (double build; in float the normals round to the same numbers).
+TEST_CASE("stability: coincident faces of boxes turned separately (B's turn in two steps) show no speckle") {
     const std::vector<V3> rots = {v3(10, 20, 30), v3(-37, 51, 163)};
     const std::vector<V3> moves = {v3(0, 0, 0), v3(12.3, -45.6, 7.89)};
     std::string per;
@@ -1273,12 +1272,12 @@ TEST_CASE("stability: no self-intersection of shadow, refracted and thin-occlude
     CHECK_MESSAGE(failures.empty(), "self-intersections:" << failures);
 }
 
-// Defect S2 (docs/testing.md, reported): a shadow (or reflected) ray starting on a face that the
+// Defect S2 (docs/testing.md; fixed: twins, primitives of the same surface, all count as the start): a shadow (or reflected) ray starting on a face that the
 // union shares with another part of the union is not protected from that other part: the twin
 // face, snapped to the same plane, finds the start a unit in the last place inside and the ray
 // "leaves" the solid at t ~ 1e-16, a hit that shadows the point. Shadow acne on part of the
-// shared face, in both builds. Remove may_fail when pray.cpp is fixed.
-TEST_CASE("stability: no shadow acne on a face shared by two parts of a union, R = 1e-3 .. 1e6" * doctest::may_fail()) {
+// shared face, in both builds.
+TEST_CASE("stability: no shadow acne on a face shared by two parts of a union, R = 1e-3 .. 1e6") {
     std::string report, failures;
     for (double R = 1e-3; R <= 1e6 * 1.0001; R *= 10) {
         const V3 Q = ANCHOR, deg = v3(10, 20, 30);
@@ -2017,9 +2016,9 @@ TEST_CASE("stability: every switch gives --brute's images and hits on the scaled
 // small on the other axes, and the grid (with bounds) drops the part of it outside: at scale
 // 2^101 the scene of these tests loses 3 pixels of its tilted cube against --brute (2^100 and
 // 2^102 are fine). The float build cannot reach 1e30 with this scene (its squares overflow from
-// 2^55 on) and checks 2^40 .. 2^48 instead. Remove may_fail when pray.cpp is fixed.
-TEST_CASE("stability: every switch gives --brute's image with coordinates near 1e30 (scale 2^96 .. 2^104; float: 2^40 .. 2^48)" *
-          doctest::may_fail()) {
+// 2^55 on) and checks 2^40 .. 2^48 instead. Fixed: the stand-in planes are placed relative to the
+// scene's own size.
+TEST_CASE("stability: every switch gives --brute's image with coordinates near 1e30 (scale 2^96 .. 2^104; float: 2^40 .. 2^48)") {
     const int k0 = float_build() ? 40 : 96;
     long renders = 0;
     std::string bad;
