@@ -2463,12 +2463,14 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
 // scenes (docs/benchmarks.md): about 4 voxels per primitive plus a floor of 4096 voxels is near
 // the best for CSG scenes of 200 to 1000 primitives; the building cost grows with the voxels, so
 // they are capped by half the primary rays. A handful of primitives is fastest without a grid.
-int auto_grid(int bounded, double rays) {
+// `fill` is the share of the cube over the longest side that the grid's box takes (each side
+// counted at least 1/16 of the longest), so that a flat scene gets that many voxels too.
+int auto_grid(int bounded, double rays, double fill) {
     if (bounded < 8) return 0;
     double v = 4.0 * bounded + 4096;
     if (v > rays / 2) v = rays / 2;
-    int n = (int)ceil(cbrt_pos(v));
-    return n < 4 ? 4 : n;
+    int n = (int)ceil(cbrt_pos(v / fill));
+    return n < 4 ? 4 : n > 1024 ? 1024 : n;
 }
 
 // Build the acceleration structure: the lists of the grid's voxels and of the space around it.
@@ -2522,12 +2524,18 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
     if (a->bounds && s->root >= 0) box_clip(&region, elem_box(s, s->root));
     int bounded = 0;  // primitives that reach into the grid's box
     for (int i = 0; i < np && !box_empty(region); i++) bounded += box_overlap(s->prims[i].box, region);
-    int want = opt_int(c, OPT_GRID);
-    if (want < 0) want = auto_grid(bounded, (double)opt_int(c, OPT_WIDTH) * opt_int(c, OPT_HEIGHT) * opt_int(c, OPT_ANTIALIAS) * opt_int(c, OPT_ANTIALIAS));
-    if (box_empty(region) || bounded == 0 || s->root < 0) want = 0;
-    double ext = 0;
-    for (int l = 0; want > 0 && l < 3; l++)
+    double ext = 0, fill = 1;
+    for (int l = 0; !box_empty(region) && l < 3; l++)
         if ((double)(region.hi[l] - region.lo[l]) > ext) ext = (double)(region.hi[l] - region.lo[l]);
+    for (int l = 0; ext > 0 && l < 3; l++) {
+        double f = (double)(region.hi[l] - region.lo[l]) / ext;
+        fill *= f > 1.0 / 16 ? f : 1.0 / 16;
+    }
+    int want = opt_int(c, OPT_GRID);
+    if (want < 0)
+        want = auto_grid(bounded, (double)opt_int(c, OPT_WIDTH) * opt_int(c, OPT_HEIGHT) * opt_int(c, OPT_ANTIALIAS) *
+                                      opt_int(c, OPT_ANTIALIAS), fill);
+    if (box_empty(region) || bounded == 0 || s->root < 0) want = 0;
     if (!(ext > 0) || !finite_num(ext)) want = 0;
     // voxels are cubes; the margin keeps classification safe from rounding in the traversal
     double mag = 0;
@@ -3448,6 +3456,7 @@ const char *untrusted_path_problem(const char *path) {
     return NULL;
 }
 
+#if PRAY_HAS_INTERP  // for the files programs name
 bool file_exists(const char *path) {
 #if PRAY_HAS_STDIO
     FILE *f = fopen(path, "rb");
@@ -3473,6 +3482,7 @@ bool inside_dir(const char *dir, const char *file) {
     return true;
 #endif
 }
+#endif
 
 // Read a whole file through the context's allocator; NULL on failure (message set).
 unsigned char *read_file(pray_ctx *c, const char *path, size_t *n, double max_bytes) {
