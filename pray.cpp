@@ -3996,6 +3996,7 @@ struct Job {
 };
 
 const int ADAPT_STEP = 4;  // spacing of the coarse lattice of undersampling
+const int ADAPT_BAND = 8;  // lattice cells per band: a band traces its last row again, once per band
 
 bool differ(const Sample &a, const Sample &b, double th) {
     return a.hit != b.hit || fabs(a.c.r - b.c.r) > th || fabs(a.c.g - b.c.g) > th || fabs(a.c.b - b.c.b) > th;
@@ -4071,10 +4072,11 @@ void set_row_background(Worker &k, int j) {
     k.tr.bg = cadd(s->bg_top, cscale(cadd(s->bg_bottom, cscale(s->bg_top, -1)), f));
 }
 
-// Undersampling: the sample of pixel (i, j), rows y0 .. y0 + ADAPT_STEP of the band cached.
+// Undersampling: the traced sample of pixel (i, j); the band's rows from y0 on are cached. A
+// pixel interpolated by one cell is traced when a neighbouring cell needs it as a corner.
 Sample &band_sample(Worker &k, int y0, int i, int j) {
     Sample &x = k.cache[(j - y0) * k.job->s->width + i];
-    if (!x.known) {
+    if (x.known != 1) {
         set_row_background(k, j);
         x = pixel(k, i, j);
     }
@@ -4131,16 +4133,21 @@ void render_band(Worker &k, int band) {
         }
         return;
     }
-    // the band's cells span rows y0 .. y0 + step (the last row shared with the next band)
-    int yl = y0 + ADAPT_STEP < H - 1 ? y0 + ADAPT_STEP : H - 1;
-    for (int q = 0; q < (ADAPT_STEP + 1) * W; q++) k.cache[q].known = 0;
-    for (int x0 = 0; x0 < W - 1 || x0 == 0; x0 += ADAPT_STEP) {
-        int x1 = x0 + ADAPT_STEP < W - 1 ? x0 + ADAPT_STEP : W - 1;
-        refine(k, y0, x0, y0, x1, yl);
-        if (x1 == W - 1) break;
+    // the band's cells span rows y0 .. y0 + band_rows (the last row shared with the next band)
+    for (int q = 0; q < (job->band_rows + 1) * W; q++) k.cache[q].known = 0;
+    for (int cy = y0; cy < y1; cy += ADAPT_STEP) {
+        int yl = cy + ADAPT_STEP < H - 1 ? cy + ADAPT_STEP : H - 1;
+        for (int x0 = 0; x0 < W - 1 || x0 == 0; x0 += ADAPT_STEP) {
+            int x1 = x0 + ADAPT_STEP < W - 1 ? x0 + ADAPT_STEP : W - 1;
+            refine(k, y0, x0, cy, x1, yl);
+            if (x1 == W - 1) break;
+        }
     }
     for (int j = y0; j < y1; j++)
-        for (int i = 0; i < W; i++) put_pixel(job, i, j, band_sample(k, y0, i, j).c);
+        for (int i = 0; i < W; i++) {
+            const Sample &x = k.cache[(j - y0) * W + i];
+            put_pixel(job, i, j, x.known ? x.c : band_sample(k, y0, i, j).c);
+        }
 }
 
 void worker_main(void *arg) {
@@ -4174,7 +4181,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
     job.s = s;
     job.out = out;
     job.adaptive = c->cur.opt.v[OPT_ADAPTIVE];
-    job.band_rows = job.adaptive > 0 ? ADAPT_STEP : 4;
+    job.band_rows = job.adaptive > 0 ? ADAPT_STEP * ADAPT_BAND : 4;
     job.bands = (s->height + job.band_rows - 1) / job.band_rows;
     if (nt > job.bands) nt = job.bands;
     // everything a thread needs is allocated here, before any starts: the context's allocator
@@ -4189,7 +4196,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
         k.job = &job;
         k.cache.init();
         if (!scratch_init(c, &k.w, s)) st = c->status;
-        else if (job.adaptive > 0 && !k.cache.reserve(c, (ADAPT_STEP + 1) * s->width)) st = c->status;
+        else if (job.adaptive > 0 && !k.cache.reserve(c, (job.band_rows + 1) * s->width)) st = c->status;
         k.tr.s = s;
         k.tr.w = &k.w;
         args[made] = &k;
