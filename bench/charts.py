@@ -2,7 +2,8 @@
 """bench/charts.py - speed against accuracy, and the acceleration benchmarks drawn.
 
 Run by bench/charts.sh (`make charts`), which installs python3-matplotlib and builds the programs.
-Renders a set of gallery scenes and measures, with one thread and the best of REPS runs:
+Renders a set of gallery scenes and measures, with one thread, the best of REPS runs made in
+separate passes over all the settings of a measurement (more when the machine was busy):
 
   adaptive   render time against error for undersampling thresholds, at antialias 1 and 4
   antialias  render time against error for antialias 1, 2, 3, 4, 8
@@ -54,6 +55,8 @@ SIZE = 256            # pixels along each side
 REF_AA = 16           # the reference: 16 x 16 samples per pixel
 REPS = 3              # best of REPS runs for every time ...
 ONCE_AA = 8           # ... except antialias 8 (64 times the work of antialias 1), made once
+DISTURBED = 0.25      # a run during which other work took more than this share of a core ...
+EXTRA = 3             # ... is repeated, at most EXTRA more times, while it is the fastest
 DEFAULT_ADAPTIVE = 0.02   # the threshold the manual recommends ("try 0.02"); the option's default is 0 = off
 THRESHOLDS = [0, 0.005, 0.02, 0.05, 0.1, 0.2]
 ADAPTIVE_AA = [1, 4]
@@ -113,7 +116,8 @@ def parse_stats(text):
 
 def render(scene, out, opts, prog=None, reps=1, brute=False, size=None, mem=False):
     """Render scene (a file) into out with options opts ({name: value}); the best of reps runs.
-    Returns the statistics of the fastest run; with mem, "peak": the largest resident set of the
+    Returns the statistics of the fastest run, with "others": the other work on the machine
+    during it, in cores (all busy CPU time from /proc/stat minus pray's own, over the wall time); with mem, "peak": the largest resident set of the
     runs in KiB, measured by /usr/bin/time (a child of python would count python's own)."""
     prog = prog or PRAY
     size = size or SIZE
@@ -218,6 +222,38 @@ def same_bytes(a, b):
 
 # ---- the measurements ----
 
+def timed(jobs, total=False):
+    """Time jobs, a list of (key, args of render): REPS passes over the whole list, so that a
+    disturbance of a few seconds hits one run of a setting rather than all of them; then up to
+    EXTRA more runs of a setting while its fastest run was disturbed by other work. A job whose
+    args have "once" runs in the first pass only. Returns {key: statistics of the fastest run},
+    fastest by render time, or by pre-processing + render time with total."""
+    def cost(x):
+        return x["render"] + (x["prep"] if total else 0)
+    best = {}
+    peak = {}
+
+    def run(key, kw):
+        kw = dict(kw)
+        kw.pop("once", None)
+        x = render(**kw)
+        peak[key] = max(peak.get(key, 0), x["peak"])
+        if key not in best or cost(x) < cost(best[key]):
+            best[key] = x
+    for rep in range(REPS):
+        for key, kw in jobs:
+            if rep == 0 or not kw.get("once"):
+                run(key, kw)
+    for key, kw in jobs:
+        for _ in range(EXTRA if REPS > 1 and not kw.get("once") else 0):
+            if best[key]["others"] <= DISTURBED:
+                break
+            run(key, kw)
+    for key in best:
+        best[key]["peak"] = peak[key]
+    return best
+
+
 def measure():
     R = {"size": SIZE, "ref_aa": REF_AA, "reps": REPS, "wrong": WRONG, "default_adaptive": DEFAULT_ADAPTIVE,
          "scenes": SCENES, "machine": machine(), "adaptive": [], "antialias": [], "grid": [],
@@ -227,64 +263,64 @@ def measure():
     refs = dict((n, reference(n)) for n in SCENES)
     one = {"threads": 1}
 
-    log("adaptive thresholds")
+    def out(*k):
+        return "%s/%s.ppm" % (img, "-".join(str(x) for x in k))
+
+    log("adaptive thresholds and antialias levels")
+    jobs = []
+    for n in SCENES:
+        for aa in sorted(set(ADAPTIVE_AA) | set(ANTIALIAS)):
+            for t in (THRESHOLDS if aa in ADAPTIVE_AA else [0]):
+                jobs.append(((n, aa, t), {"scene": scene_file(n), "out": out(n, "aa%d" % aa, "ad%g" % t),
+                                          "opts": dict(one, antialias=aa, adaptive=t), "once": aa >= ONCE_AA}))
+    T = timed(jobs)
     for n in SCENES:
         for aa in ADAPTIVE_AA:
-            full = None
+            full = out(n, "aa%d" % aa, "ad0")
             for t in THRESHOLDS:
-                out = "%s/%s-aa%d-ad%g.ppm" % (img, n, aa, t)
-                s = render(scene_file(n), out, dict(one, antialias=aa, adaptive=t), reps=REPS)
-                if t == 0:
-                    full = out
-                p, w = error(out, refs[n])
-                pf, wf = error(out, full)
+                s = T[(n, aa, t)]
+                o = out(n, "aa%d" % aa, "ad%g" % t)
+                p, w = error(o, refs[n])
+                pf, wf = error(o, full)
                 R["adaptive"].append({"scene": n, "aa": aa, "threshold": t, "time": s["render"],
                                       "rays": s["primary"] / s["primary_full"], "psnr": p, "wrong": w,
                                       "psnr_full": pf, "wrong_full": wf})
                 log("  %-9s aa %d adaptive %-6g %7.3f s  %5.1f %% rays  %s dB  %.2f %% wrong" %
                     (n, aa, t, s["render"], 100 * s["primary"] / s["primary_full"], fmt_db(p), 100 * w))
-
-    log("antialias")
-    for n in SCENES:
         for aa in ANTIALIAS:
-            out = "%s/%s-aa%d-ad0.ppm" % (img, n, aa)
-            old = [r for r in R["adaptive"] if r["scene"] == n and r["aa"] == aa and r["threshold"] == 0]
-            if old:
-                tm = old[0]["time"]
-            else:
-                tm = render(scene_file(n), out, dict(one, antialias=aa), reps=1 if aa >= ONCE_AA else REPS)["render"]
-            p, w = error(out, refs[n])
+            p, w = error(out(n, "aa%d" % aa, "ad0"), refs[n])
+            tm = T[(n, aa, 0)]["render"]
             R["antialias"].append({"scene": n, "aa": aa, "time": tm, "psnr": p, "wrong": w})
             log("  %-9s aa %d %7.3f s  %s dB  %.2f %% wrong" % (n, aa, tm, fmt_db(p), 100 * w))
 
     log("grid resolutions")
+    jobs = [((n, g), {"scene": scene_file(n), "out": out(n, "grid%d" % g), "opts": dict(one, grid=g)})
+            for n in SCENES for g in GRIDS]
+    T = timed(jobs, total=True)
     for n in SCENES:
-        auto = "%s/%s-grid-1.ppm" % (img, n)
-        rows = []
-        for g in [-1] + [g for g in GRIDS if g != -1]:
-            out = "%s/%s-grid%d.ppm" % (img, n, g)
-            s = render(scene_file(n), out, dict(one, grid=g), reps=REPS)
-            rows.append({"scene": n, "grid": g, "layout": s.get("grid", "?"), "prep": s["prep"], "time": s["render"],
-                         "tests": s.get("tests", 0), "same": same_bytes(out, auto)})
+        for g in GRIDS:
+            s = T[(n, g)]
+            R["grid"].append({"scene": n, "grid": g, "layout": s.get("grid", "?"), "prep": s["prep"], "time": s["render"],
+                              "tests": s.get("tests", 0), "same": same_bytes(out(n, "grid%d" % g), out(n, "grid-1"))})
             log("  %-9s grid %-4d %-12s prep %.3f render %7.3f s  same image: %s" %
-                (n, g, s.get("grid", "?"), s["prep"], s["render"], rows[-1]["same"]))
-        R["grid"] += rows
+                (n, g, s.get("grid", "?"), s["prep"], s["render"], R["grid"][-1]["same"]))
 
     log("float against double")
+    jobs = []
     for n in SCENES:
-        for aa in [1]:
-            dbl = "%s/%s-aa%d-ad0.ppm" % (img, n, aa)
-            flt = "%s/%s-aa%d-float.ppm" % (img, n, aa)
-            sd = render(scene_file(n), dbl, dict(one, antialias=aa), reps=REPS)
-            sf = render(scene_file(n), flt, dict(one, antialias=aa), prog=PRAY_FLOAT, reps=REPS)
-            pd, wd = error(dbl, refs[n])
-            pf, wf = error(flt, refs[n])
-            px, wx = error(flt, dbl)
-            R["precision"].append({"scene": n, "aa": aa, "time_double": sd["render"], "time_float": sf["render"],
-                                   "psnr_double": pd, "wrong_double": wd, "psnr_float": pf, "wrong_float": wf,
-                                   "psnr_fd": px, "wrong_fd": wx})
-            log("  %-9s aa %d double %7.3f s %s dB, float %7.3f s %s dB; float against double %s dB, %.3f %% wrong" %
-                (n, aa, sd["render"], fmt_db(pd), sf["render"], fmt_db(pf), fmt_db(px), 100 * wx))
+        jobs.append(((n, "double"), {"scene": scene_file(n), "out": out(n, "double"), "opts": one}))
+        jobs.append(((n, "float"), {"scene": scene_file(n), "out": out(n, "float"), "opts": one, "prog": PRAY_FLOAT}))
+    T = timed(jobs)
+    for n in SCENES:
+        sd, sf = T[(n, "double")], T[(n, "float")]
+        pd, wd = error(out(n, "double"), refs[n])
+        pf, wf = error(out(n, "float"), refs[n])
+        px, wx = error(out(n, "float"), out(n, "double"))
+        R["precision"].append({"scene": n, "aa": 1, "time_double": sd["render"], "time_float": sf["render"],
+                               "psnr_double": pd, "wrong_double": wd, "psnr_float": pf, "wrong_float": wf,
+                               "psnr_fd": px, "wrong_fd": wx})
+        log("  %-9s double %7.3f s %s dB, float %7.3f s %s dB; float against double %s dB, %.3f %% wrong" %
+            (n, sd["render"], fmt_db(pd), sf["render"], fmt_db(pf), fmt_db(px), 100 * wx))
 
     R["threads"] = measure_threads()
 
@@ -292,55 +328,63 @@ def measure():
     settings = [("grid + freezing", {"grid": -1, "freeze": 1}, False), ("grid", {"grid": -1, "freeze": 0}, False),
                 ("gridless + freezing", {"grid": 0, "freeze": 1}, False), ("gridless", {"grid": 0, "freeze": 0}, False),
                 ("brute", {}, True)]
+    jobs = [((n, i), {"scene": scene_file(n), "out": out("t361", n, i), "opts": dict(one, **o), "brute": brute,
+                      "size": 256}) for n in TABLE_SCENES for i, (label, o, brute) in enumerate(settings)]
+    T = timed(jobs)
     for n in TABLE_SCENES:
-        first = None
-        for label, o, brute in settings:
-            out = "%s/t361-%s-%d.ppm" % (img, n, settings.index((label, o, brute)))
-            s = render(scene_file(n), out, dict(one, **o), reps=REPS, brute=brute, size=256)
-            first = first or out
+        for i, (label, o, brute) in enumerate(settings):
+            s = T[(n, i)]
             R["table361"].append({"scene": n, "setting": label, "prep": s["prep"], "time": s["render"],
-                                  "prims": s.get("prims", 0), "tests": s.get("tests", 0),
-                                  "frozen": s.get("frozen", 0), "same": same_bytes(out, first)})
+                                  "prims": s.get("prims", 0), "tests": s.get("tests", 0), "frozen": s.get("frozen", 0),
+                                  "same": same_bytes(out("t361", n, i), out("t361", n, 0))})
             log("  %-8s %-20s %7.3f s  same image: %s" % (n, label, s["render"], R["table361"][-1]["same"]))
 
     log("scaling")
     with open("bench/spheres.ray") as f:
         body = f.read()
+    jobs = []
     for N in SCALING_N:
         prog = "%s/spheres-%d.ray" % (WORK, N)
         with open(prog, "w") as f:
             f.write("N = %d\n" % N + body)
-        g = render(prog, "%s/spheres-g.ppm" % img, one, reps=REPS, size=128, mem=True)
+        jobs.append(((N, "grid"), {"scene": prog, "out": out("spheres", N, "g"), "opts": one, "size": 128, "mem": True}))
+        if N <= SCALING_BRUTE_MAX:
+            jobs.append(((N, "brute"), {"scene": prog, "out": out("spheres", N, "b"), "opts": one, "size": 128,
+                                        "mem": True, "brute": True}))
+    T = timed(jobs)
+    for N in SCALING_N:
+        g = T[(N, "grid")]
         row = {"n": N, "prep": g["prep"], "time": g["render"], "peak": g["peak"] / 1024.0,
                "struct": g.get("gridbytes", 0) / 1048576.0, "grid": g.get("grid", "none"), "brute": None,
                "brute_peak": None, "same": None}
-        if N <= SCALING_BRUTE_MAX:
-            b = render(prog, "%s/spheres-b.ppm" % img, one, reps=REPS, brute=True, size=128, mem=True)
+        if (N, "brute") in T:
+            b = T[(N, "brute")]
             row.update(brute=b["render"], brute_peak=b["peak"] / 1024.0,
-                       same=same_bytes("%s/spheres-g.ppm" % img, "%s/spheres-b.ppm" % img))
-        os.remove(prog)
+                       same=same_bytes(out("spheres", N, "g"), out("spheres", N, "b")))
+        os.remove("%s/spheres-%d.ray" % (WORK, N))
         R["scaling"].append(row)
         log("  N %6d prep %.3f render %.3f s, brute %s" % (N, g["prep"], g["render"], row["brute"]))
     return R
 
 
 def measure_threads():
-    """One thread against two, alternated REPS times so that a change of the machine's load hits
-    both; with the other work on the machine (in cores) during the fastest two-thread run."""
+    """One thread against two on THREAD_AA x THREAD_AA samples, in interleaved passes; with the
+    other work on the machine (in cores) during the fastest runs."""
     log("threads (load average %.2f)" % os.getloadavg()[0])
+    jobs = []
+    for n in SCENES:
+        for t in (1, 2):
+            jobs.append(((n, t), {"scene": scene_file(n), "out": "%s/img/%s-threads%d.ppm" % (WORK, n, t),
+                                  "opts": {"threads": t, "antialias": THREAD_AA}}))
+    T = timed(jobs)
     rows = []
     for n in SCENES:
-        out = "%s/img/%s-threads.ppm" % (WORK, n)
-        a = b = None
-        for _ in range(REPS):
-            x = render(scene_file(n), out, {"threads": 1, "antialias": THREAD_AA})
-            y = render(scene_file(n), out, {"threads": 2, "antialias": THREAD_AA})
-            a = x if a is None or x["render"] < a["render"] else a
-            b = y if b is None or y["render"] < b["render"] else b
+        a, b = T[(n, 1)], T[(n, 2)]
         rows.append({"scene": n, "aa": THREAD_AA, "t1": a["render"], "t2": b["render"],
-                     "others1": a["others"], "others2": b["others"]})
-        log("  %-9s 1 thread %7.3f s, 2 threads %7.3f s: %.2f times (other work: %.2f, %.2f cores)" %
-            (n, a["render"], b["render"], a["render"] / b["render"], a["others"], b["others"]))
+                     "others1": a["others"], "others2": b["others"], "same": same_bytes(
+                         "%s/img/%s-threads1.ppm" % (WORK, n), "%s/img/%s-threads2.ppm" % (WORK, n))})
+        log("  %-9s 1 thread %7.3f s, 2 threads %7.3f s: %.2f times (other work: %.2f, %.2f cores), same image: %s" %
+            (n, a["render"], b["render"], a["render"] / b["render"], a["others"], b["others"], rows[-1]["same"]))
     return rows
 
 
@@ -360,8 +404,12 @@ def machine():
                              text=True).stdout.splitlines()[0]
     except (OSError, IndexError):
         cxx = "?"
+    git = subprocess.run(["git", "log", "-1", "--format=%h", "--", "pray.cpp", "pray.hpp"], capture_output=True,
+                         text=True).stdout.strip() or "?"
+    if subprocess.run(["git", "diff", "--quiet", "--", "pray.cpp", "pray.hpp"]).returncode != 0:
+        git += " with uncommitted changes"
     return {"cpu": cpu, "cores": os.cpu_count(), "load": os.getloadavg()[0], "pray": ver, "cxx": cxx,
-            "date": time.strftime("%Y-%m-%d")}
+            "date": time.strftime("%Y-%m-%d %H:%M"), "source": git}
 
 
 # ---- tables ----
@@ -371,7 +419,11 @@ def fmt_db(p):
 
 
 def fmt_pct(w):
-    return "0" if w == 0 else ("%.2f" % (100 * w) if w < 0.1 else "%.1f" % (100 * w))
+    if w == 0:
+        return "0"
+    if w < 0.0001:
+        return "< 0.01"
+    return "%.2f" % (100 * w) if w < 0.1 else "%.1f" % (100 * w)
 
 
 def table(head, rows):
@@ -388,8 +440,9 @@ def geomean(xs):
 def tables(R):
     T = []
     m = R["machine"]
-    T.append("Machine: %s, %d cores, load %.2f at the start; %s; %s; %s; %d x %d, best of %d runs, one thread."
-             % (m["cpu"], m["cores"], m["load"], m["cxx"], m["pray"], m["date"], R["size"], R["size"], R["reps"]))
+    T.append("Machine: %s, %d cores, load %.2f at the start; %s; %s, pray.cpp of %s; %s; %d x %d, best of %d runs, "
+             "one thread." % (m["cpu"], m["cores"], m["load"], m["cxx"], m["pray"], m.get("source", "?"), m["date"],
+                              R["size"], R["size"], R["reps"]))
     d = R["default_adaptive"]
     for aa in sorted(set(r["aa"] for r in R["adaptive"])):
         rows = []
@@ -418,22 +471,35 @@ def tables(R):
             tf += full["time"]
             ta += ad["time"]
             sp.append(full["time"] / ad["time"])
-            ok = full["time"] / ad["time"] >= 2 and ad["psnr"] >= 40
+            fast, good = full["time"] / ad["time"] >= 2, ad["psnr"] >= 40
+            ok = "yes" if fast and good else "no (speed)" if good else "no (PSNR)" if fast else "no"
             rows.append([n, aa, "%.3f" % full["time"], "%.3f" % ad["time"], "%.2f" % (full["time"] / ad["time"]),
-                         fmt_db(full["psnr"]), fmt_db(ad["psnr"]), fmt_db(ad["psnr_full"]), "yes" if ok else "no"])
+                         fmt_db(full["psnr"]), fmt_db(ad["psnr"]), fmt_db(ad["psnr_full"]), ok])
         if sp:
             rows.append(["**all (sum of times)**", aa, "%.3f" % tf, "%.3f" % ta, "%.2f" % (tf / ta), "", "", "", ""])
             rows.append(["**geometric mean**", aa, "", "", "%.2f" % geomean(sp), "", "", "", ""])
     T.append("### The target: adaptive %g against full sampling\n\n" % d + table(
-        ["scene", "antialias", "full (s)", "adaptive (s)", "speed-up", "PSNR full (dB)", "PSNR adaptive (dB)",
-         "PSNR adaptive vs full (dB)", ">= 2x and >= 40 dB"], rows))
+        ["scene", "antialias", "full (s)", "adaptive %g (s)" % d, "speed-up", "PSNR full (dB)", "PSNR adaptive (dB)",
+         "PSNR adaptive vs full (dB)", "≥ 2× and ≥ 40 dB"], rows))
+    # at equal quality: the fastest full sampling and the fastest undersampling reaching 40 dB
     rows = []
     for n in R["scenes"]:
-        rs = [r for r in R["antialias"] if r["scene"] == n]
-        for r in rs:
-            rows.append([n if r is rs[0] else "", "%d" % r["aa"], "%.3f" % r["time"], "%.1f" % (r["time"] / rs[0]["time"]),
-                         fmt_db(r["psnr"]), fmt_pct(r["wrong"])])
-    T.append("### Antialias\n\n" + table(["scene", "antialias", "time (s)", "time / antialias 1", "PSNR (dB)", "wrong (%)"], rows))
+        full = [r for r in R["antialias"] if r["scene"] == n and r["psnr"] >= 40]
+        ad = [r for r in R["adaptive"] if r["scene"] == n and r["threshold"] > 0 and r["psnr"] >= 40]
+        f = min(full, key=lambda r: r["time"]) if full else None
+        a = min(ad, key=lambda r: r["time"]) if ad else None
+        rows.append([n, "antialias %d: %.3f s" % (f["aa"], f["time"]) if f else "—",
+                     "antialias %d, adaptive %g: %.3f s" % (a["aa"], a["threshold"], a["time"]) if a else "—",
+                     "%.2f" % (f["time"] / a["time"]) if f and a else "—"])
+    T.append("### At equal quality: the fastest setting of at least 40 dB\n\n" + table(
+        ["scene", "full sampling", "undersampling", "speed-up"], rows))
+    rows = []
+    levels = sorted(set(r["aa"] for r in R["antialias"]))
+    for n in R["scenes"]:
+        rs = dict((r["aa"], r) for r in R["antialias"] if r["scene"] == n)
+        rows.append([n] + ["%.3f s, %s dB, %s %%" % (rs[a]["time"], fmt_db(rs[a]["psnr"]), fmt_pct(rs[a]["wrong"]))
+                           for a in levels])
+    T.append("### Antialias (time, PSNR, wrong pixels)\n\n" + table(["scene"] + [str(a) for a in levels], rows))
     grids = []
     for r in R["grid"]:
         if r["grid"] not in grids:
@@ -445,31 +511,33 @@ def tables(R):
         row = [n]
         for g in grids:
             row.append("%.3f" % (rs[g]["prep"] + rs[g]["time"]) + ("" if rs[g]["same"] else " **differs**"))
-        row.append(rs[-1]["layout"])
+        row.append(rs[-1]["layout"].replace("x", " × "))
         rows.append(row)
     T.append("### Grid resolution: pre-processing + render (s)\n\n" + table(
         ["scene"] + [grid_label(g) for g in grids] + ["automatic grid"], rows))
     rows = []
     for r in R["precision"]:
-        rows.append([r["scene"], r["aa"], "%.3f" % r["time_double"], "%.3f" % r["time_float"],
+        rows.append([r["scene"], "%.3f" % r["time_double"], "%.3f" % r["time_float"],
                      "%.2f" % (r["time_double"] / r["time_float"]), fmt_db(r["psnr_double"]), fmt_db(r["psnr_float"]),
-                     fmt_pct(r["wrong_double"]), fmt_pct(r["wrong_float"]), fmt_db(r["psnr_fd"]), fmt_pct(r["wrong_fd"])])
-    T.append("### float against double\n\n" + table(
-        ["scene", "antialias", "double (s)", "float (s)", "double / float", "PSNR double (dB)", "PSNR float (dB)",
-         "wrong double (%)", "wrong float (%)", "PSNR float vs double (dB)", "wrong float vs double (%)"], rows))
+                     fmt_db(r["psnr_fd"]), fmt_pct(r["wrong_fd"])])
+    T.append("### float against double (antialias 1)\n\n" + table(
+        ["scene", "double (s)", "float (s)", "double / float", "PSNR double (dB)", "PSNR float (dB)",
+         "PSNR float vs double (dB)", "wrong float vs double (%)"], rows))
     rows = []
     s1 = s2 = 0.0
     for r in R["threads"]:
         s1 += r["t1"]
         s2 += r["t2"]
         rows.append([r["scene"], "%.3f" % r["t1"], "%.3f" % r["t2"], "%.2f" % (r["t1"] / r["t2"]),
-                     "%.2f" % r.get("others1", 0), "%.2f" % r.get("others2", 0)])
+                     "%.2f" % r.get("others1", 0), "%.2f" % r.get("others2", 0),
+                     {True: "yes", False: "**no**"}.get(r.get("same"), "?")])
     if R["threads"]:
-        rows.append(["**all (sum of times)**", "%.3f" % s1, "%.3f" % s2, "%.2f" % (s1 / s2), "", ""])
-        rows.append(["**geometric mean**", "", "", "%.2f" % geomean([r["t1"] / r["t2"] for r in R["threads"]]), "", ""])
+        rows.append(["**all (sum of times)**", "%.3f" % s1, "%.3f" % s2, "%.2f" % (s1 / s2), "", "", ""])
+        rows.append(["**geometric mean**", "", "", "%.2f" % geomean([r["t1"] / r["t2"] for r in R["threads"]]),
+                     "", "", ""])
         T.append("### Threads (antialias %d)\n\n" % R["threads"][0]["aa"] + table(
             ["scene", "1 thread (s)", "2 threads (s)", "speed-up", "other work, 1 thread (cores)",
-             "other work, 2 threads (cores)"], rows))
+             "other work, 2 threads (cores)", "same image"], rows))
     rows = []
     for n in TABLE_SCENES:
         rs = [r for r in R["table361"] if r["scene"] == n]
