@@ -1965,18 +1965,24 @@ struct Scratch {
     int root_fixed;                 // the root's status cannot change any more on this ray
 };
 
+// What threads write all the time stays off the cache lines of other threads' data: every
+// per-thread block gets this much slack behind it.
+const size_t LINE_SLACK = 128;
+
+void *thread_alloc(pray_ctx *c, size_t n) { return mem_zalloc(c, n + LINE_SLACK); }
+
 bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     memset(w, 0, sizeof *w);
     size_t np = (size_t)s->prims.n + 1, nn = (size_t)s->nodes.n + 1;
-    w->cross = (Cross *)mem_alloc(c, sizeof(Cross) * 2 * np);
-    w->pstat = (unsigned char *)mem_zalloc(c, np);
-    w->nstat = (unsigned char *)mem_zalloc(c, nn);
-    w->nfirst = (unsigned char *)mem_zalloc(c, nn);
-    w->cnt = (int *)mem_zalloc(c, sizeof(int) * nn);
-    w->span = (Span *)mem_zalloc(c, sizeof(Span) * np);
-    w->nfrozen = (unsigned *)mem_zalloc(c, sizeof(unsigned) * nn);
-    w->nfixed = (unsigned *)mem_zalloc(c, sizeof(unsigned) * nn);
-    w->nfixval = (unsigned char *)mem_zalloc(c, nn);
+    w->cross = (Cross *)thread_alloc(c, sizeof(Cross) * 2 * np);
+    w->pstat = (unsigned char *)thread_alloc(c, np);
+    w->nstat = (unsigned char *)thread_alloc(c, nn);
+    w->nfirst = (unsigned char *)thread_alloc(c, nn);
+    w->cnt = (int *)thread_alloc(c, sizeof(int) * nn);
+    w->span = (Span *)thread_alloc(c, sizeof(Span) * np);
+    w->nfrozen = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
+    w->nfixed = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
+    w->nfixval = (unsigned char *)thread_alloc(c, nn);
     return w->cross && w->pstat && w->nstat && w->nfirst && w->cnt && w->span && w->nfrozen && w->nfixed && w->nfixval;
 }
 
@@ -4170,6 +4176,8 @@ void worker_main(void *arg) {
     }
 }
 
+Worker &worker_at(char *buf, size_t stride, int i) { return *(Worker *)(buf + LINE_SLACK + (size_t)i * stride); }
+
 pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
     int nt = opt_int(c, OPT_THREADS);
     if (nt <= 0) nt = cpu_count();
@@ -4186,13 +4194,15 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
     if (nt > job.bands) nt = job.bands;
     // everything a thread needs is allocated here, before any starts: the context's allocator
     // is used by one thread only
-    Worker *ws = (Worker *)mem_zalloc(c, sizeof(Worker) * (size_t)nt);
+    // one Worker per thread, each on cache lines of its own (its counters change with every ray)
+    const size_t stride = (sizeof(Worker) + LINE_SLACK - 1) / LINE_SLACK * LINE_SLACK + LINE_SLACK;
+    char *wbuf = (char *)mem_zalloc(c, stride * (size_t)nt + LINE_SLACK);
     void **args = (void **)mem_zalloc(c, sizeof(void *) * (size_t)nt);
     void *starts = mem_zalloc(c, 64 * sizeof(void *) * 2);
-    pray_status st = ws && args && starts ? PRAY_OK : c->status;
+    pray_status st = wbuf && args && starts ? PRAY_OK : c->status;
     int made = 0;
     for (; st == PRAY_OK && made < nt; made++) {
-        Worker &k = ws[made];
+        Worker &k = worker_at(wbuf, stride, made);
         k.job = &job;
         k.cache.init();
         if (!scratch_init(c, &k.w, s)) st = c->status;
@@ -4207,8 +4217,8 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
         job.mu.destroy();
         if (job.cancelled) st = fail(c, PRAY_ERR_LIMIT, "render cancelled");
     }
-    for (int i = 0; ws && i < made; i++) {
-        const Counters &k = ws[i].w.k;
+    for (int i = 0; wbuf && i < made; i++) {
+        const Counters &k = worker_at(wbuf, stride, i).w.k;
         c->stats.rays_primary += k.rays[RAY_PRIMARY];
         c->stats.rays_shadow += k.rays[RAY_SHADOW];
         c->stats.rays_reflected += k.rays[RAY_REFLECT];
@@ -4220,12 +4230,12 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
         c->stats.set_outside += k.set_out;
         c->stats.checks += k.checks;
         c->stats.frozen_skips += k.frozen;
-        scratch_release(c, &ws[i].w);
-        ws[i].cache.release(c);
+        scratch_release(c, &worker_at(wbuf, stride, i).w);
+        worker_at(wbuf, stride, i).cache.release(c);
     }
     c->stats.rays_primary_full += (double)s->width * s->height * s->antialias * s->antialias;
     c->stats.threads = nt;
-    mem_free(c, ws);
+    mem_free(c, wbuf);
     mem_free(c, args);
     mem_free(c, starts);
     return st;
