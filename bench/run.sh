@@ -30,7 +30,7 @@ stat() {
 
 run() {  # run FILE LABEL OPTIONS...: render and keep the --stats report
   f=$1; label=$2; shift 2
-  $PRAY --quiet --stats -s $SIZE -o "$OUT/$label.ppm" "$@" "$f" > /dev/null 2> "$OUT/$label.txt"
+  $PRAY --quiet --stats --threads 1 -s $SIZE -o "$OUT/$label.ppm" "$@" "$f" > /dev/null 2> "$OUT/$label.txt"
 }
 
 echo "Table 3.6.1 rebuilt: $SIZE, one thread, times in seconds ($(uname -m), $(nproc) cores)"
@@ -69,11 +69,11 @@ n=16
 : > "$OUT/fit.txt"
 while [ $n -le $max ]; do
   { echo "N = $n"; cat bench/spheres.ray; } > "$OUT/s.ray"
-  /usr/bin/time -f '%M' -o "$OUT/mem" $PRAY --quiet --stats -s $SIZE -o "$OUT/s.ppm" "$OUT/s.ray" > /dev/null 2> "$OUT/g.txt"
+  /usr/bin/time -f '%M' -o "$OUT/mem" $PRAY --quiet --stats --threads 1 -s $SIZE -o "$OUT/s.ppm" "$OUT/s.ray" > /dev/null 2> "$OUT/g.txt"
   gt=$(stat render $OUT/g.txt)
   peak=$(awk '{printf "%.1f", $1 / 1024}' "$OUT/mem")
   if [ $n -le 4096 ] && [ -z "$QUICK" -o $n -le 1024 ]; then
-    /usr/bin/time -f '%M' -o "$OUT/bmem" $PRAY --quiet --stats --brute -s $SIZE -o "$OUT/b.ppm" "$OUT/s.ray" > /dev/null 2> "$OUT/b.txt"
+    /usr/bin/time -f '%M' -o "$OUT/bmem" $PRAY --quiet --stats --threads 1 --brute -s $SIZE -o "$OUT/b.ppm" "$OUT/s.ray" > /dev/null 2> "$OUT/b.txt"
     bt=$(stat render $OUT/b.txt); bm=$(awk '{printf "%.1f", $1 / 1024}' "$OUT/bmem")
     cmp -s "$OUT/s.ppm" "$OUT/b.ppm" || echo "warning: N=$n grid and brute images differ"
   else bt=-; bm=-; fi
