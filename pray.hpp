@@ -353,7 +353,8 @@ pray_status pray_render_file(const char *program, const char *const *options, in
    areas), and bounding boxes prune what cannot be met. Options grid, freeze, merge and bounds
    switch the parts on and off; every setting gives the image of brute=1, byte for byte.
    docs/acceleration.md explains the methods, docs/benchmarks.md measures them.
-   Secondary rays know the primitive they start on and never meet it again at their origin.
+   Secondary rays know the primitive they start on and never meet it again at their origin;
+   nor any primitive of exactly the same surface (faces shared by parts, snapped to be equal).
 
    7. The language
    docs/pray-language.md is the full manual; pray-language.md of the specification fixes it.
