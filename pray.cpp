@@ -1226,7 +1226,7 @@ struct Prim {
     R3 mu, mv;
     int mirrored;       // longitudes of a spheremap run the other way
     int id;             // position among the declared primitives, left to right
-    int surf;           // the first primitive of the scene with exactly this surface (twins)
+    int surf;           // the same number for primitives snapped to exactly one surface (twins)
     int parent;         // node index, -1 for the root
     unsigned char first;  // first child of a difference
     unsigned char settles;  // 1: being outside for good decides the parent, 2: inside (3.5)
@@ -1676,6 +1676,7 @@ bool same_key(const SnapKey &a, const SnapKey &b) {
 // that became equal are neighbours, and the parameters of each group are snapped to its first.
 pray_status snap_coincident(pray_ctx *c, Scene *s) {
     int n = s->prims.n;
+    if (n == 1) s->prims[0].surf = 0;
     if (n < 2) return PRAY_OK;
     SnapKey *k = (SnapKey *)mem_alloc(c, sizeof(SnapKey) * (size_t)n);
     SnapComp *o = (SnapComp *)mem_alloc(c, sizeof(SnapComp) * (size_t)n);
@@ -1691,6 +1692,7 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
         k[i].prim = i;
         snap_key(s->prims[i], &k[i]);
         scale[i] = prim_scale(s->prims[i]);
+        s->prims[i].surf = i;
     }
     for (int comp = 1; comp < 8; comp++) {
         for (int i = 0; i < n; i++) {
@@ -1720,6 +1722,7 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
             Prim &b = s->prims[k[j].prim];
             if (!snap_close(a, b, k[i].sign, k[j].sign)) continue;
             int f = k[i].sign * k[j].sign;  // +1 same orientation, -1 opposite
+            b.surf = a.surf;                // twins from now on
             if (a.kind != O_PLANE) b.p = a.p;  // a plane's point is its texture origin only
             b.r = a.r;
             b.r2 = a.r2;
@@ -1731,27 +1734,6 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
     mem_free(c, k);
     mem_free(c, o);
     mem_free(c, scale);
-    return PRAY_OK;
-}
-
-// Twins: primitives with exactly the same surface (after snapping), whatever their orientation.
-// A secondary ray that starts on one starts on all of them.
-pray_status mark_twins(pray_ctx *c, Scene *s) {
-    int n = s->prims.n;
-    if (n == 0) return PRAY_OK;
-    SnapKey *k = (SnapKey *)mem_alloc(c, sizeof(SnapKey) * (size_t)n);
-    if (!k) return c->status;
-    for (int i = 0; i < n; i++) {
-        k[i].prim = i;
-        snap_key(s->prims[i], &k[i]);
-    }
-    qsort(k, (size_t)n, sizeof(SnapKey), snap_cmp);
-    for (int i = 0; i < n;) {
-        int j = i;
-        for (; j < n && same_key(k[i], k[j]); j++) s->prims[k[j].prim].surf = k[i].prim;
-        i = j;
-    }
-    mem_free(c, k);
     return PRAY_OK;
 }
 
@@ -3933,7 +3915,7 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     s->root = flatten(c, s, root);
     // snapped before compaction, over every primitive flattened, so that the reference and the
     // simplified scene give the same surviving primitives the same numbers
-    if (s->root == -3 || snap_coincident(c, s) || scene_compact(c, s) || mark_twins(c, s)) return c->status;
+    if (s->root == -3 || snap_coincident(c, s) || scene_compact(c, s)) return c->status;
     c->stats.primitives_declared = root->nprims;
     if (!opt_int(c, OPT_BRUTE) && accel_build(c, s)) return c->status;
     for (int i = 0; lights && i < lights->n; i++) {
@@ -6507,27 +6489,25 @@ pray_status bi_spheremap(Interp &I, const Expr *call, Value *a, Value *out) {
 pray_texture *program_texture(Interp &I, const Expr *call, const Value &name) {
     pray_ctx *c = I.c;
     const char *path = ((const Str *)name.ref)->s;
+    char beside[1100];
+    snprintf(beside, sizeof beside, "%s%s", c->run_dir, path);
+    const char *use = path;
     if (c->untrusted) {
         const char *why = untrusted_path_problem(path);
-        char full[1100];
-        snprintf(full, sizeof full, "%s%s", c->run_dir, path);
-        if (!why && file_exists(full) && !inside_dir(c->run_dir, full))
+        if (!why && file_exists(beside) && !inside_dir(c->run_dir, beside))
             why = "a link that leads out of the program's directory";
         if (why) {
             rerr(I, call, PRAY_ERR_RUNTIME, "untrusted program: '%s' is %s; files are read from the program's "
                  "directory only", *Shown(path), why);
             return NULL;
         }
-        pray_texture *t = pray_texture_file(c, full);
-        if (!t && api_err(I, call->line, call->col) == PRAY_ERR_IO) c->status = PRAY_ERR_RUNTIME;
-        return t;
+        use = beside;
+    } else {
+        // as written, else beside the program; when neither opens, the message names it as written
+        bool relative = path[0] && path[0] != '/' && path[0] != '\\' && path[1] != ':';
+        if (relative && c->run_dir[0] && !file_exists(path) && file_exists(beside)) use = beside;
     }
-    // as written, else beside the program; when neither opens, the message names it as written
-    bool relative = path[0] && path[0] != '/' && path[0] != '\\' && !(path[0] && path[1] == ':');
-    char alt[1100];
-    snprintf(alt, sizeof alt, "%s%s", c->run_dir, path);
-    bool beside = relative && c->run_dir[0] && !file_exists(path) && file_exists(alt);
-    pray_texture *t = pray_texture_file(c, beside ? alt : path);
+    pray_texture *t = pray_texture_file(c, use);
     if (!t && api_err(I, call->line, call->col) == PRAY_ERR_IO) c->status = PRAY_ERR_RUNTIME;
     return t;
 }

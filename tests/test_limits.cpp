@@ -55,6 +55,20 @@ void at_and_past(const char *name, double limit, const std::string &prog, const 
 
 const char *const TINY = "option \"width\", 2\noption \"height\", 2\n";
 
+// A side x side TIFF of a sphere of radius r in a flat colour, written to each of `paths`.
+void write_sphere_tiffs(const std::vector<std::string> &paths, int side, pray_rgb colour, double r) {
+    pray_ctx *c = pray_new();
+    pray_option(c, "width", side);
+    pray_option(c, "height", side);
+    pray_object *s = pray_sphere(c, pray_color(c, colour), pray_vec{0, 0, 0}, r);
+    pray_image img;
+    REQUIRE(pray_render(c, s, NULL, &img) == PRAY_OK);
+    for (const std::string &p : paths) REQUIRE(pray_write_image(c, &img, p.c_str(), 8) == PRAY_OK);
+    pray_image_free(c, &img);
+    pray_release(c, s);
+    pray_free(c);
+}
+
 } // namespace
 
 TEST_CASE("limit maxsteps: a program of N statements runs with maxsteps N, stops at N - 1") {
@@ -182,16 +196,7 @@ TEST_CASE("limit gridmem: the grid's tables stay within the budget") {
 
 TEST_CASE("limit texmem and maxmem: a texture over the budget, a context over its memory") {
     // a 640 x 640 8-bit RGB TIFF: 1.2 MB, over texmem 1; decoded it needs less than 16 MiB
-    pray_ctx *c = pray_new();
-    pray_option(c, "width", 640);
-    pray_option(c, "height", 640);
-    pray_object *s = pray_sphere(c, pray_color(c, pray_rgb{1, 0.5, 0.25}), pray_vec{0, 0, 0}, 1);
-    pray_image img;
-    REQUIRE(pray_render(c, s, NULL, &img) == PRAY_OK);
-    REQUIRE(pray_write_image(c, &img, "limits_big.tif", 8) == PRAY_OK);
-    pray_image_free(c, &img);
-    pray_release(c, s);
-    pray_free(c);
+    write_sphere_tiffs({"limits_big.tif"}, 640, pray_rgb{1, 0.5, 0.25}, 1);
     std::string prog = std::string(TINY) + "M = color({1})\nT = tiff(M, M, \"limits_big.tif\")\n"
                                            "rendertiff planemap(T, [0, 0, 0], <1, 0, 0>, <0, 1, 0>, <0, 0, 1>)\n";
     Result r = testkit::run(prog, {"texmem=1"});
@@ -204,12 +209,13 @@ TEST_CASE("limit texmem and maxmem: a texture over the budget, a context over it
     CHECK(testkit::run(prog, {"maxmem=64", "texmem=16"}).status == PRAY_OK);
     std::remove("limits_big.tif");
     // maxmem lowers the host's cap, never raises it
-    c = pray_new();
+    pray_ctx *c = pray_new();
     pray_set_memory_limit(c, 100000);
     pray_option(c, "maxmem", 64);
     pray_option(c, "width", 256);
     pray_option(c, "height", 256);
-    s = pray_sphere(c, pray_color(c, pray_rgb{1, 1, 1}), pray_vec{0, 0, 0}, 1);
+    pray_object *s = pray_sphere(c, pray_color(c, pray_rgb{1, 1, 1}), pray_vec{0, 0, 0}, 1);
+    pray_image img;
     CHECK(pray_render(c, s, NULL, &img) == PRAY_ERR_NOMEM);
     pray_set_memory_limit(c, 0);
     REQUIRE(pray_render(c, s, NULL, &img) == PRAY_OK);
@@ -272,18 +278,7 @@ TEST_CASE("untrusted mode: files only from the program's directory") {
     std::string clean = "rm -rf " + dir;
     REQUIRE(std::system(clean.c_str()) == 0);
     REQUIRE(std::system(("mkdir -p " + dir + "/sub").c_str()) == 0);
-    pray_ctx *c = pray_new();
-    pray_option(c, "width", 4);
-    pray_option(c, "height", 4);
-    pray_object *s = pray_sphere(c, pray_color(c, pray_rgb{1, 0, 0}), pray_vec{0, 0, 0}, 9);
-    pray_image img;
-    REQUIRE(pray_render(c, s, NULL, &img) == PRAY_OK);
-    REQUIRE(pray_write_image(c, &img, (dir + "/red.tif").c_str(), 8) == PRAY_OK);
-    REQUIRE(pray_write_image(c, &img, (dir + "/sub/red.tif").c_str(), 8) == PRAY_OK);
-    REQUIRE(pray_write_image(c, &img, "limits_outside.tif", 8) == PRAY_OK);
-    pray_image_free(c, &img);
-    pray_release(c, s);
-    pray_free(c);
+    write_sphere_tiffs({dir + "/red.tif", dir + "/sub/red.tif", "limits_outside.tif"}, 4, pray_rgb{1, 0, 0}, 9);
 #ifdef HAVE_SYMLINK
     REQUIRE(symlink("../limits_outside.tif", (dir + "/link.tif").c_str()) == 0);
 #endif
