@@ -2163,7 +2163,9 @@ enum { CL_OUT = 0, CL_IN = 1, CL_BD = 2 };
 struct Accel {
     int n[3];          // voxels per axis; all 0 without a grid
     real org[3], h;    // low corner of the grid and side of a voxel
+    real inv_h;        // 1 / h
     int *voxel;        // list of each voxel, x fastest
+    unsigned char *reach;  // per voxel: how far around it every voxel has its list (see reach_build)
     Array<int> data, off;
     int outer;         // list of the space outside the grid (everything without a grid)
     int freeze, merge, bounds;
@@ -2174,6 +2176,7 @@ struct Accel {
 void accel_release(pray_ctx *c, Accel *a) {
     if (!a) return;
     mem_free(c, a->voxel);
+    mem_free(c, a->reach);
     a->data.release(c);
     a->off.release(c);
     mem_free(c, a);
@@ -2461,6 +2464,74 @@ int auto_grid(int bounded, double rays, double fill) {
     return n < 4 ? 4 : n > 1024 ? 1024 : n;
 }
 
+// Smallest and largest of each voxel's value and its two neighbours along axis `l` (fewer at the
+// grid's edge), in place.
+void window3(int *mn, int *mx, const int *n, int l) {
+    long st = l == 0 ? 1 : l == 1 ? n[0] : (long)n[0] * n[1];
+    long nv = (long)n[0] * n[1] * n[2];
+    for (long v0 = 0; v0 < nv; v0++) {
+        if (v0 / st % n[l] != 0) continue;  // the first voxel of a line along l
+        int pmn = mn[v0], pmx = mx[v0];
+        for (int i = 0; i < n[l]; i++) {
+            long v = v0 + i * st;
+            int cmn = mn[v], cmx = mx[v];
+            int nmn = i + 1 < n[l] ? mn[v + st] : cmn, nmx = i + 1 < n[l] ? mx[v + st] : cmx;
+            mn[v] = pmn < cmn ? (pmn < nmn ? pmn : nmn) : (cmn < nmn ? cmn : nmn);
+            mx[v] = pmx > cmx ? (pmx > nmx ? pmx : nmx) : (cmx > nmx ? cmx : nmx);
+            pmn = cmn;
+            pmx = cmx;
+        }
+    }
+}
+
+// Merging into areas (3.6) makes crossing an area cheap; jumps make it cheaper still. reach[v]
+// is the chessboard distance from voxel v to the nearest voxel with a neighbour of another list
+// (at most 255; the grid's edge does not count): every voxel within that distance of v has v's
+// list, so a ray in v goes on to where it leaves that cube of voxels without looking at them.
+bool reach_build(pray_ctx *c, Accel *a) {
+    const int nx = a->n[0], ny = a->n[1], nz = a->n[2];
+    const long nv = (long)nx * ny * nz;
+    const long px = nx + 2, py = ny + 2, np = px * py * (nz + 2);  // with a border of one voxel
+    a->reach = (unsigned char *)mem_alloc(c, (size_t)nv);
+    int *mn = (int *)mem_alloc(c, sizeof(int) * (size_t)nv), *mx = (int *)mem_alloc(c, sizeof(int) * (size_t)nv);
+    unsigned char *r = (unsigned char *)mem_alloc(c, (size_t)np);
+    bool ok = a->reach && mn && mx && r;
+    if (ok) {
+        // 0 where the 3 x 3 x 3 voxels around hold more than one list (a separable filter)
+        memcpy(mn, a->voxel, sizeof(int) * (size_t)nv);
+        memcpy(mx, a->voxel, sizeof(int) * (size_t)nv);
+        for (int l = 0; l < 3; l++) window3(mn, mx, a->n, l);
+        memset(r, 255, (size_t)np);  // the border: the grid's edge is no boundary
+        for (long v = 0; v < nv; v++)
+            r[((v / nx / ny + 1) * py + v / nx % ny + 1) * px + v % nx + 1] = mn[v] == mx[v] ? 255 : 0;
+        // the chessboard distance to those voxels: a raster pass forwards over the 13 neighbours
+        // visited before, then one backwards (exact for this distance)
+        long off[13];
+        int k = 0;
+        for (int dz = -1; dz <= 0; dz++)
+            for (int dy = -1; dy <= 1; dy++)
+                for (int dx = -1; dx <= 1; dx++)
+                    if (dz < 0 || dy < 0 || (dy == 0 && dx < 0)) off[k++] = (dz * py + dy) * px + dx;
+        for (int pass = 0; pass < 2; pass++)
+            for (int z = 1; z <= nz; z++)
+                for (int y = 1; y <= ny; y++)
+                    for (int x = 1; x <= nx; x++) {
+                        long q = pass == 0 ? ((long)z * py + y) * px + x : ((long)(nz + 1 - z) * py + (ny + 1 - y)) * px + (nx + 1 - x);
+                        int d = r[q];
+                        for (int i = 0; i < 13; i++) {
+                            int e = r[pass == 0 ? q + off[i] : q - off[i]] + 1;
+                            d = e < d ? e : d;
+                        }
+                        r[q] = (unsigned char)d;
+                    }
+        for (long v = 0; v < nv; v++) a->reach[v] = r[((v / nx / ny + 1) * py + v / nx % ny + 1) * px + v % nx + 1];
+    }
+    mem_free(c, mn);
+    mem_free(c, mx);
+    mem_free(c, r);
+    return ok;
+}
+
 // Build the acceleration structure: the lists of the grid's voxels and of the space around it.
 pray_status accel_build(pray_ctx *c, Scene *s) {
     Accel *a = (Accel *)mem_zalloc(c, sizeof(Accel));
@@ -2563,6 +2634,7 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
     long nv = 0;
     while (want > 0 && st == PRAY_OK) {
         a->h = (real)(ext / want);
+        a->inv_h = (real)1 / a->h;
         margin = (double)a->h * 1e-6 + 64 * eps * (mag + ext) * (want + 4);
         // far from the origin in low precision the voxels would be smaller than the rounding of
         // the positions: then no grid
@@ -2590,7 +2662,7 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
             }
             refs += cnt;
         }
-        if (vox <= 268435456.0 && refs <= 64.0 * 1048576 && (2 * vox + refs) * sizeof(int) <= budget) {
+        if (vox <= 268435456.0 && refs <= 64.0 * 1048576 && (2 * vox + refs) * sizeof(int) + vox <= budget) {
             nv = (long)vox;
             break;
         }
@@ -2658,6 +2730,7 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
                     if (L < 0) st = c->status;
                     else a->voxel[v] = L;
                 }
+        if (st == PRAY_OK && !reach_build(c, a)) st = c->status;
         // areas: connected voxels with the same list (for the statistics)
         if (st == PRAY_OK) {
             Array<int> q;
@@ -2713,7 +2786,7 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
     mem_free(c, eff);
     lb_release(b);
     nv = (long)a->n[0] * a->n[1] * a->n[2];
-    a->memory = (double)sizeof(Accel) + (double)nv * sizeof(int) + (double)a->data.cap * sizeof(int) +
+    a->memory = (double)sizeof(Accel) + (double)nv * (sizeof(int) + 1) + (double)a->data.cap * sizeof(int) +
                 (double)a->off.cap * sizeof(int);
     c->stats.grid[0] = a->n[0];
     c->stats.grid[1] = a->n[1];
@@ -2811,6 +2884,36 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
     const int *nodes = d + 4, *prims = d + 4 + 3 * na;
     w->k.set_in += d[2];
     w->k.set_out += d[3];
+    if (na == 1 && nodes[1] == 0 && 2 * nodes[0] + 1 == s->root && s->nodes[nodes[0]].op == O_UNION) {
+        // Only primitives of the root union, none inside for the whole region (the common list
+        // of a scene of many objects): while the ray is outside them all, the first visible
+        // surface is the nearest entry. Anything less plain (a primitive inside at a, entries
+        // at the same t, a grazing touch) is left to the full evaluation.
+        int first = -1;
+        real tf = 0;
+        bool plain = true;
+        for (int i = 0; i < np && plain; i++) {
+            int p = prims[i];
+            const Span &sp = span_get(s, w, ray, p, self);
+            if (sp.kind == SPAN_NONE || (sp.kind == SPAN && sp.t1 <= a)) continue;
+            plain = sp.kind == SPAN && sp.t0 > a && s->prims[p].parent == nodes[0];
+            if (!plain || sp.t0 > b || !(sp.t0 < tmax) || (first >= 0 && sp.t0 > tf)) continue;
+            plain = sp.t1 > sp.t0 && !(first >= 0 && sp.t0 == tf);
+            first = p;
+            tf = sp.t0;
+        }
+        if (plain) {
+            w->k.checks += np;
+            if (first < 0) return false;
+            Hit h;
+            h.t = tf;
+            h.prim = first;
+            h.prim_enter = 1;
+            h.root_enter = 1;
+            if (!visit(h)) return true;
+            a = tf;  // the visitor goes on through the solid: the rest in full
+        }
+    }
     for (int i = na - 1; i >= 0; i--) {  // parents first: pass freezing down
         int j = nodes[3 * i];
         w->cnt[j] = nodes[3 * i + 1];
@@ -2890,23 +2993,20 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
     return false;
 }
 
-// Where the ray meets the box: [*t0, *t1]; false when it misses.
-bool ray_box(const Ray &r, const real *lo, const real *hi, real *t0, real *t1) {
+// Where the ray meets the box: [*t0, *t1]; false when it misses. `inv` holds the reciprocals
+// of the direction's components, 0 for a ray parallel to that axis.
+bool ray_box(const Ray &r, const real *inv, const real *lo, const real *hi, real *t0, real *t1) {
     real a = -REAL_INF, b = REAL_INF;
     for (int l = 0; l < 3; l++) {
-        real o = comp(r.o, l), dd = comp(r.d, l);
-        if (dd == 0) {
+        real o = comp(r.o, l);
+        if (inv[l] == 0) {
             if (o < lo[l] || o > hi[l]) return false;
             continue;
         }
-        real u = (lo[l] - o) / dd, v = (hi[l] - o) / dd;
-        if (u > v) {
-            real x = u;
-            u = v;
-            v = x;
-        }
-        if (u > a) a = u;
-        if (v < b) b = v;
+        real u = (lo[l] - o) * inv[l], v = (hi[l] - o) * inv[l];
+        real n = u < v ? u : v, f = u < v ? v : u;
+        a = n > a ? n : a;
+        b = f < b ? f : b;
     }
     *t0 = a;
     *t1 = b;
@@ -2926,6 +3026,11 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
         w->ray = 1;
     }
     w->root_fixed = 0;
+    real inv[3];
+    for (int l = 0; l < 3; l++) {  // 0: parallel to the axis, or so nearly that 1 / d overflows
+        real q = comp(ray.d, l) != 0 ? (real)1 / comp(ray.d, l) : 0;
+        inv[l] = q - q == 0 ? q : 0;
+    }
     if (A->bounds && A->n[0] == 0) {
         // without a grid, a bounded node whose box the ray misses is outside for the whole ray
         for (int j = s->nodes.n - 1; j >= 0; j--) {
@@ -2936,7 +3041,7 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
             }
             if (w->nfixed[j] == w->ray || !box_finite(nd.box)) continue;
             real t0, t1;
-            if (ray_box(ray, nd.box.lo, nd.box.hi, &t0, &t1) && t1 > 0 && t0 < tmax) continue;
+            if (ray_box(ray, inv, nd.box.lo, nd.box.hi, &t0, &t1) && t1 > 0 && t0 < tmax) continue;
             w->nfixed[j] = w->ray;
             w->nfixval[j] = 0;
             if (A->freeze) settle(s, w, 2 * j + 1, false);
@@ -2952,7 +3057,7 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
         hi[l] = (real)((double)A->org[l] + A->n[l] * (double)A->h);
     }
     real tin, tout;
-    if (!ray_box(ray, lo, hi, &tin, &tout) || tout <= 0 || tin >= tmax) {
+    if (!ray_box(ray, inv, lo, hi, &tin, &tout) || tout <= 0 || tin >= tmax) {
         eval_list(s, A, w, ray, A->outer, 0, tmax, tmax, self, visit);
         return;
     }
@@ -2965,28 +3070,19 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
     // step is two comparisons and one addition.
     R3 p = ray.o + ray.d * t;
     int ix[3], step[3];
-    real next[3], delta[3];
+    real next[3], delta[3], slope[3];  // slope: voxels per unit of t along each axis
     for (int l = 0; l < 3; l++) {
-        real dd = comp(ray.d, l);
-        double g = floor((double)((comp(p, l) - A->org[l]) / A->h));  // clamped before the cast
+        real dd = inv[l] == 0 ? 0 : comp(ray.d, l);
+        double g = floor((double)((comp(p, l) - A->org[l]) * A->inv_h));  // clamped before the cast
         ix[l] = !(g > 0) ? 0 : g >= A->n[l] ? A->n[l] - 1 : (int)g;
-        if (dd > 0) {
-            step[l] = 1;
-            next[l] = (A->org[l] + (real)(ix[l] + 1) * A->h - comp(ray.o, l)) / dd;
-            delta[l] = A->h / dd;
-        } else if (dd < 0) {
-            step[l] = -1;
-            next[l] = (A->org[l] + (real)ix[l] * A->h - comp(ray.o, l)) / dd;
-            delta[l] = -A->h / dd;
-        } else {
-            step[l] = 0;
-            next[l] = REAL_INF;
-            delta[l] = 0;
-        }
+        step[l] = dd > 0 ? 1 : dd < 0 ? -1 : 0;
+        next[l] = dd == 0 ? REAL_INF : (A->org[l] + (real)(ix[l] + (dd > 0)) * A->h - comp(ray.o, l)) * inv[l];
+        delta[l] = A->h * (inv[l] < 0 ? -inv[l] : inv[l]);
+        slope[l] = (dd < 0 ? -dd : dd) * A->inv_h;
     }
     int run = -1;  // the list of the area being crossed
     real run_a = t;
-    const int *cell = A->voxel + ((long)ix[2] * A->n[1] + ix[1]) * A->n[0] + ix[0];
+    long at = ((long)ix[2] * A->n[1] + ix[1]) * A->n[0] + ix[0];  // the voxel the ray is in
     long stride[3];  // a step along each axis, in cells
     stride[0] = step[0];
     stride[1] = (long)step[1] * A->n[0];
@@ -2995,40 +3091,69 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
     long steps = 0, moves = 0;  // counted here, added to the counters once per ray
     bool stopped = false;
     for (;;) {
-        int L = *cell;
-        // the axis of the nearest boundary, ties to the later axis; without branches, as the
-        // choice is a coin toss for the branch predictor
-        // the axis of the nearest boundary, ties to the later axis (selects, not branches: the
-        // choice is a coin toss for a branch predictor)
-        int ax = 0;
-        real near = next[0];
-        if (next[1] <= near) ax = 1, near = next[1];
-        if (next[2] <= near) ax = 2, near = next[2];
-        real exit = near < tend ? near : tend;
+        int L = A->voxel[at];
         steps++;
         if (L == run && merge) {
             moves++;  // same list: a move, no evaluation
         } else {
-            if (run >= 0 && eval_list(s, A, w, ray, run, run_a, t, tmax, self, visit)) {
+            if (run > 0 && eval_list(s, A, w, ray, run, run_a, t, tmax, self, visit)) {
                 stopped = true;
                 break;
             }
             run = L;
             run_a = t;
         }
+        int r = merge ? A->reach[at] : 0;
+        int ax = 0;
+        if (r < 2) {
+            // the axis of the nearest boundary, ties to the later axis (selects, not branches:
+            // the choice is a coin toss for a branch predictor)
+            real near = next[0];
+            if (next[1] <= near) ax = 1, near = next[1];
+            if (next[2] <= near) ax = 2, near = next[2];
+            real exit = near < tend ? near : tend;
+            t = exit > t ? exit : t;
+            if (exit >= tend) break;
+            ix[ax] += step[ax];
+            if (ix[ax] < 0 || ix[ax] >= A->n[ax]) break;
+            at += stride[ax];
+            next[ax] += delta[ax];
+            continue;
+        }
+        // a jump: every voxel within r of this one has its list; go to where the ray leaves
+        // that cube, m[l] voxels further along axis l at most
+        int m[3];
+        real e[3];
+        for (int l = 0; l < 3; l++) {
+            int room = step[l] > 0 ? A->n[l] - 1 - ix[l] : ix[l];
+            m[l] = room < r ? room : r;
+            e[l] = next[l] + (real)m[l] * delta[l];  // no step along l: infinite
+        }
+        real near = e[0];
+        if (e[1] <= near) ax = 1, near = e[1];
+        if (e[2] <= near) ax = 2, near = e[2];
+        real exit = near < tend ? near : tend;
         t = exit > t ? exit : t;
         if (exit >= tend) break;
-        ix[ax] += step[ax];
+        // across the boundary of axis ax; along the others, across the boundaries before it
+        for (int l = 0; l < 3; l++) {
+            int k = m[l] + 1;
+            if (l != ax) {
+                real f = (near - next[l]) * slope[l];
+                k = step[l] == 0 || !(f >= 0) ? 0 : f < (real)m[l] ? (int)f + 1 : m[l];
+            }
+            ix[l] += step[l] * k;
+            next[l] += (real)k * delta[l];
+        }
         if (ix[ax] < 0 || ix[ax] >= A->n[ax]) break;
-        cell += stride[ax];
-        next[ax] += delta[ax];
+        at = ((long)ix[2] * A->n[1] + ix[1]) * A->n[0] + ix[0];
     }
     w->k.steps += (double)steps;
     w->k.moves += (double)moves;
     if (stopped) return;
     // the last stretch ends where the ray leaves the grid's box, whatever rounding the stepping
     // gathered, so that it meets the stretch after the grid without a gap
-    if (run >= 0 && eval_list(s, A, w, ray, run, run_a, tend, tmax, self, visit)) return;
+    if (run > 0 && eval_list(s, A, w, ray, run, run_a, tend, tmax, self, visit)) return;
     if (tend < tmax) eval_list(s, A, w, ray, A->outer, tend, tmax, tmax, self, visit);
 }
 
