@@ -2002,3 +2002,83 @@ TEST_CASE("textures: on the command line a missing texture exits with 1 and writ
     CHECK_MESSAGE(rc == 0, out);
     CHECK(d.listing() == "missing-wood.tif tex.ray x.tif");
 }
+
+TEST_CASE("undersampling keeps texture detail that falls between its samples") {
+    // A white texture with one black row of texels, one texel to a pixel, seen head-on by a
+    // parallel camera: the row lands on image row 21, between the rows of the coarse lattice
+    // (every 4th pixel; every 2nd with antialiasing), where all lattice samples are white.
+    TempDir d;
+    REQUIRE(!d.path.empty());
+    std::vector<float> px(64 * 64 * 3, 1.0f);
+    for (int x = 0; x < 64; x++)
+        for (int k = 0; k < 3; k++) px[(10 * 64 + x) * 3 + k] = 0;
+    pray_image tex;
+    tex.width = tex.height = 64;
+    tex.pixels = px.data();
+    {
+        Ctx c;
+        REQUIRE(pray_write_image(c, &tex, (d / "line.tif").c_str(), 8) == PRAY_OK);
+    }
+    std::string prog = "parallel <1, 0, 0>, <0, 0, -1>, [0, -4, 0], [0, 0, 0]\n"
+                       "M = tiff(color({0}), color({1}), \"" + (d / "line.tif") + "\")\n"
+                       "rendertiff planemap(M, [0, 0, 0], <0, -1, 0>, <2, 0, 0>, <0, 0, 2>), none\n";
+    for (int aa : {1, 3}) {
+        CAPTURE(aa);
+        std::vector<testkit::Frame> frames;
+        pray_stats st[2];
+        for (int on = 0; on < 2; on++) {
+            Ctx c;
+            pray_option(c, "width", 64);
+            pray_option(c, "height", 64);
+            pray_option(c, "antialias", aa);
+            pray_option(c, "adaptive", on ? 0.05 : 0);
+            pray_set_frame(c, testkit::frame_sink, &frames);
+            REQUIRE(pray_run_string(c, "line.ray", prog.data(), prog.size()) == PRAY_OK);
+            pray_stats_get(c, &st[on]);
+        }
+        REQUIRE(frames.size() == 2);
+        for (int x = 0; x < 64; x++) {
+            CAPTURE(x);
+            REQUIRE(frames[0].at(x, 21, 0) < 0.5f);  // the line is there in the full image
+            REQUIRE(frames[0].at(x, 19, 0) == 1.0f);
+            CHECK(frames[1].at(x, 21, 1) == frames[0].at(x, 21, 1));  // ... and with undersampling
+        }
+        CHECK(frames[1].pixels == frames[0].pixels);
+        CHECK(st[1].rays_primary < st[0].rays_primary / 2);  // the white field is interpolated
+    }
+}
+
+TEST_CASE("undersampling: a texture that only ramps between samples is interpolated") {
+    // The same view of a texture that grows evenly from black to white across: between any two
+    // lattice samples it stays within their values, so nothing is refined for the texture.
+    TempDir d;
+    REQUIRE(!d.path.empty());
+    std::vector<float> px(64 * 64 * 3);
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++)
+            for (int k = 0; k < 3; k++) px[(y * 64 + x) * 3 + k] = (float)(x / 63.0);
+    pray_image tex;
+    tex.width = tex.height = 64;
+    tex.pixels = px.data();
+    {
+        Ctx c;
+        REQUIRE(pray_write_image(c, &tex, (d / "ramp.tif").c_str(), 16) == PRAY_OK);
+    }
+    // one texel to a pixel: lattice samples 4 pixels apart differ by 4/63, under the threshold
+    // 0.08, while the texels between them and their neighbours span 6/63, over it
+    std::string prog = "parallel <1, 0, 0>, <0, 0, -1>, [0, -4, 0], [0, 0, 0]\n"
+                       "M = tiff(color({0}), color({1}), \"" + (d / "ramp.tif") + "\")\n"
+                       "rendertiff planemap(M, [-1, 0, 0], <0, -1, 0>, <2, 0, 0>, <0, 0, 2>), none\n";
+    Ctx c;
+    pray_option(c, "width", 64);
+    pray_option(c, "height", 64);
+    pray_option(c, "adaptive", 0.08);
+    std::vector<testkit::Frame> frames;
+    pray_set_frame(c, testkit::frame_sink, &frames);
+    REQUIRE(pray_run_string(c, "ramp.ray", prog.data(), prog.size()) == PRAY_OK);
+    pray_stats st;
+    pray_stats_get(c, &st);
+    REQUIRE(frames.size() == 1);
+    CHECK(frames[0].at(63, 32, 0) - frames[0].at(0, 32, 0) > 0.9f);  // the whole ramp is in view
+    CHECK(st.rays_primary < st.rays_primary_full / 6);  // 499 of 4096; refined for any spread: 1114
+}
