@@ -2956,6 +2956,7 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
         if (in) bump(s, w, 2 * p);
     }
     if (w->root_fixed) return true;  // the root keeps its status from a on
+    if (nc == 0) return false;       // nothing crosses in (a, b]: the root keeps its status
     for (int i = 0; i < na; i++) {
         int j = nodes[3 * i];
         if (w->nfrozen[j] == w->ray) continue;
