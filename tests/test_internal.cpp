@@ -1034,3 +1034,100 @@ TEST_CASE("folding of nothing and one") {
         CHECK(B2.hits(r).empty());
     }
 }
+
+TEST_CASE("reach: every voxel's cube of its list, exactly as large as it can be (against counting)") {
+    // Random grids of boxes of lists: the reach of each voxel is compared with a direct search,
+    // the largest r such that every voxel within chessboard distance r (inside the grid) has
+    // the voxel's list.
+    pray_ctx *c = pray_new();
+    for (uint64_t seed = 1; seed <= 40; seed++) {
+        CAPTURE(seed);
+        TRng g(seed * 7919ull);
+        Accel a;
+        memset(&a, 0, sizeof a);
+        for (int l = 0; l < 3; l++) a.n[l] = 1 + g.below(seed % 4 == 0 ? 40 : 14);
+        long nv = (long)a.n[0] * a.n[1] * a.n[2];
+        std::vector<int> lists((size_t)nv, 0);
+        int boxes = g.below(6);  // 0: one list everywhere
+        for (int b = 0; b < boxes; b++) {
+            int lo[3], hi[3];
+            for (int l = 0; l < 3; l++) {
+                lo[l] = g.below(a.n[l]);
+                hi[l] = lo[l] + g.below(a.n[l] - lo[l]);
+            }
+            int L = 1 + g.below(3);
+            for (int z = lo[2]; z <= hi[2]; z++)
+                for (int y = lo[1]; y <= hi[1]; y++)
+                    for (int x = lo[0]; x <= hi[0]; x++) lists[((size_t)z * a.n[1] + y) * a.n[0] + x] = L;
+        }
+        a.voxel = lists.data();
+        REQUIRE(reach_build(c, &a));
+        long wrong = 0;
+        for (int z = 0; z < a.n[2]; z++)
+            for (int y = 0; y < a.n[1]; y++)
+                for (int x = 0; x < a.n[0]; x++) {
+                    long v = ((long)z * a.n[1] + y) * a.n[0] + x;
+                    int r = 0;  // grow the cube while it holds only this list
+                    for (bool same = true; same && r < 255;) {
+                        int q = r + 1;
+                        for (int dz = -q; dz <= q && same; dz++)
+                            for (int dy = -q; dy <= q && same; dy++)
+                                for (int dx = -q; dx <= q && same; dx++) {
+                                    int u[3] = {x + dx, y + dy, z + dz};
+                                    if (u[0] < 0 || u[1] < 0 || u[2] < 0 || u[0] >= a.n[0] || u[1] >= a.n[1] || u[2] >= a.n[2])
+                                        continue;
+                                    same = lists[((size_t)u[2] * a.n[1] + u[1]) * a.n[0] + u[0]] == lists[(size_t)v];
+                                }
+                        if (same) r = q;
+                        if (q > a.n[0] && q > a.n[1] && q > a.n[2]) break;  // the whole grid: one list
+                    }
+                    bool whole = r >= a.n[0] && r >= a.n[1] && r >= a.n[2];
+                    if (whole ? a.reach[v] < r : a.reach[v] != r) wrong++;
+                }
+        CHECK(wrong == 0);
+        mem_free(c, a.reach);
+    }
+    pray_free(c);
+}
+
+TEST_CASE("texture pyramid: the range over texels holds every value a lookup between the coordinates takes") {
+    pray_ctx *c = pray_new();
+    for (uint64_t seed = 1; seed <= 30; seed++) {
+        CAPTURE(seed);
+        TRng g(seed * 104729ull);
+        pray_texture tx;
+        memset(&tx, 0, sizeof tx);
+        tx.w = 1 + g.below(seed % 3 == 0 ? 70 : 17);
+        tx.hgt = 1 + g.below(seed % 3 == 1 ? 70 : 17);
+        std::vector<float> rgb((size_t)tx.w * tx.hgt * 3);
+        for (size_t i = 0; i < rgb.size(); i++) rgb[i] = (float)g.u01();
+        tx.rgb = rgb.data();
+        REQUIRE(tex_pyramid(c, &tx));
+        for (int q = 0; q < 200; q++) {
+            double s0 = g.uni(-3, 3), t0 = g.uni(-3, 3);
+            double s1 = s0 + (q % 4 == 0 ? g.uni(0, 2) : g.uni(0, 0.2)), t1 = t0 + (q % 4 == 1 ? g.uni(0, 2) : g.uni(0, 0.2));
+            float mn[3], mx[3];
+            tex_spread(&tx, s0, s1, t0, t1, mn, mx);
+            // lookups on a fine lattice of the rectangle stay inside the range
+            bool inside = true;
+            for (int i = 0; i <= 12 && inside; i++)
+                for (int j = 0; j <= 12 && inside; j++) {
+                    pray_rgb v = tex_lookup(&tx, s0 + (s1 - s0) * i / 12, t0 + (t1 - t0) * j / 12);
+                    double ch[3] = {v.r, v.g, v.b};
+                    for (int l = 0; l < 3; l++) inside = inside && ch[l] >= mn[l] - 1e-6 && ch[l] <= mx[l] + 1e-6;
+                }
+            CHECK(inside);
+            // and no wider than the texture
+            for (int l = 0; l < 3; l++) CHECK((mn[l] >= 0 && mx[l] <= 1));
+        }
+        // a single texel's neighbourhood at level 0 is exact: the lookup at a texel's centre
+        float mn[3], mx[3];
+        int x = g.below(tx.w), y = g.below(tx.hgt);
+        double s = (x + 0.5) / tx.w, t = (y + 0.5) / tx.hgt;
+        tex_spread(&tx, s, s, t, t, mn, mx);
+        const float *px = &rgb[((size_t)y * tx.w + x) * 3];
+        for (int l = 0; l < 3; l++) CHECK((mn[l] <= px[l] && mx[l] >= px[l]));
+        mem_free(c, tx.mm);
+    }
+    pray_free(c);
+}
