@@ -3016,6 +3016,17 @@ bool ray_box(const Ray &r, const real *inv, const real *lo, const real *hi, real
     return a <= b;
 }
 
+// The smallest of three distances and its axis, ties to the later axis (selects, not branches:
+// the choice is a coin toss for a branch predictor).
+inline real nearest(const real *v, int *axis) {
+    int ax = 0;
+    real near = v[0];
+    if (v[1] <= near) ax = 1, near = v[1];
+    if (v[2] <= near) ax = 2, near = v[2];
+    *axis = ax;
+    return near;
+}
+
 // The accelerated counterpart of `sweep`: the same hits, in the same order.
 template <class Visit>
 void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
@@ -3107,13 +3118,9 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
             run_a = t;
         }
         int r = merge ? A->reach[at] : 0;
-        int ax = 0;
+        int ax;
         if (r < 2) {
-            // the axis of the nearest boundary, ties to the later axis (selects, not branches:
-            // the choice is a coin toss for a branch predictor)
-            real near = next[0];
-            if (next[1] <= near) ax = 1, near = next[1];
-            if (next[2] <= near) ax = 2, near = next[2];
+            real near = nearest(next, &ax);
             real exit = near < tend ? near : tend;
             t = exit > t ? exit : t;
             if (exit >= tend) break;
@@ -3132,9 +3139,7 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
             m[l] = room < r ? room : r;
             e[l] = next[l] + (real)m[l] * delta[l];  // no step along l: infinite
         }
-        real near = e[0];
-        if (e[1] <= near) ax = 1, near = e[1];
-        if (e[2] <= near) ax = 2, near = e[2];
+        real near = nearest(e, &ax);
         real exit = near < tend ? near : tend;
         t = exit > t ? exit : t;
         if (exit >= tend) break;

@@ -2003,6 +2003,22 @@ TEST_CASE("textures: on the command line a missing texture exits with 1 and writ
     CHECK(d.listing() == "missing-wood.tif tex.ray x.tif");
 }
 
+namespace {
+
+// A 64 x 64 texture written as `name` in d, and a program showing it head-on through a parallel
+// camera over x, z in [-1, 1], the texture's corner at `corner`, one texel to a pixel at 64 x 64.
+std::string texture_view(const TempDir &d, const char *name, std::vector<float> &px, int bits, const char *corner) {
+    pray_image tex;
+    tex.width = tex.height = 64;
+    tex.pixels = px.data();
+    Ctx c;
+    REQUIRE(pray_write_image(c, &tex, (d / name).c_str(), bits) == PRAY_OK);
+    return std::string("parallel <1, 0, 0>, <0, 0, -1>, [0, -4, 0], [0, 0, 0]\n") + "M = tiff(color({0}), color({1}), \"" +
+           (d / name) + "\")\nrendertiff planemap(M, " + corner + ", <0, -1, 0>, <2, 0, 0>, <0, 0, 2>), none\n";
+}
+
+} // namespace
+
 TEST_CASE("undersampling keeps texture detail that falls between its samples") {
     // A white texture with one black row of texels, one texel to a pixel, seen head-on by a
     // parallel camera: the row lands on image row 21, between the rows of the coarse lattice
@@ -2012,16 +2028,7 @@ TEST_CASE("undersampling keeps texture detail that falls between its samples") {
     std::vector<float> px(64 * 64 * 3, 1.0f);
     for (int x = 0; x < 64; x++)
         for (int k = 0; k < 3; k++) px[(10 * 64 + x) * 3 + k] = 0;
-    pray_image tex;
-    tex.width = tex.height = 64;
-    tex.pixels = px.data();
-    {
-        Ctx c;
-        REQUIRE(pray_write_image(c, &tex, (d / "line.tif").c_str(), 8) == PRAY_OK);
-    }
-    std::string prog = "parallel <1, 0, 0>, <0, 0, -1>, [0, -4, 0], [0, 0, 0]\n"
-                       "M = tiff(color({0}), color({1}), \"" + (d / "line.tif") + "\")\n"
-                       "rendertiff planemap(M, [0, 0, 0], <0, -1, 0>, <2, 0, 0>, <0, 0, 2>), none\n";
+    std::string prog = texture_view(d, "line.tif", px, 8, "[0, 0, 0]");
     for (int aa : {1, 3}) {
         CAPTURE(aa);
         std::vector<testkit::Frame> frames;
@@ -2057,18 +2064,9 @@ TEST_CASE("undersampling: a texture that only ramps between samples is interpola
     for (int y = 0; y < 64; y++)
         for (int x = 0; x < 64; x++)
             for (int k = 0; k < 3; k++) px[(y * 64 + x) * 3 + k] = (float)(x / 63.0);
-    pray_image tex;
-    tex.width = tex.height = 64;
-    tex.pixels = px.data();
-    {
-        Ctx c;
-        REQUIRE(pray_write_image(c, &tex, (d / "ramp.tif").c_str(), 16) == PRAY_OK);
-    }
-    // one texel to a pixel: lattice samples 4 pixels apart differ by 4/63, under the threshold
-    // 0.08, while the texels between them and their neighbours span 6/63, over it
-    std::string prog = "parallel <1, 0, 0>, <0, 0, -1>, [0, -4, 0], [0, 0, 0]\n"
-                       "M = tiff(color({0}), color({1}), \"" + (d / "ramp.tif") + "\")\n"
-                       "rendertiff planemap(M, [-1, 0, 0], <0, -1, 0>, <2, 0, 0>, <0, 0, 2>), none\n";
+    // lattice samples 4 pixels apart differ by 4/63, under the threshold 0.08, while the texels
+    // between them and their neighbours span 6/63, over it
+    std::string prog = texture_view(d, "ramp.tif", px, 16, "[-1, 0, 0]");
     Ctx c;
     pray_option(c, "width", 64);
     pray_option(c, "height", 64);
