@@ -2518,7 +2518,8 @@ bool reach_build(pray_ctx *c, Accel *a) {
             for (int z = 1; z <= nz; z++)
                 for (int y = 1; y <= ny; y++)
                     for (int x = 1; x <= nx; x++) {
-                        long q = pass == 0 ? ((long)z * py + y) * px + x : ((long)(nz + 1 - z) * py + (ny + 1 - y)) * px + (nx + 1 - x);
+                        int zz = pass == 0 ? z : nz + 1 - z, yy = pass == 0 ? y : ny + 1 - y, xx = pass == 0 ? x : nx + 1 - x;
+                        long q = ((long)zz * py + yy) * px + xx;
                         int d = r[q];
                         for (int i = 0; i < 13; i++) {
                             int e = r[pass == 0 ? q + off[i] : q - off[i]] + 1;
