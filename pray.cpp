@@ -3138,7 +3138,8 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
         for (int l = 0; l < 3; l++) {
             int room = step[l] > 0 ? A->n[l] - 1 - ix[l] : ix[l];
             m[l] = room < r ? room : r;
-            e[l] = next[l] + (real)m[l] * delta[l];  // no step along l: infinite
+            // (delta may be infinite for a direction of ~1e-308: no 0 x infinity)
+            e[l] = m[l] > 0 ? next[l] + (real)m[l] * delta[l] : next[l];  // no step along l: infinite
         }
         real near = nearest(e, &ax);
         real exit = near < tend ? near : tend;
@@ -3151,6 +3152,7 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
                 real f = (near - next[l]) * slope[l];
                 k = step[l] == 0 || !(f >= 0) ? 0 : f < (real)m[l] ? (int)f + 1 : m[l];
             }
+            if (k == 0) continue;
             ix[l] += step[l] * k;
             next[l] += (real)k * delta[l];
         }

@@ -345,13 +345,14 @@ std::vector<RayCase> make_rays(const Scene &s, Rng &rng) {
             push(sub(q.p, mul(d, far)), d, R_IN_FACE);
         }
     }
-    // nearly parallel to an axis: the other components tiny, down to subnormal numbers
+    // nearly parallel to an axis: the other components tiny, down to subnormal numbers, and
+    // just above them, where a voxel's width over the component overflows
     for (int i = 0; i < 8; i++) {
-        static const double tiny[] = {1e-9, 1e-17, 1e-200, 4e-310};
+        static const double tiny[] = {1e-9, 1e-17, 1e-200, 1e-306, 3e-308, 4e-310};
         int a = rng.below(3);
         pray_vec d = axis_vec(a, rng.sign());
         for (int l = 0; l < 3; l++)
-            if (l != a && rng.chance(0.7)) set_comp(d, l, rng.sign() * tiny[rng.below(4)]);
+            if (l != a && rng.chance(0.7)) set_comp(d, l, rng.sign() * tiny[rng.below(6)]);
         pray_vec o = rng.in_box(lo, hi);
         if (rng.chance(0.5)) set_comp(o, (a + 1) % 3, fraction((a + 1) % 3));
         if (rng.chance(0.5)) set_comp(o, a, comp(C, a) - comp(d, a) * far);
