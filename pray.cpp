@@ -2486,6 +2486,11 @@ void window3(int *mn, int *mx, const int *n, int l) {
     }
 }
 
+// Voxel v of a grid nx x ny x ... in the same grid with a border of one voxel all round.
+long bordered(long v, int nx, int ny) {
+    return ((v / nx / ny + 1) * (ny + 2) + v / nx % ny + 1) * (nx + 2) + v % nx + 1;
+}
+
 // Merging into areas (3.6) makes crossing an area cheap; jumps make it cheaper still. reach[v]
 // is the chessboard distance from voxel v to the nearest voxel with a neighbour of another list
 // (at most 255; the grid's edge does not count): every voxel within that distance of v has v's
@@ -2504,8 +2509,7 @@ bool reach_build(pray_ctx *c, Accel *a) {
         memcpy(mx, a->voxel, sizeof(int) * (size_t)nv);
         for (int l = 0; l < 3; l++) window3(mn, mx, a->n, l);
         memset(r, 255, (size_t)np);  // the border: the grid's edge is no boundary
-        for (long v = 0; v < nv; v++)
-            r[((v / nx / ny + 1) * py + v / nx % ny + 1) * px + v % nx + 1] = mn[v] == mx[v] ? 255 : 0;
+        for (long v = 0; v < nv; v++) r[bordered(v, nx, ny)] = mn[v] == mx[v] ? 255 : 0;
         // the chessboard distance to those voxels: a raster pass forwards over the 13 neighbours
         // visited before, then one backwards (exact for this distance)
         long off[13];
@@ -2527,7 +2531,7 @@ bool reach_build(pray_ctx *c, Accel *a) {
                         }
                         r[q] = (unsigned char)d;
                     }
-        for (long v = 0; v < nv; v++) a->reach[v] = r[((v / nx / ny + 1) * py + v / nx % ny + 1) * px + v % nx + 1];
+        for (long v = 0; v < nv; v++) a->reach[v] = r[bordered(v, nx, ny)];
     }
     mem_free(c, mn);
     mem_free(c, mx);
@@ -4078,8 +4082,9 @@ pray_rgb transmit_at(const Prim &q, R3 x) {
 }
 
 // The colour a ray brings back. `hit`, when given, receives the primitive it meets (-1: none);
-// `st`, when given, the texture coordinates there (when the primitive's model has a texture).
+// `st`, when given, the texture coordinates there (0, 0 when the primitive's model has no texture).
 pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, int *hit = NULL, double *st = NULL) {
+    if (st) st[0] = st[1] = 0;
     const Scene *s = tr.s;
     if (level > s->depth) return cmake(0, 0, 0);
     tr.w->k.rays[kind] += 1;
@@ -4292,7 +4297,6 @@ Sample pixel(Worker &k, int i, int j) {
     int W = s->width, H = s->height, A = s->antialias;
     Sample r;
     r.known = 1;
-    r.st[0] = r.st[1] = 0;
     if (A == 1) {
         real u = (real)(2.0 * (i + 0.5) / W - 1.0), v = (real)(2.0 * (j + 0.5) / H - 1.0);
         r.c = trace(k.tr, camera_ray(s, u, v), 1, -1, RAY_PRIMARY, &r.hit, r.st);
@@ -4305,7 +4309,6 @@ Sample pixel(Worker &k, int i, int j) {
             for (int a = 0; a < A; a += A - 1) {
                 real u = (real)(2.0 * (i + (a + 0.5) / A) / W - 1.0);
                 real v = (real)(2.0 * (j + (b + 0.5) / A) / H - 1.0);
-                sub[n].st[0] = sub[n].st[1] = 0;
                 sub[n].c = trace(k.tr, camera_ray(s, u, v), 1, -1, RAY_PRIMARY, &sub[n].hit, sub[n].st);
                 n++;
             }
@@ -4331,7 +4334,6 @@ Sample pixel(Worker &k, int i, int j) {
             } else {
                 real u = (real)(2.0 * (i + (a + 0.5) / A) / W - 1.0);
                 real v = (real)(2.0 * (j + (b + 0.5) / A) / H - 1.0);
-                x.st[0] = x.st[1] = 0;
                 x.c = trace(k.tr, camera_ray(s, u, v), 1, -1, RAY_PRIMARY, &x.hit, x.st);
             }
             sum = cadd(sum, x.c);
