@@ -1935,8 +1935,16 @@ struct Span {
     int kind;
 };
 
+// An intersection of primitives as one solid along the ray (see eval_list's plain evaluation).
+struct Hull {
+    real t0, t1;  // its latest entry and earliest exit so far
+    int prim;     // the primitive entered last, -1: none yet
+    int tie;      // two primitives entered at that same t
+};
+
 struct Scratch {
     Cross *cross;
+    Hull *hull;  // per node
     unsigned char *pstat, *nstat, *nfirst;
     int *cnt;
     Counters k;
@@ -1959,6 +1967,7 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     memset(w, 0, sizeof *w);
     size_t np = (size_t)s->prims.n + 1, nn = (size_t)s->nodes.n + 1;
     w->cross = (Cross *)thread_alloc(c, sizeof(Cross) * 2 * np);
+    w->hull = (Hull *)thread_alloc(c, sizeof(Hull) * nn);
     w->pstat = (unsigned char *)thread_alloc(c, np);
     w->nstat = (unsigned char *)thread_alloc(c, nn);
     w->nfirst = (unsigned char *)thread_alloc(c, nn);
@@ -1967,7 +1976,7 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->nfrozen = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
     w->nfixed = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
     w->nfixval = (unsigned char *)thread_alloc(c, nn);
-    return w->cross && w->pstat && w->nstat && w->nfirst && w->cnt && w->span && w->nfrozen && w->nfixed && w->nfixval;
+    return w->cross && w->hull && w->pstat && w->nstat && w->nfirst && w->cnt && w->span && w->nfrozen && w->nfixed && w->nfixval;
 }
 
 void scratch_release(pray_ctx *c, Scratch *w) {
@@ -1976,6 +1985,7 @@ void scratch_release(pray_ctx *c, Scratch *w) {
     mem_free(c, w->nfixed);
     mem_free(c, w->nfixval);
     mem_free(c, w->cross);
+    mem_free(c, w->hull);
     mem_free(c, w->pstat);
     mem_free(c, w->nstat);
     mem_free(c, w->nfirst);
@@ -2165,10 +2175,12 @@ enum { CL_OUT = 0, CL_IN = 1, CL_BD = 2 };
 struct Accel {
     int n[3];          // voxels per axis; all 0 without a grid
     real org[3], h;    // low corner of the grid and side of a voxel
+    real top[3];       // high corner of the grid
     real inv_h;        // 1 / h
     int *voxel;        // list of each voxel, x fastest
     unsigned char *reach;  // per voxel: how far around it every voxel has its list (see reach_build)
     Array<int> data, off;
+    Array<unsigned char> plain;  // per list: only unions, and intersections of primitives (list_plain)
     int outer;         // list of the space outside the grid (everything without a grid)
     int freeze, merge, bounds;
     long areas;
@@ -2181,6 +2193,7 @@ void accel_release(pray_ctx *c, Accel *a) {
     mem_free(c, a->reach);
     a->data.release(c);
     a->off.release(c);
+    a->plain.release(c);
     mem_free(c, a);
 }
 
@@ -2452,6 +2465,22 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
     return lb_store(b);
 }
 
+// A list is plain when its active nodes are unions, with no child inside for the whole region,
+// and intersections of primitives (boxes, slabs, capped cylinders): the root is then a union of
+// solids, each a primitive or such an intersection, and eval_list can take the nearest entry.
+bool list_plain(const Scene *s, const int *d) {
+    int na = d[0];
+    const int *nodes = d + 4;
+    for (int i = 0; i < na; i++) {
+        const Node &nd = s->nodes[nodes[3 * i]];
+        if (nd.op == O_UNION && nodes[3 * i + 1] == 0) continue;
+        if (nd.op != O_INTER) return false;
+        for (int k = 0; k < nd.n; k++)
+            if (e_is_node(s->kids[nd.k0 + k])) return false;
+    }
+    return na > 0;
+}
+
 // Voxels along the longest axis when the grid option is automatic. Measured on the benchmark
 // scenes (docs/benchmarks.md): about 4 voxels per primitive plus a floor of 4096 voxels is near
 // the best for CSG scenes of 200 to 1000 primitives; the building cost grows with the voxels, so
@@ -2546,6 +2575,7 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
     s->accel = a;
     a->data.init();
     a->off.init();
+    a->plain.init();
     a->freeze = opt_int(c, OPT_FREEZE);
     a->merge = opt_int(c, OPT_MERGE);
     a->bounds = opt_int(c, OPT_BOUNDS);
@@ -2677,6 +2707,7 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
     }
     if (want <= 0) a->n[0] = a->n[1] = a->n[2] = 0;
     if (want > 0) {
+        for (int l = 0; l < 3; l++) a->top[l] = (real)((double)a->org[l] + a->n[l] * (double)a->h);
         a->voxel = (int *)mem_zalloc(c, sizeof(int) * (size_t)nv);
         if (!a->voxel) st = c->status;
         // candidates per voxel, in two passes (count, then fill)
@@ -2778,7 +2809,7 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
             if (box_empty(bx)) continue;
             bool inside = a->n[0] > 0;
             for (int l = 0; l < 3 && inside; l++)
-                inside = bx.lo[l] > a->org[l] && bx.hi[l] < (real)((double)a->org[l] + a->n[l] * (double)a->h);
+                inside = bx.lo[l] > a->org[l] && bx.hi[l] < a->top[l];
             if (inside) continue;
             if (!cand.push(c, i) || !cls.push(c, CL_BD)) st = c->status;
         }
@@ -2792,9 +2823,11 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
     cls.release(c);
     mem_free(c, eff);
     lb_release(b);
+    for (int L = 0; st == PRAY_OK && L < a->off.n; L++)
+        if (!a->plain.push(c, (unsigned char)list_plain(s, a->data.p + a->off[L]))) st = c->status;
     nv = (long)a->n[0] * a->n[1] * a->n[2];
     a->memory = (double)sizeof(Accel) + (double)nv * (sizeof(int) + 1) + (double)a->data.cap * sizeof(int) +
-                (double)a->off.cap * sizeof(int);
+                (double)a->off.cap * sizeof(int) + (double)a->plain.cap;
     c->stats.grid[0] = a->n[0];
     c->stats.grid[1] = a->n[1];
     c->stats.grid[2] = a->n[2];
@@ -2891,23 +2924,59 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
     const int *nodes = d + 4, *prims = d + 4 + 3 * na;
     w->k.set_in += d[2];
     w->k.set_out += d[3];
-    if (na == 1 && nodes[1] == 0 && 2 * nodes[0] + 1 == s->root && s->nodes[nodes[0]].op == O_UNION) {
-        // Only primitives of the root union, none inside for the whole region (the common list
-        // of a scene of many objects): while the ray is outside them all, the first visible
-        // surface is the nearest entry. Anything less plain (a primitive inside at a, entries
-        // at the same t, a grazing touch) is left to the full evaluation.
+    if (A->plain[L]) {
+        // A union of solids, each a primitive or an intersection of primitives (plain lists: the
+        // common lists of a scene of many objects), none inside for the whole region: while the
+        // ray is outside them all, the first visible surface is the nearest entry. An
+        // intersection is entered at the latest entry of its primitives and left at the earliest
+        // exit. Anything less plain (a solid inside at a, entries at the same t, a grazing
+        // touch) is left to the full evaluation.
+        for (int i = 0; i < na; i++) {
+            Hull &u = w->hull[nodes[3 * i]];
+            u.t0 = -REAL_INF;
+            u.t1 = REAL_INF;
+            u.prim = -1;
+            u.tie = 0;
+        }
         int first = -1;
         real tf = 0;
         bool plain = true;
-        for (int i = 0; i < np && plain; i++) {
-            int p = prims[i];
-            const Span &sp = span_get(s, w, ray, p, self);
-            if (sp.kind == SPAN_NONE || (sp.kind == SPAN && sp.t1 <= a)) continue;
-            plain = sp.kind == SPAN && sp.t0 > a && s->prims[p].parent == nodes[0];
-            if (!plain || sp.t0 > b || !(sp.t0 < tmax) || (first >= 0 && sp.t0 > tf)) continue;
-            plain = sp.t1 > sp.t0 && !(first >= 0 && sp.t0 == tf);
+        for (int i = 0; i < np + na && plain; i++) {
+            int p, kind;
+            real t0, t1;
+            bool tie = false;
+            if (i < np) {  // the primitives: those of intersections are gathered first
+                p = prims[i];
+                const Span &sp = span_get(s, w, ray, p, self);
+                kind = sp.kind;
+                t0 = sp.t0;
+                t1 = sp.t1;
+                int j = s->prims[p].parent;
+                if (j >= 0 && s->nodes[j].op == O_INTER) {
+                    Hull &u = w->hull[j];
+                    if (kind == SPAN_NONE) u.t1 = -REAL_INF;
+                    if (kind != SPAN) continue;
+                    if (t0 == u.t0) u.tie = 1;
+                    if (t0 > u.t0) u.t0 = t0, u.prim = p, u.tie = 0;
+                    if (t1 < u.t1) u.t1 = t1;
+                    continue;
+                }
+            } else {  // then the intersections, as solids
+                int j = nodes[3 * (i - np)];
+                if (s->nodes[j].op != O_INTER) continue;
+                const Hull &u = w->hull[j];
+                p = u.prim;
+                t0 = u.t0;
+                t1 = u.t1;
+                tie = u.tie != 0;
+                kind = t0 <= t1 ? SPAN : SPAN_NONE;  // inside from -infinity when no primitive is entered
+            }
+            if (kind == SPAN_NONE || (kind == SPAN && t1 <= a)) continue;
+            plain = plain && kind == SPAN && t0 > a;
+            if (!plain || t0 > b || !(t0 < tmax) || (first >= 0 && t0 > tf)) continue;
+            plain = t1 > t0 && !tie && !(first >= 0 && t0 == tf);
             first = p;
-            tf = sp.t0;
+            tf = t0;
         }
         if (plain) {
             w->k.checks += np;
@@ -3046,8 +3115,8 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
     }
     w->root_fixed = 0;
     real inv[3];
-    for (int l = 0; l < 3; l++) {  // 0: parallel to the axis, or so nearly that 1 / d overflows
-        real q = comp(ray.d, l) != 0 ? (real)1 / comp(ray.d, l) : 0;
+    for (int l = 0; l < 3; l++) {  // 0: parallel to the axis (1 / 0 is infinite), or so nearly that 1 / d overflows
+        real q = (real)1 / comp(ray.d, l);
         inv[l] = q - q == 0 ? q : 0;
     }
     if (A->bounds && A->n[0] == 0) {
@@ -3070,13 +3139,8 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
         eval_list(s, A, w, ray, A->outer, 0, tmax, tmax, self, visit);
         return;
     }
-    real lo[3], hi[3];
-    for (int l = 0; l < 3; l++) {
-        lo[l] = A->org[l];
-        hi[l] = (real)((double)A->org[l] + A->n[l] * (double)A->h);
-    }
     real tin, tout;
-    if (!ray_box(ray, inv, lo, hi, &tin, &tout) || tout <= 0 || tin >= tmax) {
+    if (!ray_box(ray, inv, A->org, A->top, &tin, &tout) || tout <= 0 || tin >= tmax) {
         eval_list(s, A, w, ray, A->outer, 0, tmax, tmax, self, visit);
         return;
     }
@@ -3092,8 +3156,8 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
     real next[3], delta[3], slope[3];  // slope: voxels per unit of t along each axis
     for (int l = 0; l < 3; l++) {
         real dd = inv[l] == 0 ? 0 : comp(ray.d, l);
-        double g = floor((double)((comp(p, l) - A->org[l]) * A->inv_h));  // clamped before the cast
-        ix[l] = !(g > 0) ? 0 : g >= A->n[l] ? A->n[l] - 1 : (int)g;
+        real g = (comp(p, l) - A->org[l]) * A->inv_h;  // clamped before the cast
+        ix[l] = !(g > 0) ? 0 : g >= (real)A->n[l] ? A->n[l] - 1 : (int)g;
         step[l] = dd > 0 ? 1 : dd < 0 ? -1 : 0;
         next[l] = dd == 0 ? REAL_INF : (A->org[l] + (real)(ix[l] + (dd > 0)) * A->h - comp(ray.o, l)) * inv[l];
         delta[l] = A->h * (inv[l] < 0 ? -inv[l] : inv[l]);
