@@ -4491,12 +4491,12 @@ void render_band(Worker &k, int band) {
         Ray rays[RAY_BATCH];
         for (int j = y0; j < y1; j++) {
             set_row_background(k, j);
+            if (s->antialias > 1) {  // pixel() makes each row of samples ahead
+                for (int i = 0; i < W; i++) put_pixel(job, i, j, pixel(k, i, j).c);
+                continue;
+            }
             for (int i0 = 0; i0 < W; i0 += RAY_BATCH) {
                 int n = W - i0 < RAY_BATCH ? W - i0 : RAY_BATCH;
-                if (s->antialias > 1) {
-                    for (int q = 0; q < n; q++) put_pixel(job, i0 + q, j, pixel(k, i0 + q, j).c);
-                    continue;
-                }
                 for (int q = 0; q < n; q++) rays[q] = sample_ray(s, i0 + q, j, 0, 0);
                 for (int q = 0; q < n; q++) put_pixel(job, i0 + q, j, trace(k.tr, rays[q], 1, -1, RAY_PRIMARY));
             }
