@@ -1935,16 +1935,17 @@ struct Span {
     int kind;
 };
 
-// An intersection of primitives as one solid along the ray (see eval_list's plain evaluation).
+// An intersection as one solid along the ray (see eval_list's plain evaluation).
 struct Hull {
     real t0, t1;  // its latest entry and earliest exit so far
-    int prim;     // the primitive entered last, -1: none yet
-    int tie;      // two primitives entered at that same t
+    int prim;     // the member entered last, -1: none yet
+    int enter;    // 0: that member is a half-space turned inside out (the ray leaves the half-space)
+    int tie;      // two members entered at that same t
 };
 
 struct Scratch {
     Cross *cross;
-    Hull *hull;  // per node
+    Hull *hull;  // per solid of a plain list (at most one per node)
     unsigned char *pstat, *nstat, *nfirst;
     int *cnt;
     Counters k;
@@ -2180,7 +2181,8 @@ struct Accel {
     int *voxel;        // list of each voxel, x fastest
     unsigned char *reach;  // per voxel: how far around it every voxel has its list (see reach_build)
     Array<int> data, off;
-    Array<unsigned char> plain;  // per list: only unions, and intersections of primitives (list_plain)
+    Array<int> plan_at;  // per list: where its plan starts in `plan`, -1 when it is not plain (list_plan)
+    Array<int> plan;
     int outer;         // list of the space outside the grid (everything without a grid)
     int freeze, merge, bounds;
     long areas;
@@ -2193,7 +2195,8 @@ void accel_release(pray_ctx *c, Accel *a) {
     mem_free(c, a->reach);
     a->data.release(c);
     a->off.release(c);
-    a->plain.release(c);
+    a->plan_at.release(c);
+    a->plan.release(c);
     mem_free(c, a);
 }
 
@@ -2465,20 +2468,68 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
     return lb_store(b);
 }
 
-// A list is plain when its active nodes are unions, with no child inside for the whole region,
-// and intersections of primitives (boxes, slabs, capped cylinders): the root is then a union of
-// solids, each a primitive or such an intersection, and eval_list can take the nearest entry.
-bool list_plain(const Scene *s, const int *d) {
-    int na = d[0];
-    const int *nodes = d + 4;
-    for (int i = 0; i < na; i++) {
-        const Node &nd = s->nodes[nodes[3 * i]];
-        if (nd.op == O_UNION && nodes[3 * i + 1] == 0) continue;
-        if (nd.op != O_INTER) return false;
-        for (int k = 0; k < nd.n; k++)
-            if (e_is_node(s->kids[nd.k0 + k])) return false;
+// A list is plain when its root, in the list's region, is a union of solids that a ray enters
+// and leaves once: primitives, half-spaces turned inside out, and intersections of them (boxes,
+// slabs, capped cylinders, a wall: the inside of a room's box taken from a solid block). Each
+// primitive is followed up to the root. A node with one active child passes it on, turned inside
+// out by a complement, or by a difference when the child is not the first (the first child is
+// then inside for the whole region: an active node is on its boundary). A node with more is a
+// union or an intersection (a difference: its first child and the others turned inside out), the
+// one turned into the other by an odd number of inversions above it. A union may not stand under
+// an intersection; an intersection right under the unions starts a solid, which the
+// intersections under it join. Appends to `plan` the number of solids and, per primitive of the
+// list, (solid + 1) * 2 + (1 when turned inside out), solid -1 standing alone. Returns where
+// that starts, or -1 (appending nothing) when the list is not plain, -2 when out of memory.
+// `kids`, `solid`: per node scratch, 0 and -1 on entry and left so.
+const int PLAN_DEPTH = 64;  // deeper trees are evaluated in full
+
+int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, Array<int> *plan) {
+    int na = d[0], np = d[1];
+    const int *nodes = d + 4, *prims = d + 4 + 3 * na;
+    for (int i = 0; i < na; i++)
+        if (s->nodes[nodes[3 * i]].parent >= 0) kids[s->nodes[nodes[3 * i]].parent]++;
+    for (int i = 0; i < np; i++)
+        if (s->prims[prims[i]].parent >= 0) kids[s->prims[prims[i]].parent]++;
+    int base = plan->n, ns = 0;
+    bool mem = np == 0 || plan->push(c, 0), ok = np > 0 && mem;
+    for (int i = 0; ok && i < np; i++) {
+        int path[PLAN_DEPTH], n = 0;  // the ancestors, the root last
+        for (int p = s->prims[prims[i]].parent; ok && p >= 0; p = s->nodes[p].parent) {
+            ok = n < PLAN_DEPTH;
+            if (ok) path[n++] = p;
+        }
+        bool inv = false;
+        int k = -1;  // the solid, -1 while under unions only
+        for (int m = n - 1; ok && m >= 0; m--) {
+            int j = path[m];
+            const Node &nd = s->nodes[j];
+            int child = m > 0 ? 2 * path[m - 1] + 1 : 2 * prims[i];
+            bool first = elem_first(s, child);
+            if (kids[j] > 1) {
+                bool inter = (nd.op != O_UNION) != inv;
+                ok = inter || k < 0;
+                if (inter && k < 0) {
+                    if (solid[j] < 0) solid[j] = ns++;
+                    k = solid[j];
+                }
+            }
+            if (nd.op == O_COMPL || (nd.op == O_DIFF && !first)) inv = !inv;
+        }
+        ok = ok && (!inv || s->prims[prims[i]].kind == O_PLANE);
+        mem = !ok || plan->push(c, (k + 1) * 2 + inv);
+        ok = ok && mem;
     }
-    return na > 0;
+    for (int i = 0; i < na; i++) {
+        int j = nodes[3 * i];
+        solid[j] = -1;
+        kids[j] = 0;  // the parents of a list's primitives and nodes are its nodes
+    }
+    if (!ok) {
+        plan->n = base;
+        return mem ? -1 : -2;
+    }
+    plan->p[base] = ns;
+    return base;
 }
 
 // Voxels along the longest axis when the grid option is automatic. Measured on the benchmark
@@ -2575,7 +2626,8 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
     s->accel = a;
     a->data.init();
     a->off.init();
-    a->plain.init();
+    a->plan_at.init();
+    a->plan.init();
     a->freeze = opt_int(c, OPT_FREEZE);
     a->merge = opt_int(c, OPT_MERGE);
     a->bounds = opt_int(c, OPT_BOUNDS);
@@ -2823,11 +2875,22 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
     cls.release(c);
     mem_free(c, eff);
     lb_release(b);
-    for (int L = 0; st == PRAY_OK && L < a->off.n; L++)
-        if (!a->plain.push(c, (unsigned char)list_plain(s, a->data.p + a->off[L]))) st = c->status;
+    if (st == PRAY_OK) {
+        int nn = s->nodes.n + 1;
+        int *kids = (int *)mem_zalloc(c, sizeof(int) * (size_t)nn);
+        int *solid = (int *)mem_alloc(c, sizeof(int) * (size_t)nn);
+        if (!kids || !solid) st = c->status;
+        for (int j = 0; st == PRAY_OK && j < nn; j++) solid[j] = -1;
+        for (int L = 0; st == PRAY_OK && L < a->off.n; L++) {
+            int where = list_plan(c, s, a->data.p + a->off[L], kids, solid, &a->plan);
+            if (where == -2 || !a->plan_at.push(c, where)) st = c->status;
+        }
+        mem_free(c, kids);
+        mem_free(c, solid);
+    }
     nv = (long)a->n[0] * a->n[1] * a->n[2];
     a->memory = (double)sizeof(Accel) + (double)nv * (sizeof(int) + 1) + (double)a->data.cap * sizeof(int) +
-                (double)a->off.cap * sizeof(int) + (double)a->plain.cap;
+                (double)a->off.cap * sizeof(int) + (double)(a->plan_at.cap + a->plan.cap) * sizeof(int);
     c->stats.grid[0] = a->n[0];
     c->stats.grid[1] = a->n[1];
     c->stats.grid[2] = a->n[2];
@@ -2924,58 +2987,67 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
     const int *nodes = d + 4, *prims = d + 4 + 3 * na;
     w->k.set_in += d[2];
     w->k.set_out += d[3];
-    if (A->plain[L]) {
-        // A union of solids, each a primitive or an intersection of primitives (plain lists: the
-        // common lists of a scene of many objects), none inside for the whole region: while the
-        // ray is outside them all, the first visible surface is the nearest entry. An
-        // intersection is entered at the latest entry of its primitives and left at the earliest
-        // exit. Anything less plain (a solid inside at a, entries at the same t, a grazing
-        // touch) is left to the full evaluation.
-        for (int i = 0; i < na; i++) {
-            Hull &u = w->hull[nodes[3 * i]];
+    if (A->plan_at[L] >= 0) {
+        // A union of solids (plain lists, list_plan: the common lists of a scene of many
+        // objects), none inside for the whole region: while the ray is outside them all, the
+        // first visible surface is the nearest entry. An intersection is entered at the latest
+        // entry of its members and left at the earliest exit; a half-space turned inside out is
+        // entered where the ray leaves the half-space. Anything less plain (a solid inside at a,
+        // entries at the same t, a grazing touch) is left to the full evaluation.
+        const int *plan = A->plan.p + A->plan_at[L] + 1;
+        int ns = plan[-1];
+        for (int k = 0; k < ns; k++) {
+            Hull &u = w->hull[k];
             u.t0 = -REAL_INF;
             u.t1 = REAL_INF;
             u.prim = -1;
+            u.enter = 1;
             u.tie = 0;
         }
-        int first = -1;
+        int first = -1, first_enter = 1;
         real tf = 0;
         bool plain = true;
-        for (int i = 0; i < np + na && plain; i++) {
-            int p, kind;
+        for (int i = 0; i < np + ns && plain; i++) {
+            int p, kind, enter;
             real t0, t1;
             bool tie = false;
-            if (i < np) {  // the primitives: those of intersections are gathered first
+            if (i < np) {  // the primitives: the members of intersections are gathered first
                 p = prims[i];
                 const Span &sp = span_get(s, w, ray, p, self);
                 kind = sp.kind;
                 t0 = sp.t0;
                 t1 = sp.t1;
-                int j = s->prims[p].parent;
-                if (j >= 0 && s->nodes[j].op == O_INTER) {
-                    Hull &u = w->hull[j];
+                enter = !(plan[i] & 1);
+                if (!enter) {  // a half-space (one end of its span infinite) turned inside out
+                    if (kind != SPAN) kind = kind == SPAN_ALL ? SPAN_NONE : SPAN_ALL;
+                    else if (t0 == -REAL_INF) t0 = t1, t1 = REAL_INF;
+                    else t1 = t0, t0 = -REAL_INF;
+                }
+                int k = (plan[i] >> 1) - 1;
+                if (k >= 0) {
+                    Hull &u = w->hull[k];
                     if (kind == SPAN_NONE) u.t1 = -REAL_INF;
                     if (kind != SPAN) continue;
                     if (t0 == u.t0) u.tie = 1;
-                    if (t0 > u.t0) u.t0 = t0, u.prim = p, u.tie = 0;
+                    if (t0 > u.t0) u.t0 = t0, u.prim = p, u.enter = enter, u.tie = 0;
                     if (t1 < u.t1) u.t1 = t1;
                     continue;
                 }
             } else {  // then the intersections, as solids
-                int j = nodes[3 * (i - np)];
-                if (s->nodes[j].op != O_INTER) continue;
-                const Hull &u = w->hull[j];
+                const Hull &u = w->hull[i - np];
                 p = u.prim;
+                enter = u.enter;
                 t0 = u.t0;
                 t1 = u.t1;
                 tie = u.tie != 0;
-                kind = t0 <= t1 ? SPAN : SPAN_NONE;  // inside from -infinity when no primitive is entered
+                kind = t0 <= t1 ? SPAN : SPAN_NONE;  // inside from -infinity when no member is entered
             }
             if (kind == SPAN_NONE || (kind == SPAN && t1 <= a)) continue;
             plain = plain && kind == SPAN && t0 > a;
             if (!plain || t0 > b || !(t0 < tmax) || (first >= 0 && t0 > tf)) continue;
             plain = t1 > t0 && !tie && !(first >= 0 && t0 == tf);
             first = p;
+            first_enter = enter;
             tf = t0;
         }
         if (plain) {
@@ -2984,7 +3056,7 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
             Hit h;
             h.t = tf;
             h.prim = first;
-            h.prim_enter = 1;
+            h.prim_enter = first_enter;
             h.root_enter = 1;
             if (!visit(h)) return true;
             a = tf;  // the visitor goes on through the solid: the rest in full
