@@ -18,7 +18,9 @@
 CXX      ?= c++
 EXE      ?=
 RUN      ?=
-OPT      ?= -O2
+# -O3 and no errno from the maths functions (pray never reads it): 4-5 % faster than -O2 on
+# the benchmark scenes, the same images
+OPT      ?= -O3 -fno-math-errno
 WARN     := -Wall -Wextra -pedantic
 override CXXFLAGS := $(OPT) $(WARN) -fno-exceptions -fno-rtti $(CXXFLAGS)
 LDLIBS   ?= -lm

@@ -39,7 +39,7 @@ mkdir -p build/charts
 # the single-precision build, the same flags as the Makefile's pray rule
 if [ ! -x build/pray_float ] || [ -n "$(find pray.cpp pray.hpp -newer build/pray_float)" ]; then
   echo "charts: building build/pray_float (PRAY_REAL=float)" >&2
-  $CXX -std=c++98 -O2 -Wall -Wextra -pedantic -fno-exceptions -fno-rtti -DPRAY_REAL=float -DPRAY_MAIN \
+  $CXX -std=c++98 -O3 -fno-math-errno -Wall -Wextra -pedantic -fno-exceptions -fno-rtti -DPRAY_REAL=float -DPRAY_MAIN \
     pray.cpp -o build/pray_float -lm
 fi
 # shellcheck disable=SC2086
