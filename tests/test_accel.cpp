@@ -389,13 +389,11 @@ bool same_t(double a, double b) { return std::fabs(a - b) <= 1e-9 * (1 + std::fa
 
 // The normal points out of the whole solid: the same primitive at the same t gives it the same
 // way round, so the sign of their dot product tells a wrong side.
-bool same_side(const pray_vec &a, const pray_vec &b) { return a.x * b.x + a.y * b.y + a.z * b.z > 0; }
-
 bool same_hits(const Hits &a, const Hits &b) {
     if (a.n != b.n) return false;
     for (size_t i = 0; i < a.h.size(); i++)
         if (a.h[i].primitive != b.h[i].primitive || a.h[i].entering != b.h[i].entering || !same_t(a.h[i].t, b.h[i].t) ||
-            !same_side(a.h[i].normal, b.h[i].normal))
+            !(dot(a.h[i].normal, b.h[i].normal) > 0))
             return false;
     return true;
 }
