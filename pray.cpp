@@ -567,6 +567,7 @@ pray_rgb cmul(pray_rgb a, pray_rgb b) { return cmake(a.r * b.r, a.g * b.g, a.b *
 pray_rgb cscale(pray_rgb a, double s) { return cmake(a.r * s, a.g * s, a.b * s); }
 bool cfinite(pray_rgb a) { return finite_num(a.r) && finite_num(a.g) && finite_num(a.b); }
 bool czero(pray_rgb a) { return a.r == 0 && a.g == 0 && a.b == 0; }
+bool same_rgb(pray_rgb a, pray_rgb b) { return a.r == b.r && a.g == b.g && a.b == b.b; }
 
 double cbrt_pos(double x) { return x > 0 ? pow(x, 1.0 / 3.0) : 0; }
 
@@ -4219,51 +4220,110 @@ pray_rgb transmit_at(const Prim &q, R3 x) {
 
 // The colour a ray brings back. `hit`, when given, receives the primitive it meets (-1: none);
 // `st`, when given, the texture coordinates there (0, 0 when the primitive's model has no texture).
-pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, int *hit = NULL, double *st = NULL) {
-    if (st) st[0] = st[1] = 0;
+// Whether a model's look at a point follows from the light arriving there and the model's
+// coefficients at the point's texture coordinates: no mirror and no transparency (their rays
+// would see other parts of the scene). Bump maps are fine: they only turn the normal.
+bool model_lit_only(const pray_model *m) {
+    if (!m) return true;
+    if (m->kind == M_FLAT) return czero(m->reflect) && czero(m->transmit);
+    return model_lit_only(m->a) && model_lit_only(m->b);
+}
+
+// What a primary ray saw, for undersampling: the primitive (-1: none) and the texture
+// coordinates; on a textured surface whose model is lit only (model_lit_only), also the light
+// that reaches the point from each light in front of it (through the shadows), for the first
+// SEEN_LIGHTS lights.
+const int SEEN_LIGHTS = 4;
+struct Seen {
+    int hit;
+    int lit_only;   // `light` and `lights` are filled
+    int enter;      // the surface is where the ray enters the primitive
+    int outward;    // its normal points out of the primitive (before it is turned to the viewer)
+    unsigned lights;  // bit i: light i is in front of the point, and light[i] is what reaches it
+    double st[2];
+    pray_rgb light[SEEN_LIGHTS];
+};
+
+// The unit direction from x to light L and the distance (infinite for a directional light);
+// false when x is at the light.
+bool toward_light(const Light &L, R3 x, R3 *l, real *dist) {
+    if (!L.point) {
+        *l = L.v;
+        *dist = REAL_INF;
+        return true;
+    }
+    R3 v = L.v - x;
+    *dist = (real)sqrt((double)dot(v, v));
+    if (*dist == 0) return false;
+    *l = v * ((real)1 / *dist);
+    return true;
+}
+
+// Add to *col what light li, arriving along l (n . l = ndl > 0), reflects towards the viewer
+// looking along d from a point with normal n and coefficients m (Phong).
+void phong_light(pray_rgb *col, const Shade *m, pray_rgb li, R3 n, R3 l, real ndl, R3 d) {
+    *col = cadd(*col, cscale(cmul(m->diffuse, li), (double)ndl));
+    if (!czero(m->specular)) {
+        R3 rl = n * (2 * ndl) - l;
+        real rv = -dot(rl, d);
+        double sp = rv > 0 ? pow((double)rv, m->exponent) : (m->exponent == 0 ? 1.0 : 0.0);
+        *col = cadd(*col, cscale(cmul(m->specular, li), sp));
+    }
+}
+
+// The normal of primitive q at x as shaded: tilted by the model's bump maps, out of the whole
+// solid (`outward`: the primitive's own normal points out of it), towards the viewer along d.
+R3 shading_normal(const Prim &q, R3 x, const Shade &sh, R3 ds, R3 dt, bool outward, R3 d) {
+    R3 n = prim_normal(q, x);
+    if (sh.bs != 0 || sh.bt != 0) {  // bump: tilt the normal, not the surface
+        R3 b = unit(n - ds * (real)sh.bs - dt * (real)sh.bt);
+        if (dot(b, b) > 0) n = b;
+    }
+    if (!outward) n = n * (real)-1;
+    if (dot(n, d) > 0) n = n * (real)-1;
+    return n;
+}
+
+pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *seen = NULL) {
     const Scene *s = tr.s;
+    if (seen) seen->hit = -1, seen->lit_only = 0, seen->st[0] = seen->st[1] = 0;
     if (level > s->depth) return cmake(0, 0, 0);
     tr.w->k.rays[kind] += 1;
     FirstHit fh;
     fh.found = false;
     find_hits(s, tr.w, ray, REAL_INF, self, fh);
-    if (hit) *hit = fh.found ? fh.h.prim : -1;
     if (!fh.found) return tr.bg;
     const Hit &h = fh.h;
     const Prim &q = s->prims[h.prim];
     R3 x = ray.o + ray.d * h.t;
-    R3 ng = prim_normal(q, x);
     Shade sh;
     const Shade *m = &sh;
+    double ts = 0, tt = 0;
+    R3 ds = r3(0, 0, 0), dt = ds;
     if (q.mat->kind == M_FLAT) shade_of(q.mat, 0, 0, &sh);
     else {
-        double ts, tt;
-        R3 ds, dt;
         tex_coords(q, x, &ts, &tt, &ds, &dt);
-        if (st) st[0] = ts, st[1] = tt;
         shade_of(q.mat, ts, tt, &sh);
-        if (sh.bs != 0 || sh.bt != 0) {  // bump: tilt the normal, not the surface
-            R3 b = unit(ng - ds * (real)sh.bs - dt * (real)sh.bt);
-            if (dot(b, b) > 0) ng = b;
-        }
     }
-    R3 n = (h.prim_enter == h.root_enter) ? ng : ng * (real)-1;  // out of the whole solid
-    if (dot(n, ray.d) > 0) n = n * (real)-1;                     // towards the viewer
+    bool outward = h.prim_enter == h.root_enter;
+    R3 n = shading_normal(q, x, sh, ds, dt, outward, ray.d);
+    bool record = seen && q.mat->kind != M_FLAT && s->lights.n <= SEEN_LIGHTS && model_lit_only(q.mat);
+    if (seen) {
+        seen->hit = h.prim;
+        seen->enter = h.prim_enter;
+        seen->outward = outward;
+        seen->lit_only = record;
+        seen->lights = 0;
+        seen->st[0] = ts;
+        seen->st[1] = tt;
+    }
     pray_rgb col = cadd(m->emit, m->ambient);
-    bool lit = !czero(m->diffuse) || !czero(m->specular);
+    bool lit = !czero(m->diffuse) || !czero(m->specular) || record;  // (the light is recorded)
     for (int i = 0; lit && i < s->lights.n; i++) {
         const Light &L = s->lights[i];
         R3 l;
         real dist;
-        if (L.point) {
-            R3 v = L.v - x;
-            dist = (real)sqrt((double)dot(v, v));
-            if (dist == 0) continue;
-            l = v * ((real)1 / dist);
-        } else {
-            l = L.v;
-            dist = REAL_INF;
-        }
+        if (!toward_light(L, x, &l, &dist)) continue;
         real ndl = dot(n, l);
         if (ndl <= 0) continue;
         pray_rgb li = L.intensity;
@@ -4277,16 +4337,13 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, int *h
             sh.f = cmake(1, 1, 1);
             tr.w->k.rays[RAY_SHADOW] += 1;
             find_hits(s, tr.w, sr, dist, h.prim, sh);
-            if (czero(sh.f)) continue;
             li = cmul(li, sh.f);
         }
-        col = cadd(col, cscale(cmul(m->diffuse, li), (double)ndl));
-        if (!czero(m->specular)) {
-            R3 rl = n * (2 * ndl) - l;
-            real rv = -dot(rl, ray.d);
-            double sp = rv > 0 ? pow((double)rv, m->exponent) : (m->exponent == 0 ? 1.0 : 0.0);
-            col = cadd(col, cscale(cmul(m->specular, li), sp));
+        if (record) {
+            seen->lights |= 1u << i;
+            seen->light[i] = li;
         }
+        if (!czero(li)) phong_light(&col, m, li, n, l, ndl, ray.d);
     }
     pray_rgb refl = m->reflect;
     if (!czero(m->transmit) && level < s->depth) {
@@ -4379,9 +4436,8 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
 // there (when that primitive has a texture).
 struct Sample {
     pray_rgb c;
-    int hit;
-    int known;
-    double st[2];
+    Seen seen;
+    int known;  // undersampling: 0 not yet, 1 traced, 2 interpolated
 };
 
 struct Job;
@@ -4390,7 +4446,7 @@ struct Worker {
     Job *job;
     Scratch w;
     Tracer tr;
-    Array<Sample> cache;  // undersampling: the samples of the current band
+    Array<Sample> cache;  // undersampling: the samples of the current tile
     pray_status st;
 };
 
@@ -4402,27 +4458,30 @@ struct Job {
     int next_band, bands, band_rows, rows_done;
     int cancelled;
     double adaptive;  // undersampling threshold, 0 = off
-    int step;         // undersampling: spacing of the coarse lattice, in pixels
+    int step;         // undersampling: spacing of the coarse lattice, in samples
+    int tile;         // undersampling: side of a tile, in samples (a multiple of step)
 };
 
-// The coarse lattice of undersampling: every 4th pixel, or every 2nd with antialiasing (there the
-// pixels are traced at their corners anyway, and detail between lattice pixels costs more than the
-// extra pixels: on the gallery, within 1 dB of full sampling instead of up to 8 dB off).
-const int ADAPT_STEP = 4, ADAPT_STEP_AA = 2;
-const int ADAPT_BAND = 8;  // lattice cells per band: a band traces its last row again, once per band
+// Undersampling works on the image's samples (antialias x antialias per pixel, in one lattice
+// over the whole image): a coarse lattice of them is traced, every 4th pixel, or with antialias
+// the samples 2 pixels apart; a cell whose corners differ is split, down to neighbouring samples.
+// The samples of a tile are kept; a tile hands its last column to the next one and a band of
+// tiles traces its last row again (a band is one row of tiles).
+const int ADAPT_PIXELS = 4, ADAPT_PIXELS_AA = 1;
+const int ADAPT_TILE = 64;  // samples along a tile's side, at least (at least one cell)
 
 bool differ(const Sample &a, const Sample &b, double th) {
-    return a.hit != b.hit || fabs(a.c.r - b.c.r) > th || fabs(a.c.g - b.c.g) > th || fabs(a.c.b - b.c.b) > th;
+    return a.seen.hit != b.seen.hit || fabs(a.c.r - b.c.r) > th || fabs(a.c.g - b.c.g) > th || fabs(a.c.b - b.c.b) > th;
 }
 
 // Detail between samples that agree: they all meet one textured primitive, and its texture
 // changes by more than the threshold somewhere between their texture coordinates (a mortar line
 // or a far checker between them would be lost).
 bool texture_between(const Scene *s, const Sample *const *x, int n, double th) {
-    int h = x[0]->hit;
+    int h = x[0]->seen.hit;
     if (h < 0 || s->prims[h].mat->kind == M_FLAT) return false;
     double ss[4], tt[4];
-    for (int i = 0; i < n && i < 4; i++) ss[i] = x[i]->st[0], tt[i] = x[i]->st[1];
+    for (int i = 0; i < n && i < 4; i++) ss[i] = x[i]->seen.st[0], tt[i] = x[i]->seen.st[1];
     return model_varies(s->prims[h].mat, ss, tt, n < 4 ? n : 4, th);
 }
 
@@ -4438,57 +4497,17 @@ Ray sample_ray(const Scene *s, int i, int j, int a, int b) {
 // overlap the tracing of others instead of delaying it (CSG at one sample: 11 % faster).
 const int RAY_BATCH = 64;
 
-// One pixel: its A x A stratified samples averaged. With undersampling, the four corner samples
-// are traced first and the rest only where those differ.
-Sample pixel(Worker &k, int i, int j) {
+// One pixel: its A x A stratified samples averaged.
+pray_rgb pixel(Worker &k, int i, int j) {
     const Scene *s = k.job->s;
     int A = s->antialias;
-    Sample r;
-    r.known = 1;
-    if (A == 1) {
-        r.c = trace(k.tr, sample_ray(s, i, j, 0, 0), 1, -1, RAY_PRIMARY, &r.hit, r.st);
-        return r;
-    }
-    Sample sub[4];
-    int n = 0;
-    if (k.job->adaptive > 0) {
-        for (int b = 0; b < A; b += A - 1)
-            for (int a = 0; a < A; a += A - 1) {
-                sub[n].c = trace(k.tr, sample_ray(s, i, j, a, b), 1, -1, RAY_PRIMARY, &sub[n].hit, sub[n].st);
-                n++;
-            }
-        bool same = true;
-        for (int q = 1; q < 4 && same; q++) same = !differ(sub[0], sub[q], k.job->adaptive);
-        const Sample *corner[4] = {&sub[0], &sub[1], &sub[2], &sub[3]};
-        if (same && !texture_between(s, corner, 4, k.job->adaptive)) {
-            r.c = cscale(cadd(cadd(sub[0].c, sub[1].c), cadd(sub[2].c, sub[3].c)), 0.25);
-            r.hit = sub[0].hit;
-            r.st[0] = sub[0].st[0];
-            r.st[1] = sub[0].st[1];
-            return r;
-        }
-    }
     pray_rgb sum = cmake(0, 0, 0);
-    r.hit = -1;
     Ray rays[RAY_BATCH];  // a row of samples (the option table caps antialias at RAY_BATCH)
     for (int b = 0; b < A; b++) {
         for (int a = 0; a < A; a++) rays[a] = sample_ray(s, i, j, a, b);
-        for (int a = 0; a < A; a++) {
-            int corner = (a == 0 || a == A - 1) && (b == 0 || b == A - 1);
-            Sample x;
-            if (n && corner) x = sub[(b == 0 ? 0 : 2) + (a == 0 ? 0 : 1)];
-            else x.c = trace(k.tr, rays[a], 1, -1, RAY_PRIMARY, &x.hit, x.st);
-            sum = cadd(sum, x.c);
-            // the primitive of the centre (odd A) or of the first sample, with its coordinates
-            if ((2 * a + 1 == A && 2 * b + 1 == A) || (a == 0 && b == 0)) {
-                r.hit = x.hit;
-                r.st[0] = x.st[0];
-                r.st[1] = x.st[1];
-            }
-        }
+        for (int a = 0; a < A; a++) sum = cadd(sum, trace(k.tr, rays[a], 1, -1, RAY_PRIMARY));
     }
-    r.c = cscale(sum, 1.0 / ((double)A * A));
-    return r;
+    return cscale(sum, 1.0 / ((double)A * A));
 }
 
 void put_pixel(const Job *job, int i, int j, pray_rgb c) {
@@ -4504,52 +4523,182 @@ void set_row_background(Worker &k, int j) {
     k.tr.bg = cadd(s->bg_top, cscale(cadd(s->bg_bottom, cscale(s->bg_top, -1)), f));
 }
 
-// Undersampling: the traced sample of pixel (i, j); the band's rows from y0 on are cached. A
-// pixel interpolated by one cell is traced when a neighbouring cell needs it as a corner.
-Sample &band_sample(Worker &k, int y0, int i, int j) {
-    Sample &x = k.cache[(j - y0) * k.job->s->width + i];
-    if (x.known != 1) {
-        set_row_background(k, j);
-        x = pixel(k, i, j);
+// Undersampling: the tile whose top left sample is (X0, Y0); sample (x, y) is sample
+// (x mod A, y mod A) of pixel (x / A, y / A).
+struct Tile {
+    int X0, Y0;
+};
+
+// The sample (x, y) of the tile, traced when it is not known yet.
+Sample &tile_sample(Worker &k, const Tile &t, int x, int y) {
+    const Scene *s = k.job->s;
+    int A = s->antialias;
+    Sample &v = k.cache[(y - t.Y0) * (k.job->tile + 1) + (x - t.X0)];
+    if (v.known != 1) {
+        set_row_background(k, y / A);
+        v.c = trace(k.tr, sample_ray(s, x / A, y / A, x % A, y % A), 1, -1, RAY_PRIMARY, &v.seen);
+        v.known = 1;
     }
-    return x;
+    return v;
 }
 
-// Fill the cell with corners (x0, y0) .. (x1, y1): interpolate when its corners agree, else split.
-void refine(Worker &k, int yb, int x0, int y0, int x1, int y1) {
-    Sample c00 = band_sample(k, yb, x0, y0), c10 = band_sample(k, yb, x1, y0);
-    Sample c01 = band_sample(k, yb, x0, y1), c11 = band_sample(k, yb, x1, y1);
+bool rgb_near(pray_rgb a, pray_rgb b, double th) {
+    return fabs(a.r - b.r) <= th && fabs(a.g - b.g) <= th && fabs(a.b - b.b) <= th;
+}
+
+// A cell whose corners see one textured primitive, on the same side, whose model is lit only,
+// lit alike at all four (the same lights in front, and what reaches the corners from each
+// differs by no more than the threshold): each sample in between is shaded at its own point of
+// the primitive, with its own texture, bumps and highlights, and the light the corners receive,
+// interpolated. No ray goes past the primitive: where only the texture changes, the cell costs
+// a ray-primitive test per sample instead of a ray and its shadow rays.
+bool shade_cell(Worker &k, const Tile &t, int x0, int y0, int x1, int y1, const Sample *const *c) {
+    double th = k.job->adaptive;
+    const Seen &c0 = c[0]->seen;
+    for (int i = 0; i < 4; i++) {
+        const Seen &a = c[i]->seen;
+        if (!a.lit_only || a.hit != c0.hit || a.enter != c0.enter || a.outward != c0.outward || a.lights != c0.lights)
+            return false;
+        for (int l = 0; l < SEEN_LIGHTS; l++)
+            for (int j = 0; j < i && (a.lights >> l & 1); j++)
+                if (!rgb_near(a.light[l], c[j]->seen.light[l], th)) return false;
+    }
+    const Scene *s = k.job->s;
+    const Prim &q = s->prims[c0.hit];
+    int A = s->antialias;
+    double sx = 1.0 / (x1 - x0 > 0 ? x1 - x0 : 1), sy = 1.0 / (y1 - y0 > 0 ? y1 - y0 : 1);
+    for (int y = y0; y <= y1; y++)
+        for (int x = x0; x <= x1; x++) {
+            Sample &v = k.cache[(y - t.Y0) * (k.job->tile + 1) + (x - t.X0)];
+            if (v.known) continue;
+            Ray r = sample_ray(s, x / A, y / A, x % A, y % A);
+            real t0, t1;
+            k.w.k.tests += 1;
+            int kind = prim_span(q, r, false, &t0, &t1);
+            real at = c0.enter ? t0 : t1;
+            if (kind != SPAN || !(at > 0) || !(at < REAL_INF)) {  // not where the corners are: trace it
+                tile_sample(k, t, x, y);
+                continue;
+            }
+            R3 p = r.o + r.d * at;
+            Seen e = c0;
+            R3 ds, dt;
+            tex_coords(q, p, &e.st[0], &e.st[1], &ds, &dt);
+            Shade sh;
+            shade_of(q.mat, e.st[0], e.st[1], &sh);
+            R3 n = shading_normal(q, p, sh, ds, dt, c0.outward != 0, r.d);
+            double fx = (x - x0) * sx, fy = (y - y0) * sy;
+            double w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+            pray_rgb col = cadd(sh.emit, sh.ambient);
+            bool lit = !czero(sh.diffuse) || !czero(sh.specular), traced = false;
+            for (int i = 0; lit && i < s->lights.n; i++) {
+                R3 l;
+                real dist;
+                if (!toward_light(s->lights[i], p, &l, &dist)) continue;
+                real ndl = dot(n, l);
+                if (ndl <= 0) continue;
+                if (!(c0.lights >> i & 1)) {  // a light the corners do not see: trace the sample
+                    tile_sample(k, t, x, y);
+                    traced = true;
+                    break;
+                }
+                pray_rgb li = cmake(0, 0, 0);
+                for (int j = 0; j < 4; j++) li = cadd(li, cscale(c[j]->seen.light[i], w[j]));
+                e.light[i] = li;
+                if (!czero(li)) phong_light(&col, &sh, li, n, l, ndl, r.d);
+            }
+            if (traced) continue;
+            v.c = col;
+            v.seen = e;
+            v.known = 2;
+        }
+    return true;
+}
+
+// Fill the cell with corner samples (x0, y0) .. (x1, y1): interpolate when its corners agree,
+// shade it when they differ only in their texture, else split it.
+void refine(Worker &k, const Tile &t, int x0, int y0, int x1, int y1) {
+    const Sample &c00 = tile_sample(k, t, x0, y0), &c10 = tile_sample(k, t, x1, y0);
+    const Sample &c01 = tile_sample(k, t, x0, y1), &c11 = tile_sample(k, t, x1, y1);
     double th = k.job->adaptive;
     if (x1 - x0 <= 1 && y1 - y0 <= 1) return;
     const Sample *corner[4] = {&c00, &c10, &c01, &c11};
-    if (!differ(c00, c10, th) && !differ(c00, c01, th) && !differ(c00, c11, th) && !differ(c10, c01, th) &&
-        !differ(c10, c11, th) && !differ(c01, c11, th) && !texture_between(k.job->s, corner, 4, th)) {
-        for (int j = y0; j <= y1; j++)
-            for (int i = x0; i <= x1; i++) {
-                Sample &x = k.cache[(j - yb) * k.job->s->width + i];
-                if (x.known) continue;
-                double fx = x1 > x0 ? (double)(i - x0) / (x1 - x0) : 0;
-                double fy = y1 > y0 ? (double)(j - y0) / (y1 - y0) : 0;
-                pray_rgb top = cadd(cscale(c00.c, 1 - fx), cscale(c10.c, fx));
-                pray_rgb bot = cadd(cscale(c01.c, 1 - fx), cscale(c11.c, fx));
-                x.c = cadd(cscale(top, 1 - fy), cscale(bot, fy));
-                x.hit = c00.hit;
-                x.known = 2;  // interpolated
+    bool same = !differ(c00, c10, th) && !differ(c00, c01, th) && !differ(c00, c11, th) && !differ(c10, c01, th) &&
+                !differ(c10, c11, th) && !differ(c01, c11, th);
+    if (!(same && !texture_between(k.job->s, corner, 4, th)) && shade_cell(k, t, x0, y0, x1, y1, corner)) return;
+    if (same && !texture_between(k.job->s, corner, 4, th)) {
+        bool flat = same_rgb(c00.c, c10.c) && same_rgb(c00.c, c01.c) && same_rgb(c00.c, c11.c);
+        double sx = x1 > x0 ? 1.0 / (x1 - x0) : 0, sy = y1 > y0 ? 1.0 / (y1 - y0) : 0;
+        for (int y = y0; y <= y1; y++) {
+            double fy = (y - y0) * sy;
+            pray_rgb l = cadd(cscale(c00.c, 1 - fy), cscale(c01.c, fy));  // down the cell's sides
+            pray_rgb r = cadd(cscale(c10.c, 1 - fy), cscale(c11.c, fy));
+            Sample *row = &k.cache[(y - t.Y0) * (k.job->tile + 1)];
+            for (int x = x0; x <= x1; x++) {
+                Sample &v = row[x - t.X0];
+                if (v.known) continue;
+                double fx = (x - x0) * sx;
+                v.c = flat ? c00.c : cadd(cscale(l, 1 - fx), cscale(r, fx));  // equal corners: exact
+                v.seen.hit = c00.seen.hit;  // (a sample interpolated is traced before it is a corner)
+                v.known = 2;
             }
+        }
         return;
     }
     int xm = (x0 + x1) / 2, ym = (y0 + y1) / 2;
     if (x1 - x0 <= 1) {
-        refine(k, yb, x0, y0, x1, ym);
-        refine(k, yb, x0, ym, x1, y1);
+        refine(k, t, x0, y0, x1, ym);
+        refine(k, t, x0, ym, x1, y1);
     } else if (y1 - y0 <= 1) {
-        refine(k, yb, x0, y0, xm, y1);
-        refine(k, yb, xm, y0, x1, y1);
+        refine(k, t, x0, y0, xm, y1);
+        refine(k, t, xm, y0, x1, y1);
     } else {
-        refine(k, yb, x0, y0, xm, ym);
-        refine(k, yb, xm, y0, x1, ym);
-        refine(k, yb, x0, ym, xm, y1);
-        refine(k, yb, xm, ym, x1, y1);
+        refine(k, t, x0, y0, xm, ym);
+        refine(k, t, xm, y0, x1, ym);
+        refine(k, t, x0, ym, xm, y1);
+        refine(k, t, xm, ym, x1, y1);
+    }
+}
+
+// Undersampling: a band of tiles, left to right. Its pixels are averages of their samples, in
+// the order of pixel(): where every sample is traced, the same colour as full sampling.
+void adaptive_band(Worker &k, int y0, int y1) {
+    const Job *job = k.job;
+    const Scene *s = job->s;
+    int A = s->antialias, T = job->tile, S = job->step, n = T + 1;
+    int SW = s->width * A, SH = s->height * A;
+    Tile t;
+    t.Y0 = y0 * A;
+    int Y1 = t.Y0 + T < SH - 1 ? t.Y0 + T : SH - 1;  // the band's last row of samples
+    for (int q = 0; q < n * n; q++) k.cache[q].known = 0;
+    for (t.X0 = 0;; t.X0 += T) {
+        int X1 = t.X0 + T < SW - 1 ? t.X0 + T : SW - 1;
+        for (int cy = t.Y0;; cy += S) {
+            int yl = cy + S < Y1 ? cy + S : Y1;
+            for (int cx = t.X0;; cx += S) {
+                int xl = cx + S < X1 ? cx + S : X1;
+                refine(k, t, cx, cy, xl, yl);
+                if (xl == X1) break;
+            }
+            if (yl == Y1) break;
+        }
+        int i1 = X1 == SW - 1 ? s->width : (t.X0 + T) / A;
+        for (int j = y0; j < y1; j++)
+            for (int i = t.X0 / A; i < i1; i++) {
+                pray_rgb sum = cmake(0, 0, 0);
+                for (int y = j * A; y < j * A + A; y++) {
+                    const Sample *row = &k.cache[(y - t.Y0) * n + (i * A - t.X0)];
+                    for (int a = 0; a < A; a++) sum = cadd(sum, row[a].c);
+                }
+                put_pixel(job, i, j, cscale(sum, 1.0 / ((double)A * A)));
+            }
+        if (X1 == SW - 1) break;
+        for (int y = 0; y < n; y++)  // the last column is the next tile's first
+            for (int x = 0; x < n; x++) {
+                Sample &v = k.cache[y * n + x];
+                if (x == 0) v = k.cache[y * n + T];
+                else v.known = 0;
+            }
     }
 }
 
@@ -4559,38 +4708,23 @@ void render_band(Worker &k, int band) {
     int W = s->width, H = s->height;
     int y0 = band * job->band_rows, y1 = y0 + job->band_rows;
     if (y1 > H) y1 = H;
-    if (job->adaptive <= 0) {
-        Ray rays[RAY_BATCH];
-        for (int j = y0; j < y1; j++) {
-            set_row_background(k, j);
-            if (s->antialias > 1) {  // pixel() makes each row of samples ahead
-                for (int i = 0; i < W; i++) put_pixel(job, i, j, pixel(k, i, j).c);
-                continue;
-            }
-            for (int i0 = 0; i0 < W; i0 += RAY_BATCH) {
-                int n = W - i0 < RAY_BATCH ? W - i0 : RAY_BATCH;
-                for (int q = 0; q < n; q++) rays[q] = sample_ray(s, i0 + q, j, 0, 0);
-                for (int q = 0; q < n; q++) put_pixel(job, i0 + q, j, trace(k.tr, rays[q], 1, -1, RAY_PRIMARY));
-            }
-        }
+    if (job->adaptive > 0) {
+        adaptive_band(k, y0, y1);
         return;
     }
-    // the band's cells span rows y0 .. y0 + band_rows (the last row shared with the next band)
-    for (int q = 0; q < (job->band_rows + 1) * W; q++) k.cache[q].known = 0;
-    int step = job->step;
-    for (int cy = y0; cy < y1; cy += step) {
-        int yl = cy + step < H - 1 ? cy + step : H - 1;
-        for (int x0 = 0; x0 < W - 1 || x0 == 0; x0 += step) {
-            int x1 = x0 + step < W - 1 ? x0 + step : W - 1;
-            refine(k, y0, x0, cy, x1, yl);
-            if (x1 == W - 1) break;
+    Ray rays[RAY_BATCH];
+    for (int j = y0; j < y1; j++) {
+        set_row_background(k, j);
+        if (s->antialias > 1) {  // pixel() makes each row of samples ahead
+            for (int i = 0; i < W; i++) put_pixel(job, i, j, pixel(k, i, j));
+            continue;
+        }
+        for (int i0 = 0; i0 < W; i0 += RAY_BATCH) {
+            int n = W - i0 < RAY_BATCH ? W - i0 : RAY_BATCH;
+            for (int q = 0; q < n; q++) rays[q] = sample_ray(s, i0 + q, j, 0, 0);
+            for (int q = 0; q < n; q++) put_pixel(job, i0 + q, j, trace(k.tr, rays[q], 1, -1, RAY_PRIMARY));
         }
     }
-    for (int j = y0; j < y1; j++)
-        for (int i = 0; i < W; i++) {
-            const Sample &x = k.cache[(j - y0) * W + i];
-            put_pixel(job, i, j, x.known ? x.c : band_sample(k, y0, i, j).c);
-        }
 }
 
 void worker_main(void *arg) {
@@ -4626,8 +4760,9 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
     job.s = s;
     job.out = out;
     job.adaptive = c->cur.opt.v[OPT_ADAPTIVE];
-    job.step = s->antialias > 1 ? ADAPT_STEP_AA : ADAPT_STEP;
-    job.band_rows = job.adaptive > 0 ? job.step * ADAPT_BAND : 4;
+    job.step = s->antialias * (s->antialias > 1 ? ADAPT_PIXELS_AA : ADAPT_PIXELS);
+    job.tile = job.step * (ADAPT_TILE > job.step ? ADAPT_TILE / job.step : 1);
+    job.band_rows = job.adaptive > 0 ? job.tile / s->antialias : 4;
     for (int i = 0; job.adaptive > 0 && i < s->prims.n; i++)  // undersampling looks into textures
         if (!model_pyramids(c, s->prims[i].mat)) return c->status;
     job.bands = (s->height + job.band_rows - 1) / job.band_rows;
@@ -4646,7 +4781,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
         k.job = &job;
         k.cache.init();
         if (!scratch_init(c, &k.w, s)) st = c->status;
-        else if (job.adaptive > 0 && !k.cache.reserve(c, (job.band_rows + 1) * s->width)) st = c->status;
+        else if (job.adaptive > 0 && !k.cache.reserve(c, (job.tile + 1) * (job.tile + 1))) st = c->status;
         k.tr.s = s;
         k.tr.w = &k.w;
         args[made] = &k;

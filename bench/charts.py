@@ -5,7 +5,7 @@ Run by bench/charts.sh (`make charts`), which installs python3-matplotlib and bu
 Renders a set of gallery scenes and measures, with one thread, the best of REPS runs made in
 separate passes over all the settings of a measurement (more when the machine was busy):
 
-  adaptive   render time against error for undersampling thresholds, at antialias 1 and 4
+  adaptive   render time against error for undersampling thresholds, at antialias 1, 4 and 8
   antialias  render time against error for antialias 1, 2, 3, 4, 8
   grid       time for grid resolutions (none, fixed, automatic); the images must be identical
   precision  the single-precision build (PRAY_REAL=float) against the double one
@@ -59,7 +59,7 @@ DISTURBED = 0.25      # a run during which other work took more than this share 
 EXTRA = 3             # ... is repeated, at most EXTRA more times, while it is the fastest
 DEFAULT_ADAPTIVE = 0.02   # the threshold the manual recommends ("try 0.02"); the option's default is 0 = off
 THRESHOLDS = [0, 0.005, 0.02, 0.05, 0.1, 0.2]
-ADAPTIVE_AA = [1, 4]
+ADAPTIVE_AA = [1, 4, 8]
 ANTIALIAS = [1, 2, 3, 4, 8]
 GRIDS = [0, 8, 16, 32, 64, -1]   # voxels along the longest axis; 0 = none, -1 = automatic
 THREAD_AA = 4         # the threads are compared on 4 x 4 samples per pixel (longer renders)

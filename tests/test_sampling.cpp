@@ -85,6 +85,44 @@ TEST_CASE("undersampling: off by default, fewer primary rays when on, exact wher
     pray_free(c);
 }
 
+TEST_CASE("undersampling refines edges down to single samples: flat colours come out as fully sampled") {
+    // A flat white rectangle on black, head-on, its sides between samples. A cell of the lattice
+    // whose corners all see the face lies on it, one whose corners all see the background lies
+    // off it (the face is convex and larger than a cell), and the cells across a side are split
+    // down to neighbouring samples: every sample ends up as full sampling traces it. The image
+    // is several tiles wide and several bands high.
+    std::string prog =
+        "parallel <1, 0, 0>, <0, 0, -1>, [0, -4, 0], [0, 0, 0]\n"
+        "W = color({1})\n"
+        "rendertiff plane(W, [0, 0, 0], <0, -1, 0>) & plane(W, [0.37, 0, 0], <1, 0, 0>) & "
+        "plane(W, [-0.41, 0, 0], <-1, 0, 0>) & plane(W, [0, 0, 0.29], <0, 0, 1>) & "
+        "plane(W, [0, 0, -0.53], <0, 0, -1>), none\n";
+    for (int aa : {1, 3, 4}) {
+        CAPTURE(aa);
+        std::vector<testkit::Frame> frames;
+        pray_stats st[2];
+        for (int on = 0; on < 2; on++) {
+            pray_ctx *c = pray_new();
+            pray_option(c, "width", 90);
+            pray_option(c, "height", 70);
+            pray_option(c, "antialias", aa);
+            pray_option(c, "adaptive", on ? 0.02 : 0);
+            pray_set_frame(c, testkit::frame_sink, &frames);
+            REQUIRE(pray_run_string(c, "rect.ray", prog.data(), prog.size()) == PRAY_OK);
+            pray_stats_get(c, &st[on]);
+            pray_free(c);
+        }
+        REQUIRE(frames.size() == 2);
+        REQUIRE(frames[0].at(45, 35, 0) == 1.0f);  // the face is in view, and its sides cut pixels
+        REQUIRE(frames[0].at(0, 0, 0) == 0.0f);
+        int partial = 0;
+        for (float v : frames[0].pixels) partial += v > 0 && v < 1;
+        REQUIRE(partial > (aa > 1 ? 0 : -1));
+        CHECK(frames[1].pixels == frames[0].pixels);
+        CHECK(st[1].rays_primary * (aa == 1 ? 3 : 6) < st[0].rays_primary);  // about one ray a pixel
+    }
+}
+
 TEST_CASE("undersampling with threshold 0 is full sampling: the same image, every primary ray") {
     for (const char *file : {"examples/csg.ray", "examples/glass.ray", "examples/holes.ray"}) {
         CAPTURE(file);

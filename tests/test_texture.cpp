@@ -2022,7 +2022,8 @@ std::string texture_view(const TempDir &d, const char *name, std::vector<float> 
 TEST_CASE("undersampling keeps texture detail that falls between its samples") {
     // A white texture with one black row of texels, one texel to a pixel, seen head-on by a
     // parallel camera: the row lands on image row 21, between the rows of the coarse lattice
-    // (every 4th pixel; every 2nd with antialiasing), where all lattice samples are white.
+    // (every 4th pixel; with antialiasing, a sample of every pixel), where all lattice samples
+    // are white.
     TempDir d;
     REQUIRE(!d.path.empty());
     std::vector<float> px(64 * 64 * 3, 1.0f);
@@ -2079,4 +2080,65 @@ TEST_CASE("undersampling: a texture that only ramps between samples is interpola
     REQUIRE(frames.size() == 1);
     CHECK(frames[0].at(63, 32, 0) - frames[0].at(0, 32, 0) > 0.9f);  // the whole ramp is in view
     CHECK(st.rays_primary < st.rays_primary_full / 6);  // 499 of 4096; refined for any spread: 1114
+}
+
+TEST_CASE("undersampling shades a lit textured surface sample by sample with the corners' light") {
+    // A striped, bump-mapped face seen head-on, lit by a directional light and a point light. A
+    // box out of view shades a quadrant of the face from the directional light: the shadow's
+    // edges are straight and along the image's axes. Where the corners of a cell see the face
+    // lit alike, its samples are shaded at their own points (texture, bumps, highlights) with
+    // the corners' light; across the shadow's edges the cells are split down to samples. The
+    // image is full sampling's, to rounding, for a fraction of the primary and shadow rays.
+    TempDir d;
+    REQUIRE(!d.path.empty());
+    std::vector<float> px(64 * 64 * 3);
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++)
+            for (int k = 0; k < 3; k++) px[(y * 64 + x) * 3 + k] = (x / 3 + y / 5) % 2 ? 1.0f : 0.2f;
+    pray_image tex;
+    tex.width = tex.height = 64;
+    tex.pixels = px.data();
+    {
+        Ctx c;
+        REQUIRE(pray_write_image(c, &tex, (d / "stripes.tif").c_str(), 8) == PRAY_OK);
+    }
+    std::string f = "\"" + d / "stripes.tif" + "\"";
+    std::string prog =
+        "parallel <1, 0, 0>, <0, 0, -1>, [0, -4, 0], [0, 0, 0]\n"
+        "M = tiffbump(tiff(phong({0.1, 0.2, 0.1}, {0.4}, 20), phong({0.9, 0.8, 0.6}, {0.4}, 20), " + f + "), 0.01, " + f + ")\n"
+        "Face = planemap(M, [-1, 0, -1], <0, -1, 0>, <2, 0, 0>, <0, 0, 2>)\n"
+        "G = phong({0.5}, {0}, 1)\n"
+        "Box = plane(G, [0, -2, 0], <0, -1, 0>) & plane(G, [0, -1.5, 0], <0, 1, 0>) & plane(G, [0, 0, 1.3], <0, 0, -1>) "
+        "& plane(G, [0, 0, 5], <0, 0, 1>) & plane(G, [0.13, 0, 0], <1, 0, 0>) & plane(G, [-5, 0, 0], <-1, 0, 0>)\n"
+        "rendertiff Face | Box, dirlight({0.7}, <0, 1, -1>), pointlight({0.5}, [0.3, -3, -0.2])\n";
+    std::vector<testkit::Frame> frames;
+    pray_stats st[2];
+    for (int on = 0; on < 2; on++) {
+        Ctx c;
+        pray_option(c, "width", 64);
+        pray_option(c, "height", 64);
+        pray_option(c, "antialias", 2);
+        pray_option(c, "adaptive", on ? 0.02 : 0);
+        pray_set_frame(c, testkit::frame_sink, &frames);
+        REQUIRE_MESSAGE(pray_run_string(c, "lit.ray", prog.data(), prog.size()) == PRAY_OK, pray_error(c));
+        pray_stats_get(c, &st[on]);
+    }
+    REQUIRE(frames.size() == 2);
+    // the shadow is there: x < 0.13 and z > -0.7 (upper left) is darker than the lit part
+    // beside it, on the same stripe
+    float lit = 0, dark = 0;
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++) {
+            bool shade = (x + 0.5) / 32 - 1 < 0.13 && 1 - (y + 0.5) / 32 > -0.7;
+            (shade ? dark : lit) += frames[0].at(x, y, 0);
+        }
+    REQUIRE(dark / (0.565 * 0.85 * 4096) < 0.8 * lit / (4096 - 0.565 * 0.85 * 4096));
+    float worst = 0;
+    for (size_t i = 0; i < frames[0].pixels.size(); i++) {
+        float e = std::fabs(frames[1].pixels[i] - frames[0].pixels[i]);
+        worst = e > worst ? e : worst;
+    }
+    CHECK(worst < 1e-5f);
+    CHECK(st[1].rays_primary * 3 < st[0].rays_primary);
+    CHECK(st[1].rays_shadow * 3 < st[0].rays_shadow);
 }
