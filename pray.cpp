@@ -4218,8 +4218,6 @@ pray_rgb transmit_at(const Prim &q, R3 x) {
     return sh.transmit;
 }
 
-// The colour a ray brings back. `hit`, when given, receives the primitive it meets (-1: none);
-// `st`, when given, the texture coordinates there (0, 0 when the primitive's model has no texture).
 // Whether a model's look at a point follows from the light arriving there and the model's
 // coefficients at the point's texture coordinates: no mirror and no transparency (their rays
 // would see other parts of the scene). Bump maps are fine: they only turn the normal.
@@ -4284,6 +4282,7 @@ R3 shading_normal(const Prim &q, R3 x, const Shade &sh, R3 ds, R3 dt, bool outwa
     return n;
 }
 
+// The colour a ray brings back; `seen`, when given, receives what it saw.
 pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *seen = NULL) {
     const Scene *s = tr.s;
     if (seen) seen->hit = -1, seen->lit_only = 0, seen->st[0] = seen->st[1] = 0;
@@ -4432,12 +4431,12 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
 }
 
 // ---- the render driver: bands of rows handed out to threads; undersampling (3.2) ----
-// A sample: a pixel's colour, the primitive its centre ray meets and the texture coordinates
-// there (when that primitive has a texture).
+// A sample of undersampling: its colour and what its ray saw (traced samples only; of an
+// interpolated or shaded one only the primitive is kept, and it is traced before it is a corner).
 struct Sample {
     pray_rgb c;
     Seen seen;
-    int known;  // undersampling: 0 not yet, 1 traced, 2 interpolated
+    int known;  // 0 not yet, 1 traced, 2 interpolated or shaded
 };
 
 struct Job;
@@ -4464,7 +4463,8 @@ struct Job {
 
 // Undersampling works on the image's samples (antialias x antialias per pixel, in one lattice
 // over the whole image): a coarse lattice of them is traced, every 4th pixel, or with antialias
-// the samples 2 pixels apart; a cell whose corners differ is split, down to neighbouring samples.
+// one sample of every pixel (thin geometry between samples 2 pixels apart, the pc's text, was
+// lost); a cell whose corners differ is split, down to neighbouring samples.
 // The samples of a tile are kept; a tile hands its last column to the next one and a band of
 // tiles traces its last row again (a band is one row of tiles).
 const int ADAPT_PIXELS = 4, ADAPT_PIXELS_AA = 1;
@@ -4580,12 +4580,11 @@ bool shade_cell(Worker &k, const Tile &t, int x0, int y0, int x1, int y1, const 
                 tile_sample(k, t, x, y);
                 continue;
             }
-            R3 p = r.o + r.d * at;
-            Seen e = c0;
-            R3 ds, dt;
-            tex_coords(q, p, &e.st[0], &e.st[1], &ds, &dt);
+            R3 p = r.o + r.d * at, ds, dt;
+            double ts, tt;
+            tex_coords(q, p, &ts, &tt, &ds, &dt);
             Shade sh;
-            shade_of(q.mat, e.st[0], e.st[1], &sh);
+            shade_of(q.mat, ts, tt, &sh);
             R3 n = shading_normal(q, p, sh, ds, dt, c0.outward != 0, r.d);
             double fx = (x - x0) * sx, fy = (y - y0) * sy;
             double w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
@@ -4604,12 +4603,11 @@ bool shade_cell(Worker &k, const Tile &t, int x0, int y0, int x1, int y1, const 
                 }
                 pray_rgb li = cmake(0, 0, 0);
                 for (int j = 0; j < 4; j++) li = cadd(li, cscale(c[j]->seen.light[i], w[j]));
-                e.light[i] = li;
                 if (!czero(li)) phong_light(&col, &sh, li, n, l, ndl, r.d);
             }
             if (traced) continue;
             v.c = col;
-            v.seen = e;
+            v.seen.hit = c0.hit;
             v.known = 2;
         }
     return true;
@@ -4623,10 +4621,10 @@ void refine(Worker &k, const Tile &t, int x0, int y0, int x1, int y1) {
     double th = k.job->adaptive;
     if (x1 - x0 <= 1 && y1 - y0 <= 1) return;
     const Sample *corner[4] = {&c00, &c10, &c01, &c11};
-    bool same = !differ(c00, c10, th) && !differ(c00, c01, th) && !differ(c00, c11, th) && !differ(c10, c01, th) &&
-                !differ(c10, c11, th) && !differ(c01, c11, th);
-    if (!(same && !texture_between(k.job->s, corner, 4, th)) && shade_cell(k, t, x0, y0, x1, y1, corner)) return;
-    if (same && !texture_between(k.job->s, corner, 4, th)) {
+    bool smooth = !differ(c00, c10, th) && !differ(c00, c01, th) && !differ(c00, c11, th) && !differ(c10, c01, th) &&
+                  !differ(c10, c11, th) && !differ(c01, c11, th) && !texture_between(k.job->s, corner, 4, th);
+    if (!smooth && shade_cell(k, t, x0, y0, x1, y1, corner)) return;
+    if (smooth) {
         bool flat = same_rgb(c00.c, c10.c) && same_rgb(c00.c, c01.c) && same_rgb(c00.c, c11.c);
         double sx = x1 > x0 ? 1.0 / (x1 - x0) : 0, sy = y1 > y0 ? 1.0 / (y1 - y0) : 0;
         for (int y = y0; y <= y1; y++) {
