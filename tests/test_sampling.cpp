@@ -99,20 +99,9 @@ TEST_CASE("undersampling refines edges down to single samples: flat colours come
         "plane(W, [0, 0, -0.53], <0, 0, -1>), none\n";
     for (int aa : {1, 3, 4}) {
         CAPTURE(aa);
-        std::vector<testkit::Frame> frames;
-        pray_stats st[2];
-        for (int on = 0; on < 2; on++) {
-            pray_ctx *c = pray_new();
-            pray_option(c, "width", 90);
-            pray_option(c, "height", 70);
-            pray_option(c, "antialias", aa);
-            pray_option(c, "adaptive", on ? 0.02 : 0);
-            pray_set_frame(c, testkit::frame_sink, &frames);
-            REQUIRE(pray_run_string(c, "rect.ray", prog.data(), prog.size()) == PRAY_OK);
-            pray_stats_get(c, &st[on]);
-            pray_free(c);
-        }
-        REQUIRE(frames.size() == 2);
+        testkit::Sampled r = testkit::full_and_adaptive(prog, 90, 70, aa, 0.02);
+        const std::vector<testkit::Frame> &frames = r.frames;
+        const pray_stats *st = r.st;
         REQUIRE(frames[0].at(45, 35, 0) == 1.0f);  // the face is in view, and its sides cut pixels
         REQUIRE(frames[0].at(0, 0, 0) == 0.0f);
         int partial = 0;

@@ -2005,16 +2005,31 @@ TEST_CASE("textures: on the command line a missing texture exits with 1 and writ
 
 namespace {
 
-// A 64 x 64 texture written as `name` in d, and a program showing it head-on through a parallel
-// camera over x, z in [-1, 1], the texture's corner at `corner`, one texel to a pixel at 64 x 64.
-std::string texture_view(const TempDir &d, const char *name, std::vector<float> &px, int bits, const char *corner) {
+// A grey 64 x 64 texture: texel (x, y) is v(x, y) in every channel.
+template <class F>
+std::vector<float> grey_texels(F v) {
+    std::vector<float> px(64 * 64 * 3);
+    for (int y = 0; y < 64; y++)
+        for (int x = 0; x < 64; x++)
+            for (int k = 0; k < 3; k++) px[(y * 64 + x) * 3 + k] = v(x, y);
+    return px;
+}
+
+// A 64 x 64 texture of RGB pixels px written as `name` in d; its path in quotes, for a program.
+std::string texture_file(const TempDir &d, const char *name, std::vector<float> &px, int bits) {
     pray_image tex;
     tex.width = tex.height = 64;
     tex.pixels = px.data();
     Ctx c;
     REQUIRE(pray_write_image(c, &tex, (d / name).c_str(), bits) == PRAY_OK);
-    return std::string("parallel <1, 0, 0>, <0, 0, -1>, [0, -4, 0], [0, 0, 0]\n") + "M = tiff(color({0}), color({1}), \"" +
-           (d / name) + "\")\nrendertiff planemap(M, " + corner + ", <0, -1, 0>, <2, 0, 0>, <0, 0, 2>), none\n";
+    return "\"" + d / name + "\"";
+}
+
+// The texture written as `name` in d, and a program showing it head-on through a parallel
+// camera over x, z in [-1, 1], the texture's corner at `corner`, one texel to a pixel at 64 x 64.
+std::string texture_view(const TempDir &d, const char *name, std::vector<float> &px, int bits, const char *corner) {
+    return std::string("parallel <1, 0, 0>, <0, 0, -1>, [0, -4, 0], [0, 0, 0]\n") + "M = tiff(color({0}), color({1}), " +
+           texture_file(d, name, px, bits) + ")\nrendertiff planemap(M, " + corner + ", <0, -1, 0>, <2, 0, 0>, <0, 0, 2>), none\n";
 }
 
 } // namespace
@@ -2032,19 +2047,9 @@ TEST_CASE("undersampling keeps texture detail that falls between its samples") {
     std::string prog = texture_view(d, "line.tif", px, 8, "[0, 0, 0]");
     for (int aa : {1, 3}) {
         CAPTURE(aa);
-        std::vector<testkit::Frame> frames;
-        pray_stats st[2];
-        for (int on = 0; on < 2; on++) {
-            Ctx c;
-            pray_option(c, "width", 64);
-            pray_option(c, "height", 64);
-            pray_option(c, "antialias", aa);
-            pray_option(c, "adaptive", on ? 0.05 : 0);
-            pray_set_frame(c, testkit::frame_sink, &frames);
-            REQUIRE(pray_run_string(c, "line.ray", prog.data(), prog.size()) == PRAY_OK);
-            pray_stats_get(c, &st[on]);
-        }
-        REQUIRE(frames.size() == 2);
+        testkit::Sampled r = testkit::full_and_adaptive(prog, 64, 64, aa, 0.05);
+        const std::vector<testkit::Frame> &frames = r.frames;
+        const pray_stats *st = r.st;
         for (int x = 0; x < 64; x++) {
             CAPTURE(x);
             REQUIRE(frames[0].at(x, 21, 0) < 0.5f);  // the line is there in the full image
@@ -2061,10 +2066,7 @@ TEST_CASE("undersampling: a texture that only ramps between samples is interpola
     // lattice samples it stays within their values, so nothing is refined for the texture.
     TempDir d;
     REQUIRE(!d.path.empty());
-    std::vector<float> px(64 * 64 * 3);
-    for (int y = 0; y < 64; y++)
-        for (int x = 0; x < 64; x++)
-            for (int k = 0; k < 3; k++) px[(y * 64 + x) * 3 + k] = (float)(x / 63.0);
+    std::vector<float> px = grey_texels([](int x, int) { return (float)(x / 63.0); });
     // lattice samples 4 pixels apart differ by 4/63, under the threshold 0.08, while the texels
     // between them and their neighbours span 6/63, over it
     std::string prog = texture_view(d, "ramp.tif", px, 16, "[-1, 0, 0]");
@@ -2091,18 +2093,8 @@ TEST_CASE("undersampling shades a lit textured surface sample by sample with the
     // image is full sampling's, to rounding, for a fraction of the primary and shadow rays.
     TempDir d;
     REQUIRE(!d.path.empty());
-    std::vector<float> px(64 * 64 * 3);
-    for (int y = 0; y < 64; y++)
-        for (int x = 0; x < 64; x++)
-            for (int k = 0; k < 3; k++) px[(y * 64 + x) * 3 + k] = (x / 3 + y / 5) % 2 ? 1.0f : 0.2f;
-    pray_image tex;
-    tex.width = tex.height = 64;
-    tex.pixels = px.data();
-    {
-        Ctx c;
-        REQUIRE(pray_write_image(c, &tex, (d / "stripes.tif").c_str(), 8) == PRAY_OK);
-    }
-    std::string f = "\"" + d / "stripes.tif" + "\"";
+    std::vector<float> px = grey_texels([](int x, int y) { return (x / 3 + y / 5) % 2 ? 1.0f : 0.2f; });
+    std::string f = texture_file(d, "stripes.tif", px, 8);
     std::string prog =
         "parallel <1, 0, 0>, <0, 0, -1>, [0, -4, 0], [0, 0, 0]\n"
         "M = tiffbump(tiff(phong({0.1, 0.2, 0.1}, {0.4}, 20), phong({0.9, 0.8, 0.6}, {0.4}, 20), " + f + "), 0.01, " + f + ")\n"
@@ -2111,21 +2103,11 @@ TEST_CASE("undersampling shades a lit textured surface sample by sample with the
         "Box = plane(G, [0, -2, 0], <0, -1, 0>) & plane(G, [0, -1.5, 0], <0, 1, 0>) & plane(G, [0, 0, 1.3], <0, 0, -1>) "
         "& plane(G, [0, 0, 5], <0, 0, 1>) & plane(G, [0.13, 0, 0], <1, 0, 0>) & plane(G, [-5, 0, 0], <-1, 0, 0>)\n"
         "rendertiff Face | Box, dirlight({0.7}, <0, 1, -1>), pointlight({0.5}, [0.3, -3, -0.2])\n";
-    std::vector<testkit::Frame> frames;
-    pray_stats st[2];
-    for (int on = 0; on < 2; on++) {
-        Ctx c;
-        pray_option(c, "width", 64);
-        pray_option(c, "height", 64);
-        pray_option(c, "antialias", 2);
-        pray_option(c, "adaptive", on ? 0.02 : 0);
-        pray_set_frame(c, testkit::frame_sink, &frames);
-        REQUIRE_MESSAGE(pray_run_string(c, "lit.ray", prog.data(), prog.size()) == PRAY_OK, pray_error(c));
-        pray_stats_get(c, &st[on]);
-    }
-    REQUIRE(frames.size() == 2);
-    // the shadow is there: x < 0.13 and z > -0.7 (upper left) is darker than the lit part
-    // beside it, on the same stripe
+    testkit::Sampled r = testkit::full_and_adaptive(prog, 64, 64, 2, 0.02);
+    const std::vector<testkit::Frame> &frames = r.frames;
+    const pray_stats *st = r.st;
+    // the shadow is there: on average the part with x < 0.13 and z > -0.7 (upper left) is
+    // darker than the rest
     float lit = 0, dark = 0;
     for (int y = 0; y < 64; y++)
         for (int x = 0; x < 64; x++) {

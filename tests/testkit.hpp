@@ -58,6 +58,30 @@ inline Result run(const std::string &program, const std::vector<std::string> &op
     return r;
 }
 
+// A program rendered at w x h with antialias aa twice: fully sampled (frames[0], st[0]), then
+// undersampled with threshold th (frames[1], st[1]). Both runs must succeed.
+struct Sampled {
+    std::vector<Frame> frames;
+    pray_stats st[2];
+};
+inline Sampled full_and_adaptive(const std::string &program, int w, int h, int aa, double th) {
+    Sampled r;
+    for (int on = 0; on < 2; on++) {
+        pray_ctx *c = pray_new();
+        pray_option(c, "width", w);
+        pray_option(c, "height", h);
+        pray_option(c, "antialias", aa);
+        pray_option(c, "adaptive", on ? th : 0);
+        pray_set_frame(c, frame_sink, &r.frames);
+        pray_status st = pray_run_string(c, "sampled.ray", program.data(), program.size());
+        REQUIRE_MESSAGE(st == PRAY_OK, pray_error(c));
+        pray_stats_get(c, &r.st[on]);
+        pray_free(c);
+    }
+    REQUIRE(r.frames.size() == 2);
+    return r;
+}
+
 // Printed output of a program that must succeed ("" and a failed check otherwise).
 inline std::string printed(const std::string &program) { return run(program).printed; }
 
