@@ -568,6 +568,10 @@ pray_rgb cscale(pray_rgb a, double s) { return cmake(a.r * s, a.g * s, a.b * s);
 bool cfinite(pray_rgb a) { return finite_num(a.r) && finite_num(a.g) && finite_num(a.b); }
 bool czero(pray_rgb a) { return a.r == 0 && a.g == 0 && a.b == 0; }
 bool same_rgb(pray_rgb a, pray_rgb b) { return a.r == b.r && a.g == b.g && a.b == b.b; }
+// No channel differs by more than th.
+bool rgb_near(pray_rgb a, pray_rgb b, double th) {
+    return fabs(a.r - b.r) <= th && fabs(a.g - b.g) <= th && fabs(a.b - b.b) <= th;
+}
 
 double cbrt_pos(double x) { return x > 0 ? pow(x, 1.0 / 3.0) : 0; }
 
@@ -4471,7 +4475,7 @@ const int ADAPT_PIXELS = 4, ADAPT_PIXELS_AA = 1;
 const int ADAPT_TILE = 64;  // samples along a tile's side, at least (at least one cell)
 
 bool differ(const Sample &a, const Sample &b, double th) {
-    return a.seen.hit != b.seen.hit || fabs(a.c.r - b.c.r) > th || fabs(a.c.g - b.c.g) > th || fabs(a.c.b - b.c.b) > th;
+    return a.seen.hit != b.seen.hit || !rgb_near(a.c, b.c, th);
 }
 
 // Detail between samples that agree: they all meet one textured primitive, and its texture
@@ -4540,10 +4544,6 @@ Sample &tile_sample(Worker &k, const Tile &t, int x, int y) {
         v.known = 1;
     }
     return v;
-}
-
-bool rgb_near(pray_rgb a, pray_rgb b, double th) {
-    return fabs(a.r - b.r) <= th && fabs(a.g - b.g) <= th && fabs(a.b - b.b) <= th;
 }
 
 // A cell whose corners see one textured primitive, on the same side, whose model is lit only,
