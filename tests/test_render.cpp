@@ -165,6 +165,13 @@ TEST_CASE("phong: specular term S*I*max(0, R.V)^E") {
     f = frame_of(std::string(ONE) + "rendertiff " + facing_plane("phong({0}, {1}, 20)") + ", dirlight({1}, <0, sqrt(3), -1>)\n");
     want = std::pow(c30, 20);
     check_near(f, 0, 0, want, want, want);
+    // whole exponents are taken by repeated squaring, others by pow: both give c30^E
+    f = frame_of(std::string(ONE) + "rendertiff " + facing_plane("phong({0}, {1}, 2.5)") + ", dirlight({1}, <0, sqrt(3), -1>)\n");
+    want = std::pow(c30, 2.5);
+    check_near(f, 0, 0, want, want, want);
+    f = frame_of(std::string(ONE) + "rendertiff " + facing_plane("phong({0}, {1}, 1000)") + ", dirlight({1}, <0, sqrt(3), -1>)\n");
+    want = std::pow(c30, 1000);  // 5e-63: black, not the 1 of a power left undone
+    check_near(f, 0, 0, want, want, want);
 }
 
 TEST_CASE("shadows: an occluder between the plane and the light leaves the ambient term only") {
