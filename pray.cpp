@@ -4544,11 +4544,16 @@ struct Tile {
     int X0, Y0;
 };
 
+// Where the tile keeps its sample (x, y) (a row of samples runs on from there).
+Sample *tile_at(Worker &k, const Tile &t, int x, int y) {
+    return &k.cache[(y - t.Y0) * (k.job->tile + 1) + (x - t.X0)];
+}
+
 // The sample (x, y) of the tile, traced when it is not known yet.
 Sample &tile_sample(Worker &k, const Tile &t, int x, int y) {
     const Scene *s = k.job->s;
     int A = s->antialias;
-    Sample &v = k.cache[(y - t.Y0) * (k.job->tile + 1) + (x - t.X0)];
+    Sample &v = *tile_at(k, t, x, y);
     if (v.known != 1) {
         set_row_background(k, y / A);
         v.c = trace(k.tr, sample_ray(s, x / A, y / A, x % A, y % A), 1, -1, RAY_PRIMARY, &v.seen);
@@ -4580,7 +4585,7 @@ bool shade_cell(Worker &k, const Tile &t, int x0, int y0, int x1, int y1, const 
     double sx = 1.0 / (x1 - x0 > 0 ? x1 - x0 : 1), sy = 1.0 / (y1 - y0 > 0 ? y1 - y0 : 1);
     for (int y = y0; y <= y1; y++)
         for (int x = x0; x <= x1; x++) {
-            Sample &v = k.cache[(y - t.Y0) * (k.job->tile + 1) + (x - t.X0)];
+            Sample &v = *tile_at(k, t, x, y);
             if (v.known) continue;
             Ray r = sample_ray(s, x / A, y / A, x % A, y % A);
             real t0, t1;
@@ -4642,9 +4647,9 @@ void refine(Worker &k, const Tile &t, int x0, int y0, int x1, int y1) {
             double fy = (y - y0) * sy;
             pray_rgb l = cadd(cscale(c00.c, 1 - fy), cscale(c01.c, fy));  // down the cell's sides
             pray_rgb r = cadd(cscale(c10.c, 1 - fy), cscale(c11.c, fy));
-            Sample *row = &k.cache[(y - t.Y0) * (k.job->tile + 1)];
+            Sample *row = tile_at(k, t, x0, y);
             for (int x = x0; x <= x1; x++) {
-                Sample &v = row[x - t.X0];
+                Sample &v = row[x - x0];
                 if (v.known) continue;
                 double fx = (x - x0) * sx;
                 v.c = flat ? c00.c : cadd(cscale(l, 1 - fx), cscale(r, fx));  // equal corners: exact
@@ -4696,7 +4701,7 @@ void adaptive_band(Worker &k, int y0, int y1) {
             for (int i = t.X0 / A; i < i1; i++) {
                 pray_rgb sum = cmake(0, 0, 0);
                 for (int y = j * A; y < j * A + A; y++) {
-                    const Sample *row = &k.cache[(y - t.Y0) * n + (i * A - t.X0)];
+                    const Sample *row = tile_at(k, t, i * A, y);
                     for (int a = 0; a < A; a++) sum = cadd(sum, row[a].c);
                 }
                 put_pixel(job, i, j, cscale(sum, 1.0 / ((double)A * A)));
