@@ -3017,11 +3017,10 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
             real t0, t1;
             bool tie = false;
             if (i < np) {  // the primitives: the members of intersections are gathered first
+                // (computed afresh, not through span_get: cheaper than its book-keeping here)
                 p = prims[i];
-                const Span &sp = span_get(s, w, ray, p, self);
-                kind = sp.kind;
-                t0 = sp.t0;
-                t1 = sp.t1;
+                w->k.tests += 1;
+                kind = prim_span(s->prims[p], ray, twin(s, p, self), &t0, &t1);
                 enter = !(plan[i] & 1);
                 if (!enter) {  // a half-space (one end of its span infinite) turned inside out
                     if (kind != SPAN) kind = kind == SPAN_ALL ? SPAN_NONE : SPAN_ALL;
