@@ -311,7 +311,7 @@ struct Block {
 // Options by index; the table in section 6 has their names, defaults and ranges.
 enum {
     OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_DEPTH, OPT_FREEZE,
-    OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_MAXLINE, OPT_MAXMEM, OPT_MAXNEST, OPT_MAXPIXELS, OPT_MAXPRIMS,
+    OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_LIGHTBUFFER, OPT_MAXLINE, OPT_MAXMEM, OPT_MAXNEST, OPT_MAXPIXELS, OPT_MAXPRIMS,
     OPT_MAXSTEPS, OPT_MAXSTRING, OPT_MERGE, OPT_OUTPUT, OPT_SHADOWS, OPT_TEXMEM, OPT_THREADS, OPT_WIDTH,
     OPT_COUNT
 };
@@ -1086,6 +1086,7 @@ const OptDef OPTS[OPT_COUNT] = {
     {"grid", -1, -1, 4096, 1, 0},
     {"gridmem", 64, 1, 65536, 1, 64},
     {"height", 256, 1, MAX_IMAGE_SIDE, 1, 0},
+    {"lightbuffer", 1, 0, 1, 1, 0},
     {"maxline", 65536, 1, 1e9, 1, 4096},
     {"maxmem", 0, 0, 1e9, 1, 1024},
     {"maxnest", 256, 1, MAX_NESTING, 1, 64},
@@ -1931,6 +1932,7 @@ struct Counters {
     double rays[4];  // primary, shadow, reflected, refracted
     double tests;
     double steps, moves, set_in, set_out, checks, frozen;
+    double lbuf;  // shadow rays answered by a light buffer
 };
 enum { RAY_PRIMARY, RAY_SHADOW, RAY_REFLECT, RAY_REFRACT };
 
@@ -2178,6 +2180,27 @@ enum { CL_OUT = 0, CL_IN = 1, CL_BD = 2 };
 // are constant in the region, summed up: the thesis' "set inside" / "set outside" actions of
 // one node done at once. Then the "check" actions: the active primitives. List 0 is the empty
 // list of a region where the root is constant, so nothing can be hit there.
+// One face of a light buffer: cells in (u, v), slabs in depth w. A directional light has one,
+// whose frame has e[2] towards the light: u, v, w are a point's coordinates in the frame, and a
+// zone runs from its slab to the buffer's end (`top`). A point light has six, one per axis and
+// sign, e[2] pointing away from the light: w is the distance along e[2], u and v the
+// coordinates along e[0], e[1] over w; a zone is the cell's pyramid from the light to the end
+// of its slab.
+struct LightFace {
+    R3 e[3];
+    real lo[3], h[3], inv[3];  // the grid: the low corner, the sides and their reciprocals
+    int n[3];                  // cells along u, v; slabs (0: a face without voxels)
+    int base;                  // the face's first voxel in LightBuf::list
+};
+
+struct LightBuf {
+    int point, faces;
+    R3 o;                      // the light's position (a point light)
+    real top;                  // a directional light: w where the zones end, past the grid
+    LightFace f[6];
+    int *list;                 // per voxel: its list; -1 for a point light's voxel
+};
+
 struct Accel {
     int n[3];          // voxels per axis; all 0 without a grid
     real org[3], h;    // low corner of the grid and side of a voxel
@@ -2190,6 +2213,8 @@ struct Accel {
     Array<int> plan;
     int outer;         // list of the space outside the grid (everything without a grid)
     int freeze, merge, bounds;
+    LightBuf *lbuf;         // per light, or NULL (option lightbuffer)
+    int nlbuf;
     long areas;
     double memory;
 };
@@ -2202,6 +2227,8 @@ void accel_release(pray_ctx *c, Accel *a) {
     a->off.release(c);
     a->plan_at.release(c);
     a->plan.release(c);
+    for (int i = 0; a->lbuf && i < a->nlbuf; i++) mem_free(c, a->lbuf[i].list);
+    mem_free(c, a->lbuf);
     mem_free(c, a);
 }
 
@@ -2624,6 +2651,420 @@ bool reach_build(pray_ctx *c, Accel *a) {
     return ok;
 }
 
+// ---- light buffers (Haines and Greenberg's light buffer, in the survey [Woo90]) ----
+// A shadow ray runs from a surface point to its light. Around each light the directions are
+// cut into cells (across a directional light: columns), and each cell into slabs by distance
+// from the light; a voxel of this light-space grid keeps the action list of its zone, the part
+// of the cell between the voxel and the light, which holds every shadow ray that starts in the
+// voxel. Such a ray evaluates that one list instead of walking the grid. The zones are classed
+// like the grid's voxels, with a margin for rounding.
+
+// A convex zone: {x : n[i].x <= d[i]}, the hull of v[0 .. nv); with a ball of radius r around c
+// joined to it (a point light's neighbourhood, where the pyramids meet; r = 0: none).
+struct Zone {
+    int np, nv;
+    R3 n[6], v[8];
+    real d[6];
+    R3 c;
+    real r;
+};
+
+// Class of primitive q, which bounds place in box bx, against a zone: conservative, like
+// classify_prim (outside only when it misses the zone, inside only when it holds all of it).
+int classify_zone(const Prim &q, const Box &bx, const Zone &z) {
+    bool out = false;  // beyond one of the polytope's planes or clear of the hull's box
+    for (int i = 0; i < z.np && !out; i++) {
+        real lo = 0;  // the least n.x over the box
+        for (int l = 0; l < 3; l++) {
+            real nl = comp(z.n[i], l);
+            if (nl != 0) lo += nl * (nl > 0 ? bx.lo[l] : bx.hi[l]);
+        }
+        out = lo > z.d[i];
+    }
+    for (int l = 0; l < 3 && !out; l++) {
+        real vlo = REAL_BIG, vhi = -REAL_BIG;
+        for (int k = 0; k < z.nv; k++) {
+            real x = comp(z.v[k], l);
+            vlo = x < vlo ? x : vlo;
+            vhi = x > vhi ? x : vhi;
+        }
+        out = vhi < bx.lo[l] || bx.hi[l] < vlo;
+    }
+    real far2 = 0;  // the box's distance from the ball's centre, squared
+    for (int l = 0; l < 3; l++) {
+        real c = comp(z.c, l), e = bx.lo[l] - c > 0 ? bx.lo[l] - c : c - bx.hi[l] > 0 ? c - bx.hi[l] : 0;
+        far2 += e * e;
+    }
+    bool out_ball = z.r == 0 || far2 > z.r * z.r;
+    bool in = true;  // every vertex inside the solid (then all of the polytope, which is convex)
+    switch (q.kind) {
+    case O_SPHERE: {
+        for (int i = 0; i < z.np && !out; i++) out = dot(z.n[i], q.p) - z.d[i] > q.r;
+        for (int k = 0; k < z.nv && in; k++) in = dot(z.v[k] - q.p, z.v[k] - q.p) < q.r2;
+        real dc = (real)sqrt((double)dot(z.c - q.p, z.c - q.p));
+        out_ball = out_ball || dc > q.r + z.r;
+        in = in && (z.r == 0 || dc + z.r < q.r);
+        break;
+    }
+    case O_PLANE: {
+        bool all_out = true;
+        for (int k = 0; k < z.nv; k++) {
+            real sd = dot(q.n, z.v[k]) - q.d;
+            in = in && sd < 0;
+            all_out = all_out && sd > 0;
+        }
+        out = out || all_out;
+        real sc = dot(q.n, z.c) - q.d;
+        out_ball = out_ball || sc > z.r;
+        in = in && (z.r == 0 || sc < -z.r);
+        break;
+    }
+    default: {  // cylinder
+        for (int k = 0; k < z.nv && in; k++) {
+            R3 x = z.v[k] - q.p;
+            R3 perp = x - q.n * dot(x, q.n);
+            in = dot(perp, perp) < q.r2;
+        }
+        R3 x = z.c - q.p;
+        R3 perp = x - q.n * dot(x, q.n);
+        in = in && (z.r == 0 || (real)sqrt((double)dot(perp, perp)) + z.r < q.r);
+    }
+    }
+    if (out && out_ball) return CL_OUT;
+    return in ? CL_IN : CL_BD;
+}
+
+// The list for a shadow ray from x towards the buffer's light, and the part (*ta, *tb] of the
+// ray in that list's zone; before and after it the ray is outside the grid's box, where the
+// outer list holds. `outer` alone when the ray misses the grid's box; -1 when x is in no voxel's
+// reach (then the grid is walked).
+inline int lightbuf_find(const LightBuf &B, int outer, R3 x, real tmax, real *ta, real *tb) {
+    if (B.faces == 0) return -1;
+    R3 m = x - B.o;
+    int f = 0;
+    if (B.point) {
+        real ax = m.x < 0 ? -m.x : m.x, ay = m.y < 0 ? -m.y : m.y, az = m.z < 0 ? -m.z : m.z;
+        int a = ax >= ay && ax >= az ? 0 : ay >= az ? 1 : 2;
+        f = 2 * a + (comp(m, a) < 0);
+    }
+    const LightFace &F = B.f[f];
+    real g[3] = {dot(m, F.e[0]), dot(m, F.e[1]), dot(m, F.e[2])};
+    *ta = 0;
+    *tb = tmax;
+    if (B.point) {
+        if (!(g[2] > 0)) return -1;  // at the light, or not a number
+        if (F.n[2] == 0) return outer;
+        real k = (real)1 / g[2];
+        g[0] *= k;
+        g[1] *= k;
+    }
+    real k[3];
+    for (int l = 0; l < 3; l++) {
+        k[l] = (g[l] - F.lo[l]) * F.inv[l];
+        if (k[l] != k[l]) return -1;
+        if (l == 2) break;
+        // a point light's zones are widened by a quarter of a cell (eps in lightbuf_build), so
+        // a point rounded just past the edge of a face (u = 1 in one face, -1 in the next) belongs
+        // in the edge cell
+        real slack = B.point ? (real)0.25 : 0;
+        if (!(k[l] >= -slack && k[l] < (real)F.n[l] + slack)) return outer;  // beside the grid's box
+        k[l] = k[l] < 0 ? 0 : k[l] < (real)F.n[l] ? k[l] : (real)(F.n[l] - 1);
+    }
+    int slab;
+    if (!B.point) {  // w grows towards the light
+        if (!(k[2] < (real)F.n[2])) return outer;  // past the box already
+        *tb = B.top - g[2];
+        slab = k[2] < 0 ? 0 : (int)k[2];
+        if (k[2] < 0) *ta = F.lo[2] - g[2];  // below the box: reaches it there
+    } else {         // w shrinks towards the light
+        if (k[2] < 0) return outer;  // between the light and the box
+        slab = k[2] < (real)F.n[2] ? (int)k[2] : F.n[2] - 1;
+        if (!(k[2] < (real)F.n[2])) *ta = tmax * ((real)1 - (F.lo[2] + (real)F.n[2] * F.h[2]) / g[2]);  // beyond it
+    }
+    return B.list[F.base + (slab * F.n[1] + (int)k[1]) * F.n[0] + (int)k[0]];
+}
+
+// The zone of voxel (iu, iv, k) of face F, widened by the margin (a point light's cells by
+// eps, its ball of radius r).
+void lightbuf_zone(const LightBuf &B, const LightFace &F, int iu, int iv, int k, real margin, real eps, real r, Zone *z) {
+    const R3 *e = F.e;
+    real u[2], v[2];
+    if (!B.point) {
+        u[0] = F.lo[0] + (real)iu * F.h[0] - margin;
+        u[1] = F.lo[0] + (real)(iu + 1) * F.h[0] + margin;
+        v[0] = F.lo[1] + (real)iv * F.h[1] - margin;
+        v[1] = F.lo[1] + (real)(iv + 1) * F.h[1] + margin;
+        real w[2] = {F.lo[2] + (real)k * F.h[2] - margin, B.top + margin};
+        z->np = 6;
+        for (int l = 0; l < 3; l++) {
+            real lo = l == 0 ? u[0] : l == 1 ? v[0] : w[0], hi = l == 0 ? u[1] : l == 1 ? v[1] : w[1];
+            z->n[2 * l] = e[l];
+            z->d[2 * l] = hi;
+            z->n[2 * l + 1] = e[l] * (real)-1;
+            z->d[2 * l + 1] = -lo;
+        }
+        z->nv = 8;
+        for (int i = 0; i < 8; i++) z->v[i] = e[0] * u[i & 1] + e[1] * v[i >> 1 & 1] + e[2] * w[i >> 2];
+        z->c = r3(0, 0, 0);
+        z->r = 0;
+        return;
+    }
+    u[0] = F.lo[0] + (real)iu * F.h[0] - eps;
+    u[1] = F.lo[0] + (real)(iu + 1) * F.h[0] + eps;
+    v[0] = F.lo[1] + (real)iv * F.h[1] - eps;
+    v[1] = F.lo[1] + (real)(iv + 1) * F.h[1] + eps;
+    real far = F.lo[2] + (real)(k + 1) * F.h[2] + margin;
+    z->np = 5;
+    z->n[0] = unit(e[2] * u[0] - e[0]);
+    z->n[1] = unit(e[0] - e[2] * u[1]);
+    z->n[2] = unit(e[2] * v[0] - e[1]);
+    z->n[3] = unit(e[1] - e[2] * v[1]);
+    z->n[4] = e[2];
+    for (int i = 0; i < 4; i++) z->d[i] = dot(z->n[i], B.o);
+    z->d[4] = dot(e[2], B.o) + far;
+    z->nv = 5;
+    z->v[0] = B.o;
+    for (int i = 0; i < 4; i++) z->v[1 + i] = B.o + (e[2] + e[0] * u[i & 1] + e[1] * v[i >> 1]) * far;
+    z->c = B.o;
+    z->r = r;
+}
+
+// Build the light buffers: cells and slabs about `cell` wide where the grid's box is, and lists
+// for the space between each voxel and its light. `eff`: where bounds place each primitive;
+// `margin`: how far rounding may move a point (the grid's).
+// A voxel whose zone meets more primitives than this is left to the grid, which stops at the
+// first blocker instead of testing everything between the point and the light.
+const int LB_MAX_CAND = 64;
+
+bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin) {
+    pray_ctx *c = b.c;
+    const Scene *s = b.s;
+    Accel *a = b.a;
+    int nl = s->lights.n, np = s->prims.n;
+    a->lbuf = (LightBuf *)mem_zalloc(c, sizeof(LightBuf) * (size_t)(nl + 1));
+    if (!a->lbuf) return false;
+    a->nlbuf = nl;
+    Array<int> start, cand, prims, seen;
+    Array<unsigned char> cls, seen_cls;
+    Array<real> key;
+    Array<int> foot;  // per primitive: u0, u1, v0, v1 (u0 > u1: not on this face)
+    start.init();
+    cand.init();
+    prims.init();
+    cls.init();
+    seen.init();
+    seen_cls.init();
+    key.init();
+    foot.init();
+    bool ok = key.reserve(c, np + 1) && foot.reserve(c, 4 * np + 4);
+    for (int li = 0; ok && li < nl; li++) {
+        const Light &L = s->lights[li];
+        LightBuf &B = a->lbuf[li];
+        B.point = L.point;
+        B.faces = L.point ? 6 : 1;
+        B.o = L.point ? L.v : r3(0, 0, 0);
+        long total = 0;
+        real eps = 0, r = 0;
+        for (int fi = 0; fi < B.faces; fi++) {
+            LightFace &F = B.f[fi];
+            if (!L.point) {
+                F.e[2] = L.v;
+                real ax = (real)fabs((double)L.v.x), ay = (real)fabs((double)L.v.y), az = (real)fabs((double)L.v.z);
+                R3 least = ax <= ay && ax <= az ? r3(1, 0, 0) : ay <= az ? r3(0, 1, 0) : r3(0, 0, 1);
+                F.e[0] = unit(cross(F.e[2], least));
+                F.e[1] = cross(F.e[2], F.e[0]);
+            } else {
+                int ax = fi / 2;
+                real sg = fi & 1 ? (real)-1 : (real)1;
+                R3 unitv[3] = {r3(1, 0, 0), r3(0, 1, 0), r3(0, 0, 1)};
+                F.e[2] = unitv[ax] * sg;
+                F.e[0] = unitv[(ax + 1) % 3];
+                F.e[1] = unitv[(ax + 2) % 3];
+            }
+            // the grid's box in the face's coordinates
+            real lo[3] = {REAL_BIG, REAL_BIG, REAL_BIG}, hi[3] = {-REAL_BIG, -REAL_BIG, -REAL_BIG};
+            bool behind = false;  // a corner of the box not in front of a point light's face
+            for (int k = 0; k < 8; k++) {
+                R3 x = r3(k & 1 ? a->top[0] : a->org[0], k & 2 ? a->top[1] : a->org[1], k & 4 ? a->top[2] : a->org[2]) - B.o;
+                real g[3] = {dot(x, F.e[0]), dot(x, F.e[1]), dot(x, F.e[2])};
+                if (L.point) {
+                    behind = behind || !(g[2] > 0);
+                    if (g[2] > 0) g[0] /= g[2], g[1] /= g[2];
+                }
+                for (int l = 0; l < 3; l++) {
+                    lo[l] = g[l] < lo[l] ? g[l] : lo[l];
+                    hi[l] = g[l] > hi[l] ? g[l] : hi[l];
+                }
+            }
+            if (L.point) {
+                if (!(hi[2] > 0)) continue;  // the box is behind the face
+                if (behind) lo[0] = lo[1] = -1, hi[0] = hi[1] = 1, lo[2] = 0;
+                for (int l = 0; l < 2; l++) {
+                    lo[l] = lo[l] < -1 ? -1 : lo[l];
+                    hi[l] = hi[l] > 1 ? 1 : hi[l];
+                }
+                real mid = (lo[2] + hi[2]) / 2;
+                F.h[0] = F.h[1] = cell / mid;
+                F.h[2] = cell;
+            } else {
+                for (int l = 0; l < 3; l++) lo[l] -= margin, hi[l] += margin;
+                F.h[0] = F.h[1] = F.h[2] = cell;
+                B.top = hi[2];
+            }
+            for (int l = 0; l < 3; l++) {
+                double n = ceil((double)(hi[l] - lo[l]) / (double)F.h[l]);
+                F.n[l] = n < 1 ? 1 : n > 256 ? 256 : (int)n;
+                F.h[l] = (hi[l] - lo[l]) / (real)F.n[l];
+                if (!(F.h[l] > 0)) F.h[l] = cell;
+                F.inv[l] = (real)1 / F.h[l];
+                F.lo[l] = lo[l];
+            }
+            F.base = (int)total;
+            total += (long)F.n[0] * F.n[1] * F.n[2];
+        }
+        // (a point light's cells are widened by a quarter; near the light, where that is less
+        // than the margin, the ball takes over)
+        if (L.point) {
+            eps = REAL_BIG;
+            for (int fi = 0; fi < 6; fi++)
+                if (B.f[fi].n[2] > 0 && B.f[fi].h[0] / 4 < eps) eps = B.f[fi].h[0] / 4;
+            r = margin * (real)2.6 / eps;
+            r = r > margin ? r : margin;
+        }
+        B.list = (int *)mem_alloc(c, sizeof(int) * (size_t)(total + 1));
+        ok = B.list != NULL;
+        for (int fi = 0; ok && fi < B.faces; fi++) {
+            LightFace &F = B.f[fi];
+            if (F.n[2] == 0) continue;
+            // each primitive's cells (its footprint) and the depth that decides its slabs
+            key.n = np;
+            foot.n = 4 * np;
+            for (int i = 0; i < np; i++) {
+                const Box &bx = eff[i];
+                int *ft = foot.p + 4 * i;
+                ft[0] = 0, ft[1] = F.n[0] - 1, ft[2] = 0, ft[3] = F.n[1] - 1;
+                key[i] = L.point ? 0 : REAL_BIG;
+                if (box_empty(bx)) {
+                    ft[0] = 1, ft[1] = 0;
+                    continue;
+                }
+                if (!box_finite(bx)) continue;
+                real d2 = 0;
+                for (int l = 0; l < 3; l++) {
+                    real cl = comp(B.o, l), e = bx.lo[l] - cl > 0 ? bx.lo[l] - cl : cl - bx.hi[l] > 0 ? cl - bx.hi[l] : 0;
+                    d2 += e * e;
+                }
+                if (L.point && d2 <= r * r) continue;
+                real lo[3] = {REAL_BIG, REAL_BIG, REAL_BIG}, hi[3] = {-REAL_BIG, -REAL_BIG, -REAL_BIG};
+                bool behind = false;
+                for (int k = 0; k < 8; k++) {
+                    R3 x = r3(k & 1 ? bx.hi[0] : bx.lo[0], k & 2 ? bx.hi[1] : bx.lo[1], k & 4 ? bx.hi[2] : bx.lo[2]) - B.o;
+                    real g[3] = {dot(x, F.e[0]), dot(x, F.e[1]), dot(x, F.e[2])};
+                    if (L.point) {
+                        behind = behind || !(g[2] > 0);
+                        if (g[2] > 0) g[0] /= g[2], g[1] /= g[2];
+                    }
+                    for (int l = 0; l < 3; l++) {
+                        lo[l] = g[l] < lo[l] ? g[l] : lo[l];
+                        hi[l] = g[l] > hi[l] ? g[l] : hi[l];
+                    }
+                }
+                if (L.point && !(hi[2] > 0)) {  // behind the face: no zone reaches it
+                    ft[0] = 1, ft[1] = 0;
+                    continue;
+                }
+                if (L.point && behind) continue;
+                key[i] = L.point ? lo[2] : hi[2];
+                real wid = L.point ? eps : margin;
+                for (int l = 0; l < 2; l++) {
+                    double g0 = ((double)(lo[l] - wid) - (double)F.lo[l]) / (double)F.h[l];
+                    double g1 = ((double)(hi[l] + wid) - (double)F.lo[l]) / (double)F.h[l];
+                    ft[2 * l] = g0 < 0 ? 0 : g0 >= F.n[l] ? F.n[l] : (int)g0;
+                    ft[2 * l + 1] = g1 < 0 ? -1 : g1 >= F.n[l] ? F.n[l] - 1 : (int)g1;
+                }
+            }
+            // candidates per cell, in two passes (count, then fill)
+            int ncell = F.n[0] * F.n[1];
+            start.n = 0;
+            ok = start.reserve(c, ncell + 1);
+            if (!ok) break;
+            start.n = ncell + 1;
+            memset(start.p, 0, sizeof(int) * (size_t)(ncell + 1));
+            for (int pass = 0; ok && pass < 2; pass++) {
+                for (int i = 0; i < np; i++) {
+                    const int *ft = foot.p + 4 * i;
+                    for (int y = ft[2]; y <= ft[3]; y++)
+                        for (int x = ft[0]; x <= ft[1]; x++) {
+                            if (pass == 0) start[y * F.n[0] + x + 1]++;
+                            else cand[start[y * F.n[0] + x]++] = i;
+                        }
+                }
+                if (pass == 0) {
+                    for (int k = 0; k < ncell; k++) start[k + 1] += start[k];
+                    cand.n = 0;
+                    ok = cand.reserve(c, start[ncell] + 1);
+                    cand.n = start[ncell];
+                } else {
+                    for (int k = ncell; k > 0; k--) start[k] = start[k - 1];
+                    start[0] = 0;
+                }
+            }
+            // a face whose cells meet many primitives on average is left to the grid (and
+            // costs no time to build)
+            bool crowded = start[ncell] > (double)ncell * LB_MAX_CAND / 2;
+            for (int cel = 0; ok && cel < ncell; cel++)
+                for (int k = 0, last = -1; ok && k < F.n[2]; k++) {
+                    int &out = B.list[F.base + (k * F.n[1] + cel / F.n[0]) * F.n[0] + cel % F.n[0]];
+                    if (crowded) {
+                        out = -1;
+                        continue;
+                    }
+                    real wk = L.point ? F.lo[2] + (real)(k + 1) * F.h[2] + margin : F.lo[2] + (real)k * F.h[2] - margin;
+                    int many = 0;
+                    for (int j = start[cel]; j < start[cel + 1]; j++) many += L.point ? key[cand[j]] <= wk : key[cand[j]] >= wk;
+                    if (many > LB_MAX_CAND) {
+                        out = -1;
+                        continue;
+                    }
+                    Zone z;
+                    lightbuf_zone(B, F, cel % F.n[0], cel / F.n[0], k, margin, eps, r, &z);
+                    prims.n = 0;
+                    cls.n = 0;
+                    for (int j = start[cel]; ok && j < start[cel + 1]; j++) {
+                        int i = cand[j];
+                        if (L.point ? key[i] > wk : key[i] < wk) continue;
+                        int cl = classify_zone(s->prims[i], eff[i], z);
+                        if (cl != CL_OUT) ok = prims.push(c, i) && cls.push(c, (unsigned char)cl);
+                    }
+                    // the next slab's zone often meets the same: then it has the same list
+                    if (last >= 0 && prims.n == seen.n && memcmp(prims.p, seen.p, sizeof(int) * (size_t)prims.n) == 0 &&
+                        memcmp(cls.p, seen_cls.p, (size_t)cls.n) == 0) {
+                        out = last;
+                        continue;
+                    }
+                    out = ok ? lb_list(b, prims.p, cls.p, prims.n) : -1;
+                    ok = out >= 0 && seen.reserve(c, prims.n + 1) && seen_cls.reserve(c, prims.n + 1);
+                    if (!ok) break;
+                    seen.n = seen_cls.n = prims.n;
+                    memcpy(seen.p, prims.p, sizeof(int) * (size_t)prims.n);
+                    memcpy(seen_cls.p, cls.p, (size_t)cls.n);
+                    last = out;
+                }
+        }
+        a->memory += (double)sizeof(int) * (double)(total + 1);
+        c->stats.lightbuf_voxels += total;
+    }
+    start.release(c);
+    cand.release(c);
+    prims.release(c);
+    cls.release(c);
+    seen.release(c);
+    seen_cls.release(c);
+    key.release(c);
+    foot.release(c);
+    return ok;
+}
+
 // Build the acceleration structure: the lists of the grid's voxels and of the space around it.
 pray_status accel_build(pray_ctx *c, Scene *s) {
     Accel *a = (Accel *)mem_zalloc(c, sizeof(Accel));
@@ -2875,6 +3316,9 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
             if (a->outer < 0) st = c->status;
         }
     }
+    if (st == PRAY_OK && a->n[0] > 0 && opt_int(c, OPT_SHADOWS) && opt_int(c, OPT_LIGHTBUFFER) && s->lights.n > 0 &&
+        !lightbuf_build(b, eff, a->h, (real)margin))
+        st = c->status;
     cand.release(c);
     start.release(c);
     cls.release(c);
@@ -2892,6 +3336,17 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
         }
         mem_free(c, kids);
         mem_free(c, solid);
+    }
+    for (int i = 0; st == PRAY_OK && a->lbuf && i < a->nlbuf; i++) {
+        LightBuf &B = a->lbuf[i];
+        long nv = 0;
+        for (int f = 0; f < B.faces; f++) nv += (long)B.f[f].n[0] * B.f[f].n[1] * B.f[f].n[2];
+        bool any = false;  // a buffer without a list to give is dropped, and costs nothing
+        for (long v = 0; v < nv; v++) {
+            if (B.list[v] > 0 && a->plan_at[B.list[v]] < 0) B.list[v] = -1;
+            any = any || B.list[v] >= 0;
+        }
+        if (!any) B.faces = 0;
     }
     nv = (long)a->n[0] * a->n[1] * a->n[2];
     a->memory = (double)sizeof(Accel) + (double)nv * (sizeof(int) + 1) + (double)a->data.cap * sizeof(int) +
@@ -3177,11 +3632,8 @@ inline real nearest(const real *v, int *axis) {
     return near;
 }
 
-// The accelerated counterpart of `sweep`: the same hits, in the same order.
-template <class Visit>
-void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
-    const Accel *A = s->accel;
-    if (s->root < 0) return;
+// A new ray: a new stamp for what is kept per ray (3.5: no explicit unfreezing).
+void ray_begin(const Scene *s, Scratch *w) {
     w->ray++;
     if (w->ray == 0) {  // the stamps wrapped around: clear them
         for (int i = 0; i < s->prims.n; i++) w->span[i].stamp = 0;
@@ -3190,6 +3642,14 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
         w->ray = 1;
     }
     w->root_fixed = 0;
+}
+
+// The accelerated counterpart of `sweep`: the same hits, in the same order.
+template <class Visit>
+void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
+    const Accel *A = s->accel;
+    if (s->root < 0) return;
+    ray_begin(s, w);
     real inv[3];
     for (int l = 0; l < 3; l++) {  // 0: parallel to the axis (1 / 0 is infinite), or so nearly that 1 / d overflows
         real q = (real)1 / comp(ray.d, l);
@@ -3317,6 +3777,24 @@ template <class Visit>
 void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
     if (s->accel) trace_accel(s, w, ray, tmax, self, visit);
     else sweep(s, w, ray, tmax, self, visit);
+}
+
+// The hits along a shadow ray towards light `light`: from the list of its light buffer's voxel
+// when the ray starts in one, else as any other ray.
+template <class Visit>
+void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, Visit &visit) {
+    const Accel *A = s->accel;
+    real ta = 0, tb = 0;
+    int L = A && A->lbuf ? lightbuf_find(A->lbuf[light], A->outer, ray.o, tmax, &ta, &tb) : -1;
+    if (L < 0) {
+        find_hits(s, w, ray, tmax, self, visit);
+        return;
+    }
+    w->k.lbuf += 1;
+    ray_begin(s, w);
+    if (ta > 0 && eval_list(s, A, w, ray, A->outer, 0, ta, tmax, self, visit)) return;
+    if (eval_list(s, A, w, ray, L, ta, tb, tmax, self, visit)) return;
+    if (tb < tmax) eval_list(s, A, w, ray, A->outer, tb, tmax, tmax, self, visit);
 }
 
 // =============================================================================================
@@ -4349,7 +4827,7 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
             sh.ray = &sr;
             sh.f = cmake(1, 1, 1);
             tr.w->k.rays[RAY_SHADOW] += 1;
-            find_hits(s, tr.w, sr, dist, h.prim, sh);
+            shadow_hits(s, tr.w, sr, dist, h.prim, i, sh);
             li = cmul(li, sh.f);
         }
         if (record) {
@@ -4406,7 +4884,6 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     // simplified scene give the same surviving primitives the same numbers
     if (s->root == -3 || snap_coincident(c, s) || scene_compact(c, s)) return c->status;
     c->stats.primitives_declared = root->nprims;
-    if (!opt_int(c, OPT_BRUTE) && accel_build(c, s)) return c->status;
     for (int i = 0; lights && i < lights->n; i++) {
         const LightSrc &src = lights->src[i];
         Light L;
@@ -4415,6 +4892,7 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
         L.v = src.point ? r3of(src.v) : r3of(vmul(vunit(src.v), -1.0));
         if (!s->lights.push(c, L)) return c->status;
     }
+    if (!opt_int(c, OPT_BRUTE) && accel_build(c, s)) return c->status;
     s->parallel = c->cur.parallel;
     s->eye = r3of(c->cur.cam_eye);
     s->point = r3of(c->cur.cam_point);
@@ -4818,6 +5296,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
         c->stats.set_outside += k.set_out;
         c->stats.checks += k.checks;
         c->stats.frozen_skips += k.frozen;
+        c->stats.rays_lightbuf += k.lbuf;
         scratch_release(c, &worker_at(wbuf, stride, i).w);
         worker_at(wbuf, stride, i).cache.release(c);
     }
@@ -7914,12 +8393,13 @@ void print_stats(pray_ctx *c) {
             "primitives: %ld declared, %ld kept; nodes %ld\n"
             "grid: %d x %d x %d = %ld voxels, %ld distinct lists, %ld areas, %.0f bytes\n"
             "rays: primary %.0f (of %.0f without undersampling), shadow %.0f, reflected %.0f, refracted %.0f\n"
+            "light buffers: %ld voxels; shadow rays from them %.0f\n"
             "traversal: %.0f voxel steps, %.0f area moves\n"
             "actions: set inside %.0f, set outside %.0f, check %.0f (frozen skips %.0f)\n"
             "intersection tests %.0f\n"
             "time: parse %.3f s, prepare %.3f s, render %.3f s on %d thread%s\n",
             s.primitives_declared, s.primitives, s.nodes, s.grid[0], s.grid[1], s.grid[2], s.voxels, s.lists,
-            s.areas, s.memory, s.rays_primary, s.rays_primary_full, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.voxel_steps,
+            s.areas, s.memory, s.rays_primary, s.rays_primary_full, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.lightbuf_voxels, s.rays_lightbuf, s.voxel_steps,
             s.area_moves, s.set_inside, s.set_outside, s.checks, s.frozen_skips, s.intersection_tests,
             s.time_parse, s.time_prepare, s.time_render, s.threads, s.threads == 1 ? "" : "s");
 }

@@ -259,6 +259,8 @@ typedef struct pray_stats {
     double memory;                   /* bytes of the acceleration structure */
     double rays_primary, rays_shadow, rays_reflected, rays_refracted;
     double rays_primary_full;        /* primary rays without undersampling (option adaptive) */
+    long lightbuf_voxels;            /* voxels of the light buffers (option lightbuffer) */
+    double rays_lightbuf;            /* shadow rays answered by a light buffer's list */
     int threads;                     /* threads of the last render */
     double voxel_steps, area_moves;  /* traversal steps; steps inside an area (no evaluation) */
     double set_inside, set_outside, checks; /* actions executed, by kind */

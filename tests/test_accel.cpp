@@ -968,6 +968,90 @@ TEST_CASE("accel stats: of a program run; parts that cannot matter are not kept"
     CHECK(r.stats.voxels == 0);
 }
 
+// ---------------------------------------------------------------------------------------------
+// Light buffers: shadow rays answered from one list per voxel around the light give the same
+// images as the reference, whether the lights are outside the scene, inside its grid or amid
+// its objects, and they do answer.
+// ---------------------------------------------------------------------------------------------
+TEST_CASE("accel light buffers: shadow rays from the light buffers' lists give the reference's image; they answer "
+          "most shadow rays of a field of spheres") {
+    struct Pick {
+        int kind, seed;
+    };
+    const Pick picks[] = {{K_RANDOM, 5},  {K_RANDOM, 23}, {K_RANDOM, 64}, {K_MANY, 1},   {K_MANY, 7},
+                          {K_LATTICE, 2}, {K_LATTICE, 9}, {K_BLOCKS, 4},  {K_FLOOR, 3},  {K_FLOOR, 11},
+                          {K_SCALED, 2},  {K_SCALED, 6},  {K_SCALED, 13}};
+    pray_rgb w = {0.6, 0.6, 0.6}, w2 = {0.5, 0.4, 0.3};
+    long renders = 0, mismatches = 0;
+    std::vector<std::string> problems;
+    for (const Pick &pk : picks) {
+        pray_ctx *c = pray_new();
+        REQUIRE(c);
+        Scene s = make_scene(c, pk.kind, (uint64_t)pk.seed);
+        CAPTURE(s.label);
+        REQUIRE_MESSAGE(s.root, std::string(pray_error(c)));
+        // a directional light, a point light far outside, one inside the grid's box, and one
+        // on the scene's centre (amid or inside the objects)
+        pray_vec lo = s.lo, hi = s.hi, mid = mul(add(lo, hi), 0.5), size = sub(hi, lo);
+        pray_light *lights = pray_light_add(
+            c, pray_light_add(c, pray_dirlight(c, w, V(1, 2, -3)), pray_pointlight(c, w2, add(hi, size))),
+            pray_light_add(c, pray_pointlight(c, w2, add(lo, mul(size, 0.3))), pray_pointlight(c, w2, mid)));
+        REQUIRE(lights);
+        Render ref = render(c, s.root, lights, reference(), 40);
+        REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
+        for (int grid : {-1, 3, 16}) {
+            for (int lb = 0; lb < 2; lb++) {
+                REQUIRE(pray_option(c, "lightbuffer", lb) == PRAY_OK);
+                pray_stats before;
+                pray_stats_get(c, &before);
+                Render r = render(c, s.root, lights, Opts{0, grid, 1, 1, 1}, 40);
+                renders++;
+                CHECK_MESSAGE(r.status == PRAY_OK, s.label << ": " << r.error);
+                double answered = r.stats.rays_lightbuf - before.rays_lightbuf;
+                if (!lb) CHECK(answered == 0);
+                std::string d = frame_difference(ref.frames, r.frames);
+                if (!d.empty()) {
+                    mismatches++;
+                    if (problems.size() < 20)
+                        problems.push_back(s.label + ", grid=" + std::to_string(grid) + " lightbuffer=" + std::to_string(lb) + ": " + d);
+                }
+            }
+        }
+        REQUIRE(pray_option(c, "lightbuffer", 1) == PRAY_OK);
+        pray_free(c);
+    }
+    std::string all;
+    for (auto &p : problems) all += "\n  - " + p;
+    MESSAGE(renders << " renders with and without light buffers, " << mismatches << " differing from brute=1");
+    CHECK_MESSAGE(mismatches == 0, mismatches << " renders differ from brute=1:" << all);
+
+    // A field of spheres lit by the sun and a lamp above: nearly every shadow ray starts in a
+    // voxel of a light buffer and is answered from its list.
+    std::string program = "perspective <1.2, 0, 0>, <0, 0.85, 0.85>, [0, -3, 3], [0, 0, 0]\n"
+                          "M = phong({0.7}, {0.3}, 20)\nAll = nothing\nI = 0\nwhile I < 400\n"
+                          "  All = All | sphere(M, [(I % 20 - 9.5) * 0.1, ((I - I % 20) / 20 - 9.5) * 0.1, 0.05 * (I % 7)], 0.04)\n"
+                          "  I = I + 1\nendwhile\n"
+                          "rendertiff All, dirlight({0.7}, <1, 2, -3>), pointlight({0.5}, [0.5, 0.5, 3])\n";
+    std::vector<std::string> opts = {"width=64", "height=64", "shadows=1"};
+    Run on = run_program("field.ray", program, opts);
+    opts.push_back("lightbuffer=0");
+    Run off = run_program("field.ray", program, opts);
+    opts.back() = "brute=1";
+    Run brute = run_program("field.ray", program, opts);
+    REQUIRE_MESSAGE(on.status == PRAY_OK, on.error);
+    REQUIRE_MESSAGE(off.status == PRAY_OK, off.error);
+    REQUIRE_MESSAGE(brute.status == PRAY_OK, brute.error);
+    INFO("lightbuffer=1: ", stats_text(on.stats), "; shadow rays answered by light buffers ", on.stats.rays_lightbuf);
+    CHECK(frame_difference(brute.frames, on.frames) == "");
+    CHECK(frame_difference(brute.frames, off.frames) == "");
+    CHECK(on.stats.lightbuf_voxels > 0);
+    CHECK(on.stats.rays_shadow > 1000);
+    CHECK(on.stats.rays_lightbuf > 0.9 * on.stats.rays_shadow);
+    CHECK(off.stats.lightbuf_voxels == 0);
+    CHECK(off.stats.rays_lightbuf == 0);
+    CHECK(on.stats.voxel_steps < off.stats.voxel_steps);
+}
+
 TEST_CASE("accel hits: degenerate roots (nothing, one, complements, a lone primitive) with every combination") {
     pray_ctx *c = pray_new();
     REQUIRE(c);
