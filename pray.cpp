@@ -2198,7 +2198,7 @@ struct LightBuf {
     R3 o;                      // the light's position (a point light)
     real top;                  // a directional light: w where the zones end, past the grid
     LightFace f[6];
-    int *list;                 // per voxel: its list; -1 for a point light's voxel
+    int *list;                 // per voxel: its list; -1: the ray walks the grid
 };
 
 struct Accel {
@@ -3051,8 +3051,6 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin) {
                     last = out;
                 }
         }
-        a->memory += (double)sizeof(int) * (double)(total + 1);
-        c->stats.lightbuf_voxels += total;
     }
     start.release(c);
     cand.release(c);
@@ -3337,10 +3335,12 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
         mem_free(c, kids);
         mem_free(c, solid);
     }
+    long lbv = 0;  // the light buffers' voxels
     for (int i = 0; st == PRAY_OK && a->lbuf && i < a->nlbuf; i++) {
         LightBuf &B = a->lbuf[i];
         long nv = 0;
         for (int f = 0; f < B.faces; f++) nv += (long)B.f[f].n[0] * B.f[f].n[1] * B.f[f].n[2];
+        lbv += nv;
         bool any = false;  // a buffer without a list to give is dropped, and costs nothing
         for (long v = 0; v < nv; v++) {
             if (B.list[v] > 0 && a->plan_at[B.list[v]] < 0) B.list[v] = -1;
@@ -3350,7 +3350,9 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
     }
     nv = (long)a->n[0] * a->n[1] * a->n[2];
     a->memory = (double)sizeof(Accel) + (double)nv * (sizeof(int) + 1) + (double)a->data.cap * sizeof(int) +
-                (double)a->off.cap * sizeof(int) + (double)(a->plan_at.cap + a->plan.cap) * sizeof(int);
+                (double)a->off.cap * sizeof(int) + (double)(a->plan_at.cap + a->plan.cap) * sizeof(int) +
+                (double)a->nlbuf * sizeof(LightBuf) + (double)lbv * sizeof(int);
+    c->stats.lightbuf_voxels = lbv;
     c->stats.grid[0] = a->n[0];
     c->stats.grid[1] = a->n[1];
     c->stats.grid[2] = a->n[2];
