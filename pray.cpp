@@ -2829,6 +2829,26 @@ void lightbuf_zone(const LightBuf &B, const LightFace &F, int iu, int iv, int k,
     z->r = r;
 }
 
+// The box in the face's coordinates (u, v, w), projected for a point light: *lo, *hi over its
+// corners. Returns whether a corner is not in front of a point light's face.
+bool face_extent(const LightBuf &B, const LightFace &F, const Box &bx, real *lo, real *hi) {
+    bool behind = false;
+    for (int l = 0; l < 3; l++) lo[l] = REAL_BIG, hi[l] = -REAL_BIG;
+    for (int k = 0; k < 8; k++) {
+        R3 x = r3(k & 1 ? bx.hi[0] : bx.lo[0], k & 2 ? bx.hi[1] : bx.lo[1], k & 4 ? bx.hi[2] : bx.lo[2]) - B.o;
+        real g[3] = {dot(x, F.e[0]), dot(x, F.e[1]), dot(x, F.e[2])};
+        if (B.point) {
+            behind = behind || !(g[2] > 0);
+            if (g[2] > 0) g[0] /= g[2], g[1] /= g[2];
+        }
+        for (int l = 0; l < 3; l++) {
+            lo[l] = g[l] < lo[l] ? g[l] : lo[l];
+            hi[l] = g[l] > hi[l] ? g[l] : hi[l];
+        }
+    }
+    return behind;
+}
+
 // Build the light buffers: cells and slabs about `cell` wide where the grid's box is, and lists
 // for the space between each voxel and its light. `eff`: where bounds place each primitive;
 // `margin`: how far rounding may move a point (the grid's).
@@ -2882,20 +2902,10 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin) {
                 F.e[1] = unitv[(ax + 2) % 3];
             }
             // the grid's box in the face's coordinates
-            real lo[3] = {REAL_BIG, REAL_BIG, REAL_BIG}, hi[3] = {-REAL_BIG, -REAL_BIG, -REAL_BIG};
-            bool behind = false;  // a corner of the box not in front of a point light's face
-            for (int k = 0; k < 8; k++) {
-                R3 x = r3(k & 1 ? a->top[0] : a->org[0], k & 2 ? a->top[1] : a->org[1], k & 4 ? a->top[2] : a->org[2]) - B.o;
-                real g[3] = {dot(x, F.e[0]), dot(x, F.e[1]), dot(x, F.e[2])};
-                if (L.point) {
-                    behind = behind || !(g[2] > 0);
-                    if (g[2] > 0) g[0] /= g[2], g[1] /= g[2];
-                }
-                for (int l = 0; l < 3; l++) {
-                    lo[l] = g[l] < lo[l] ? g[l] : lo[l];
-                    hi[l] = g[l] > hi[l] ? g[l] : hi[l];
-                }
-            }
+            Box grid;
+            for (int l = 0; l < 3; l++) grid.lo[l] = a->org[l], grid.hi[l] = a->top[l];
+            real lo[3], hi[3];
+            bool behind = face_extent(B, F, grid, lo, hi);
             if (L.point) {
                 if (!(hi[2] > 0)) continue;  // the box is behind the face
                 if (behind) lo[0] = lo[1] = -1, hi[0] = hi[1] = 1, lo[2] = 0;
@@ -2955,20 +2965,8 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin) {
                     d2 += e * e;
                 }
                 if (L.point && d2 <= r * r) continue;
-                real lo[3] = {REAL_BIG, REAL_BIG, REAL_BIG}, hi[3] = {-REAL_BIG, -REAL_BIG, -REAL_BIG};
-                bool behind = false;
-                for (int k = 0; k < 8; k++) {
-                    R3 x = r3(k & 1 ? bx.hi[0] : bx.lo[0], k & 2 ? bx.hi[1] : bx.lo[1], k & 4 ? bx.hi[2] : bx.lo[2]) - B.o;
-                    real g[3] = {dot(x, F.e[0]), dot(x, F.e[1]), dot(x, F.e[2])};
-                    if (L.point) {
-                        behind = behind || !(g[2] > 0);
-                        if (g[2] > 0) g[0] /= g[2], g[1] /= g[2];
-                    }
-                    for (int l = 0; l < 3; l++) {
-                        lo[l] = g[l] < lo[l] ? g[l] : lo[l];
-                        hi[l] = g[l] > hi[l] ? g[l] : hi[l];
-                    }
-                }
+                real lo[3], hi[3];
+                bool behind = face_extent(B, F, bx, lo, hi);
                 if (L.point && !(hi[2] > 0)) {  // behind the face: no zone reaches it
                     ft[0] = 1, ft[1] = 0;
                     continue;
