@@ -3035,8 +3035,10 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin) {
                         if (cl != CL_OUT) ok = prims.push(c, i) && cls.push(c, (unsigned char)cl);
                     }
                     // the next slab's zone often meets the same: then it has the same list
-                    if (last >= 0 && prims.n == seen.n && memcmp(prims.p, seen.p, sizeof(int) * (size_t)prims.n) == 0 &&
-                        memcmp(cls.p, seen_cls.p, (size_t)cls.n) == 0) {
+                    // (no memcmp/memcpy of an empty list: its pointer may still be null)
+                    if (last >= 0 && prims.n == seen.n &&
+                        (prims.n == 0 || (memcmp(prims.p, seen.p, sizeof(int) * (size_t)prims.n) == 0 &&
+                                          memcmp(cls.p, seen_cls.p, (size_t)cls.n) == 0))) {
                         out = last;
                         continue;
                     }
@@ -3044,8 +3046,10 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin) {
                     ok = out >= 0 && seen.reserve(c, prims.n + 1) && seen_cls.reserve(c, prims.n + 1);
                     if (!ok) break;
                     seen.n = seen_cls.n = prims.n;
-                    memcpy(seen.p, prims.p, sizeof(int) * (size_t)prims.n);
-                    memcpy(seen_cls.p, cls.p, (size_t)cls.n);
+                    if (prims.n) {
+                        memcpy(seen.p, prims.p, sizeof(int) * (size_t)prims.n);
+                        memcpy(seen_cls.p, cls.p, (size_t)cls.n);
+                    }
                     last = out;
                 }
         }
