@@ -124,7 +124,7 @@ void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
 /* ---------------------------------------------------------------------------------------------
    Options: the same names as the PRAY `option` statement: width, height (pixels, default 256),
    depth (ray depth, 5), antialias (samples per pixel side, 1), adaptive (0), grid (-1 =
-   automatic), gridmem (MiB for the grid, 64), freeze, merge, bounds, lightbuffer, shadows (1/0,
+   automatic), gridmem (MiB for the grid, 64), freeze, merge, bounds, lightbuffer, eyebuffer, shadows (1/0,
    default 1), brute (1 = the brute-force reference renderer, 0), threads (0 = automatic), maxsteps
    (statements a program may execute, 10000000; 0 = no limit), texmem (MiB for textures, 256),
    bits (8 or 16 per sample in TIFF/PPM files), and the string option output (file name of
@@ -261,6 +261,8 @@ typedef struct pray_stats {
     double rays_primary_full;        /* primary rays without undersampling (option adaptive) */
     long lightbuf_voxels;            /* voxels of the light buffers (option lightbuffer) */
     double rays_lightbuf;            /* shadow rays answered by a light buffer's list */
+    long eyebuf_voxels;              /* voxels of the eye's buffer (option eyebuffer) */
+    double rays_eyebuf;              /* primary rays traced through the eye's buffer */
     int threads;                     /* threads of the last render */
     double voxel_steps, area_moves;  /* traversal steps; steps inside an area (no evaluation) */
     double set_inside, set_outside, checks; /* actions executed, by kind */
@@ -352,9 +354,11 @@ pray_status pray_render_file(const char *program, const char *const *options, in
    an n-ary CSG status tree (thesis 3.4). Option brute=1 does exactly that for every primitive:
    the reference. By default the scene is simplified, a uniform grid of voxels with per-voxel
    action lists is built (thesis 3.3-3.6: leading-axis traversal, set/check actions, freezing,
-   areas), bounding boxes prune what cannot be met, and light buffers answer shadow rays
-   from one list per voxel around each light. Options grid, freeze, merge, bounds and
-   lightbuffer switch the parts on and off; every setting gives the image of brute=1, byte for byte.
+   areas), bounding boxes prune what cannot be met, light buffers answer shadow rays from one
+   list per voxel around each light, and primary rays walk the lists of the eye's buffer, a
+   grid of pyramids around a perspective camera's eye. Options grid, freeze, merge, bounds,
+   lightbuffer and eyebuffer switch the parts on and off; every setting gives the image of
+   brute=1, byte for byte.
    docs/acceleration.md explains the methods, docs/benchmarks.md measures them.
    Secondary rays know the primitive they start on and never meet it again at their origin;
    nor any primitive of exactly the same surface (faces shared by parts, snapped to be equal).

@@ -982,7 +982,7 @@ TEST_CASE("accel light buffers: shadow rays from the light buffers' lists give t
                           {K_LATTICE, 2}, {K_LATTICE, 9}, {K_BLOCKS, 4},  {K_FLOOR, 3},  {K_FLOOR, 11},
                           {K_SCALED, 2},  {K_SCALED, 6},  {K_SCALED, 13}};
     pray_rgb w = {0.6, 0.6, 0.6}, w2 = {0.5, 0.4, 0.3};
-    long renders = 0, mismatches = 0;
+    long renders = 0, mismatches = 0, used = 0;
     std::vector<std::string> problems;
     for (const Pick &pk : picks) {
         pray_ctx *c = pray_new();
@@ -997,18 +997,20 @@ TEST_CASE("accel light buffers: shadow rays from the light buffers' lists give t
             c, pray_light_add(c, pray_dirlight(c, w, V(1, 2, -3)), pray_pointlight(c, w2, add(hi, size))),
             pray_light_add(c, pray_pointlight(c, w2, add(lo, mul(size, 0.3))), pray_pointlight(c, w2, mid)));
         REQUIRE(lights);
-        Render ref = render(c, s.root, lights, reference(), 40);
+        // (128 x 128 and coarse grids: a buffer is built for images with enough pixels per voxel)
+        Render ref = render(c, s.root, lights, reference(), 128);
         REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
-        for (int grid : {-1, 3, 16}) {
+        for (int grid : {3, 5, 8}) {
             for (int lb = 0; lb < 2; lb++) {
                 REQUIRE(pray_option(c, "lightbuffer", lb) == PRAY_OK);
                 pray_stats before;
                 pray_stats_get(c, &before);
-                Render r = render(c, s.root, lights, Opts{0, grid, 1, 1, 1}, 40);
+                Render r = render(c, s.root, lights, Opts{0, grid, 1, 1, 1}, 128);
                 renders++;
                 CHECK_MESSAGE(r.status == PRAY_OK, s.label << ": " << r.error);
                 double answered = r.stats.rays_lightbuf - before.rays_lightbuf;
                 if (!lb) CHECK(answered == 0);
+                used += answered > 0;
                 std::string d = frame_difference(ref.frames, r.frames);
                 if (!d.empty()) {
                     mismatches++;
@@ -1022,8 +1024,10 @@ TEST_CASE("accel light buffers: shadow rays from the light buffers' lists give t
     }
     std::string all;
     for (auto &p : problems) all += "\n  - " + p;
-    MESSAGE(renders << " renders with and without light buffers, " << mismatches << " differing from brute=1");
+    MESSAGE(renders << " renders with and without light buffers, " << used << " of them answered from them, " << mismatches
+                    << " differing from brute=1");
     CHECK_MESSAGE(mismatches == 0, mismatches << " renders differ from brute=1:" << all);
+    CHECK(used > renders / 4);
 
     // A field of spheres lit by the sun and a lamp above: nearly every shadow ray starts in a
     // voxel of a light buffer and is answered from its list.
@@ -1032,7 +1036,8 @@ TEST_CASE("accel light buffers: shadow rays from the light buffers' lists give t
                           "  All = All | sphere(M, [(I % 20 - 9.5) * 0.1, ((I - I % 20) / 20 - 9.5) * 0.1, 0.05 * (I % 7)], 0.04)\n"
                           "  I = I + 1\nendwhile\n"
                           "rendertiff All, dirlight({0.7}, <1, 2, -3>), pointlight({0.5}, [0.5, 0.5, 3])\n";
-    std::vector<std::string> opts = {"width=64", "height=64", "shadows=1"};
+    // (a coarse grid, as in the eye's buffer's case below: buffers of few voxels)
+    std::vector<std::string> opts = {"width=160", "height=160", "shadows=1", "grid=12"};
     Run on = run_program("field.ray", program, opts);
     opts.push_back("lightbuffer=0");
     Run off = run_program("field.ray", program, opts);
@@ -1050,6 +1055,110 @@ TEST_CASE("accel light buffers: shadow rays from the light buffers' lists give t
     CHECK(off.stats.lightbuf_voxels == 0);
     CHECK(off.stats.rays_lightbuf == 0);
     CHECK(on.stats.voxel_steps < off.stats.voxel_steps);
+}
+
+TEST_CASE("accel eye buffer: primary rays through the eye's buffer give the reference's image from eyes outside, "
+          "inside, on the edge of and far from the grid's box; it answers the primary rays of a field of spheres") {
+    struct Pick {
+        int kind, seed;
+    };
+    const Pick picks[] = {{K_RANDOM, 4},  {K_RANDOM, 31}, {K_MANY, 3},   {K_MANY, 8},   {K_LATTICE, 5},
+                          {K_BLOCKS, 6},  {K_FLOOR, 4},   {K_FLOOR, 13}, {K_SCALED, 3}, {K_SCALED, 9}};
+    long renders = 0, mismatches = 0, used = 0;
+    std::vector<std::string> problems;
+    for (const Pick &pk : picks) {
+        pray_ctx *c = pray_new();
+        REQUIRE(c);
+        Scene s = make_scene(c, pk.kind, (uint64_t)pk.seed);
+        CAPTURE(s.label);
+        REQUIRE_MESSAGE(s.root, std::string(pray_error(c)));
+        pray_light *lights = some_lights(c);
+        REQUIRE(lights);
+        pray_vec lo = s.lo, hi = s.hi, mid = mul(add(lo, hi), 0.5), size = sub(hi, lo);
+        double big = std::max(size.x, std::max(size.y, size.z));
+        struct Eye {
+            const char *name;
+            pray_vec at;
+        };
+        // (a corner of the box: on three of its faces, and on the edges of the buffer's faces)
+        const Eye eyes[] = {{"outside", add(mid, V(0.3 * big, -2.5 * big, 0.8 * big))},
+                            {"amid the objects", add(mid, mul(size, 0.1))},
+                            {"on a corner of the box", lo},
+                            {"far away", add(mid, V(-300 * big, -500 * big, 200 * big))}};
+        for (const Eye &e : eyes) {
+            pray_vec look = sub(mid, e.at);
+            if (dot(look, look) < 1e-6 * big * big) look = V(0, big, 0);
+            pray_vec side = cross(look, V(0, 0, 1));
+            if (dot(side, side) < 1e-12 * dot(look, look)) side = cross(look, V(1, 0, 0));
+            pray_vec x = mul(unit(side), 0.6 * big), y = mul(unit(cross(look, x)), 0.6 * big);
+            REQUIRE(pray_perspective(c, x, y, e.at, add(e.at, mul(unit(look), big))) == PRAY_OK);
+            Render ref = render(c, s.root, lights, reference(), 64);
+            REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
+            for (int grid : {3, 8}) {
+                for (int eb = 0; eb < 2; eb++) {
+                    REQUIRE(pray_option(c, "eyebuffer", eb) == PRAY_OK);
+                    pray_stats before;
+                    pray_stats_get(c, &before);
+                    Render r = render(c, s.root, lights, Opts{0, grid, 1, 1, 1}, 64);
+                    renders++;
+                    CHECK_MESSAGE(r.status == PRAY_OK, s.label << ": " << r.error);
+                    double through = r.stats.rays_eyebuf - before.rays_eyebuf;
+                    if (!eb) CHECK(through == 0);
+                    used += through > 0;
+                    std::string d = frame_difference(ref.frames, r.frames);
+                    if (!d.empty()) {
+                        mismatches++;
+                        if (problems.size() < 20)
+                            problems.push_back(s.label + ", eye " + e.name + ", grid=" + std::to_string(grid) +
+                                               " eyebuffer=" + std::to_string(eb) + ": " + d);
+                    }
+                }
+            }
+        }
+        pray_free(c);
+    }
+    std::string all;
+    for (auto &p : problems) all += "\n  - " + p;
+    MESSAGE(renders << " renders with and without the eye's buffer, " << used << " of them through it, " << mismatches
+                    << " differing from brute=1");
+    CHECK_MESSAGE(mismatches == 0, mismatches << " renders differ from brute=1:" << all);
+    CHECK(used > renders / 4);  // most renders with the buffer on: not all, crowded cells walk the grid
+
+    // A field of spheres seen from above: every primary ray walks its cell of the eye's buffer,
+    // and none steps through the grid's voxels. Small images and parallel projections build none.
+    std::string field = "M = phong({0.7}, {0.3}, 20)\nAll = nothing\nI = 0\nwhile I < 400\n"
+                        "  All = All | sphere(M, [(I % 20 - 9.5) * 0.1, ((I - I % 20) / 20 - 9.5) * 0.1, 0.05 * (I % 7)], 0.04)\n"
+                        "  I = I + 1\nendwhile\n"
+                        "rendertiff All, dirlight({0.7}, <1, 2, -3>)\n";
+    std::string program = "perspective <1.2, 0, 0>, <0, 0.85, 0.85>, [0, -3, 3], [0, 0, 0]\n" + field;
+    // (a coarse grid: the buffer's cells are as wide as its voxels, and this image has pixels
+    // enough for that many)
+    std::vector<std::string> opts = {"width=160", "height=160", "shadows=0", "grid=12"};
+    Run on = run_program("field.ray", program, opts);
+    opts.push_back("eyebuffer=0");
+    Run off = run_program("field.ray", program, opts);
+    opts.back() = "brute=1";
+    Run brute = run_program("field.ray", program, opts);
+    REQUIRE_MESSAGE(on.status == PRAY_OK, on.error);
+    REQUIRE_MESSAGE(off.status == PRAY_OK, off.error);
+    REQUIRE_MESSAGE(brute.status == PRAY_OK, brute.error);
+    INFO("eyebuffer=1: ", stats_text(on.stats), "; primary rays through the eye's buffer ", on.stats.rays_eyebuf);
+    CHECK(frame_difference(brute.frames, on.frames) == "");
+    CHECK(frame_difference(brute.frames, off.frames) == "");
+    CHECK(on.stats.eyebuf_voxels > 0);
+    CHECK(on.stats.rays_eyebuf == on.stats.rays_primary);
+    CHECK(on.stats.voxel_steps == 0);
+    CHECK(off.stats.eyebuf_voxels == 0);
+    CHECK(off.stats.rays_eyebuf == 0);
+    CHECK(off.stats.voxel_steps > 0);
+    Run tiny = run_program("field.ray", program, {"width=8", "height=8", "shadows=0", "grid=12"});
+    REQUIRE_MESSAGE(tiny.status == PRAY_OK, tiny.error);
+    CHECK(tiny.stats.eyebuf_voxels == 0);
+    Run par = run_program("field.ray", "parallel <1.2, 0, 0>, <0, 0.85, 0.85>, [0, -3, 3], [0, 0, 0]\n" + field,
+                          {"width=160", "height=160", "shadows=0", "grid=12"});
+    REQUIRE_MESSAGE(par.status == PRAY_OK, par.error);
+    CHECK(par.stats.eyebuf_voxels == 0);
+    CHECK(par.stats.rays_eyebuf == 0);
 }
 
 TEST_CASE("accel hits: degenerate roots (nothing, one, complements, a lone primitive) with every combination") {
