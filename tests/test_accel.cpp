@@ -973,6 +973,76 @@ TEST_CASE("accel stats: of a program run; parts that cannot matter are not kept"
 // images as the reference, whether the lights are outside the scene, inside its grid or amid
 // its objects, and they do answer.
 // ---------------------------------------------------------------------------------------------
+// Renders of a scene with a switch (an option of 0 or 1) off and on at each grid size, compared
+// float for float with the reference's frames; `counted`: the statistic that grows when the
+// switched method is used, which must stay put when it is off.
+struct SwitchTally {
+    long renders = 0, used = 0, mismatches = 0;
+    std::vector<std::string> problems;  // the first 20
+};
+
+void render_switched(pray_ctx *c, pray_object *root, pray_light *lights, const Render &ref, const char *option,
+                     double pray_stats::*counted, std::initializer_list<int> grids, int size, const std::string &label,
+                     SwitchTally &t) {
+    for (int grid : grids) {
+        for (int on = 0; on < 2; on++) {
+            REQUIRE(pray_option(c, option, on) == PRAY_OK);
+            pray_stats before;
+            pray_stats_get(c, &before);
+            Render r = render(c, root, lights, Opts{0, grid, 1, 1, 1}, size);
+            t.renders++;
+            CHECK_MESSAGE(r.status == PRAY_OK, label << ": " << r.error);
+            double grew = r.stats.*counted - before.*counted;
+            if (!on) CHECK(grew == 0);
+            t.used += grew > 0;
+            std::string d = frame_difference(ref.frames, r.frames);
+            if (!d.empty() && ++t.mismatches <= 20)
+                t.problems.push_back(label + ", grid=" + std::to_string(grid) + " " + option + "=" + std::to_string(on) + ": " + d);
+        }
+    }
+    REQUIRE(pray_option(c, option, 1) == PRAY_OK);
+}
+
+// The field of spheres of the buffers' tests: 400 small balls on a plane, the camera's vectors
+// (for `perspective` or `parallel`) looking down on it at 45 degrees; the lights are added.
+const char *const FIELD_CAMERA = " <1.2, 0, 0>, <0, 0.85, 0.85>, [0, -3, 3], [0, 0, 0]\n";
+const char *const FIELD =
+    "M = phong({0.7}, {0.3}, 20)\nAll = nothing\nI = 0\nwhile I < 400\n"
+    "  All = All | sphere(M, [(I % 20 - 9.5) * 0.1, ((I - I % 20) / 20 - 9.5) * 0.1, 0.05 * (I % 7)], 0.04)\n"
+    "  I = I + 1\nendwhile\n";
+
+// A program run with a switch on (its default), off, and as the reference: both images must be
+// the reference's.
+struct Switched {
+    Run on, off;
+};
+
+Switched run_switched(const std::string &program, std::vector<std::string> opts, const char *option) {
+    Switched r;
+    r.on = run_program("field.ray", program, opts);
+    opts.push_back(std::string(option) + "=0");
+    r.off = run_program("field.ray", program, opts);
+    opts.back() = "brute=1";
+    Run brute = run_program("field.ray", program, opts);
+    REQUIRE_MESSAGE(r.on.status == PRAY_OK, r.on.error);
+    REQUIRE_MESSAGE(r.off.status == PRAY_OK, r.off.error);
+    REQUIRE_MESSAGE(brute.status == PRAY_OK, brute.error);
+    CHECK(frame_difference(brute.frames, r.on.frames) == "");
+    CHECK(frame_difference(brute.frames, r.off.frames) == "");
+    return r;
+}
+
+// No render differs from the reference, and at least a quarter of them used the method (not
+// all: crowded cells and small images walk the grid).
+void check_tally(const SwitchTally &t, const char *option) {
+    std::string all;
+    for (auto &p : t.problems) all += "\n  - " + p;
+    MESSAGE(t.renders << " renders with " << std::string(option) << " 0 and 1, " << t.used << " of them using it, " << t.mismatches
+                      << " differing from brute=1");
+    CHECK_MESSAGE(t.mismatches == 0, t.mismatches << " renders differ from brute=1:" << all);
+    CHECK(t.used > t.renders / 4);
+}
+
 TEST_CASE("accel light buffers: shadow rays from the light buffers' lists give the reference's image; they answer "
           "most shadow rays of a field of spheres") {
     struct Pick {
@@ -982,8 +1052,7 @@ TEST_CASE("accel light buffers: shadow rays from the light buffers' lists give t
                           {K_LATTICE, 2}, {K_LATTICE, 9}, {K_BLOCKS, 4},  {K_FLOOR, 3},  {K_FLOOR, 11},
                           {K_SCALED, 2},  {K_SCALED, 6},  {K_SCALED, 13}};
     pray_rgb w = {0.6, 0.6, 0.6}, w2 = {0.5, 0.4, 0.3};
-    long renders = 0, mismatches = 0, used = 0;
-    std::vector<std::string> problems;
+    SwitchTally t;
     for (const Pick &pk : picks) {
         pray_ctx *c = pray_new();
         REQUIRE(c);
@@ -1000,55 +1069,19 @@ TEST_CASE("accel light buffers: shadow rays from the light buffers' lists give t
         // (128 x 128 and coarse grids: a buffer is built for images with enough pixels per voxel)
         Render ref = render(c, s.root, lights, reference(), 128);
         REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
-        for (int grid : {3, 5, 8}) {
-            for (int lb = 0; lb < 2; lb++) {
-                REQUIRE(pray_option(c, "lightbuffer", lb) == PRAY_OK);
-                pray_stats before;
-                pray_stats_get(c, &before);
-                Render r = render(c, s.root, lights, Opts{0, grid, 1, 1, 1}, 128);
-                renders++;
-                CHECK_MESSAGE(r.status == PRAY_OK, s.label << ": " << r.error);
-                double answered = r.stats.rays_lightbuf - before.rays_lightbuf;
-                if (!lb) CHECK(answered == 0);
-                used += answered > 0;
-                std::string d = frame_difference(ref.frames, r.frames);
-                if (!d.empty()) {
-                    mismatches++;
-                    if (problems.size() < 20)
-                        problems.push_back(s.label + ", grid=" + std::to_string(grid) + " lightbuffer=" + std::to_string(lb) + ": " + d);
-                }
-            }
-        }
-        REQUIRE(pray_option(c, "lightbuffer", 1) == PRAY_OK);
+        render_switched(c, s.root, lights, ref, "lightbuffer", &pray_stats::rays_lightbuf, {3, 5, 8}, 128, s.label, t);
         pray_free(c);
     }
-    std::string all;
-    for (auto &p : problems) all += "\n  - " + p;
-    MESSAGE(renders << " renders with and without light buffers, " << used << " of them answered from them, " << mismatches
-                    << " differing from brute=1");
-    CHECK_MESSAGE(mismatches == 0, mismatches << " renders differ from brute=1:" << all);
-    CHECK(used > renders / 4);
+    check_tally(t, "lightbuffer");
 
     // A field of spheres lit by the sun and a lamp above: nearly every shadow ray starts in a
     // voxel of a light buffer and is answered from its list.
-    std::string program = "perspective <1.2, 0, 0>, <0, 0.85, 0.85>, [0, -3, 3], [0, 0, 0]\n"
-                          "M = phong({0.7}, {0.3}, 20)\nAll = nothing\nI = 0\nwhile I < 400\n"
-                          "  All = All | sphere(M, [(I % 20 - 9.5) * 0.1, ((I - I % 20) / 20 - 9.5) * 0.1, 0.05 * (I % 7)], 0.04)\n"
-                          "  I = I + 1\nendwhile\n"
+    std::string program = std::string("perspective") + FIELD_CAMERA + FIELD +
                           "rendertiff All, dirlight({0.7}, <1, 2, -3>), pointlight({0.5}, [0.5, 0.5, 3])\n";
     // (a coarse grid, as in the eye's buffer's case below: buffers of few voxels)
-    std::vector<std::string> opts = {"width=160", "height=160", "shadows=1", "grid=12"};
-    Run on = run_program("field.ray", program, opts);
-    opts.push_back("lightbuffer=0");
-    Run off = run_program("field.ray", program, opts);
-    opts.back() = "brute=1";
-    Run brute = run_program("field.ray", program, opts);
-    REQUIRE_MESSAGE(on.status == PRAY_OK, on.error);
-    REQUIRE_MESSAGE(off.status == PRAY_OK, off.error);
-    REQUIRE_MESSAGE(brute.status == PRAY_OK, brute.error);
+    Switched r = run_switched(program, {"width=160", "height=160", "shadows=1", "grid=12"}, "lightbuffer");
+    const Run &on = r.on, &off = r.off;
     INFO("lightbuffer=1: ", stats_text(on.stats), "; shadow rays answered by light buffers ", on.stats.rays_lightbuf);
-    CHECK(frame_difference(brute.frames, on.frames) == "");
-    CHECK(frame_difference(brute.frames, off.frames) == "");
     CHECK(on.stats.lightbuf_voxels > 0);
     CHECK(on.stats.rays_shadow > 1000);
     CHECK(on.stats.rays_lightbuf > 0.9 * on.stats.rays_shadow);
@@ -1064,8 +1097,7 @@ TEST_CASE("accel eye buffer: primary rays through the eye's buffer give the refe
     };
     const Pick picks[] = {{K_RANDOM, 4},  {K_RANDOM, 31}, {K_MANY, 3},   {K_MANY, 8},   {K_LATTICE, 5},
                           {K_BLOCKS, 6},  {K_FLOOR, 4},   {K_FLOOR, 13}, {K_SCALED, 3}, {K_SCALED, 9}};
-    long renders = 0, mismatches = 0, used = 0;
-    std::vector<std::string> problems;
+    SwitchTally t;
     for (const Pick &pk : picks) {
         pray_ctx *c = pray_new();
         REQUIRE(c);
@@ -1094,57 +1126,22 @@ TEST_CASE("accel eye buffer: primary rays through the eye's buffer give the refe
             REQUIRE(pray_perspective(c, x, y, e.at, add(e.at, mul(unit(look), big))) == PRAY_OK);
             Render ref = render(c, s.root, lights, reference(), 64);
             REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
-            for (int grid : {3, 8}) {
-                for (int eb = 0; eb < 2; eb++) {
-                    REQUIRE(pray_option(c, "eyebuffer", eb) == PRAY_OK);
-                    pray_stats before;
-                    pray_stats_get(c, &before);
-                    Render r = render(c, s.root, lights, Opts{0, grid, 1, 1, 1}, 64);
-                    renders++;
-                    CHECK_MESSAGE(r.status == PRAY_OK, s.label << ": " << r.error);
-                    double through = r.stats.rays_eyebuf - before.rays_eyebuf;
-                    if (!eb) CHECK(through == 0);
-                    used += through > 0;
-                    std::string d = frame_difference(ref.frames, r.frames);
-                    if (!d.empty()) {
-                        mismatches++;
-                        if (problems.size() < 20)
-                            problems.push_back(s.label + ", eye " + e.name + ", grid=" + std::to_string(grid) +
-                                               " eyebuffer=" + std::to_string(eb) + ": " + d);
-                    }
-                }
-            }
+            render_switched(c, s.root, lights, ref, "eyebuffer", &pray_stats::rays_eyebuf, {3, 8}, 64,
+                            s.label + ", eye " + e.name, t);
         }
         pray_free(c);
     }
-    std::string all;
-    for (auto &p : problems) all += "\n  - " + p;
-    MESSAGE(renders << " renders with and without the eye's buffer, " << used << " of them through it, " << mismatches
-                    << " differing from brute=1");
-    CHECK_MESSAGE(mismatches == 0, mismatches << " renders differ from brute=1:" << all);
-    CHECK(used > renders / 4);  // most renders with the buffer on: not all, crowded cells walk the grid
+    check_tally(t, "eyebuffer");
 
     // A field of spheres seen from above: every primary ray walks its cell of the eye's buffer,
     // and none steps through the grid's voxels. Small images and parallel projections build none.
-    std::string field = "M = phong({0.7}, {0.3}, 20)\nAll = nothing\nI = 0\nwhile I < 400\n"
-                        "  All = All | sphere(M, [(I % 20 - 9.5) * 0.1, ((I - I % 20) / 20 - 9.5) * 0.1, 0.05 * (I % 7)], 0.04)\n"
-                        "  I = I + 1\nendwhile\n"
-                        "rendertiff All, dirlight({0.7}, <1, 2, -3>)\n";
-    std::string program = "perspective <1.2, 0, 0>, <0, 0.85, 0.85>, [0, -3, 3], [0, 0, 0]\n" + field;
+    std::string field = std::string(FIELD_CAMERA) + FIELD + "rendertiff All, dirlight({0.7}, <1, 2, -3>)\n";
+    std::string program = "perspective" + field;
     // (a coarse grid: the buffer's cells are as wide as its voxels, and this image has pixels
     // enough for that many)
-    std::vector<std::string> opts = {"width=160", "height=160", "shadows=0", "grid=12"};
-    Run on = run_program("field.ray", program, opts);
-    opts.push_back("eyebuffer=0");
-    Run off = run_program("field.ray", program, opts);
-    opts.back() = "brute=1";
-    Run brute = run_program("field.ray", program, opts);
-    REQUIRE_MESSAGE(on.status == PRAY_OK, on.error);
-    REQUIRE_MESSAGE(off.status == PRAY_OK, off.error);
-    REQUIRE_MESSAGE(brute.status == PRAY_OK, brute.error);
+    Switched r = run_switched(program, {"width=160", "height=160", "shadows=0", "grid=12"}, "eyebuffer");
+    const Run &on = r.on, &off = r.off;
     INFO("eyebuffer=1: ", stats_text(on.stats), "; primary rays through the eye's buffer ", on.stats.rays_eyebuf);
-    CHECK(frame_difference(brute.frames, on.frames) == "");
-    CHECK(frame_difference(brute.frames, off.frames) == "");
     CHECK(on.stats.eyebuf_voxels > 0);
     CHECK(on.stats.rays_eyebuf == on.stats.rays_primary);
     CHECK(on.stats.voxel_steps == 0);
@@ -1154,7 +1151,7 @@ TEST_CASE("accel eye buffer: primary rays through the eye's buffer give the refe
     Run tiny = run_program("field.ray", program, {"width=8", "height=8", "shadows=0", "grid=12"});
     REQUIRE_MESSAGE(tiny.status == PRAY_OK, tiny.error);
     CHECK(tiny.stats.eyebuf_voxels == 0);
-    Run par = run_program("field.ray", "parallel <1.2, 0, 0>, <0, 0.85, 0.85>, [0, -3, 3], [0, 0, 0]\n" + field,
+    Run par = run_program("field.ray", "parallel" + field,
                           {"width=160", "height=160", "shadows=0", "grid=12"});
     REQUIRE_MESSAGE(par.status == PRAY_OK, par.error);
     CHECK(par.stats.eyebuf_voxels == 0);
