@@ -2761,6 +2761,22 @@ inline int cube_face(R3 m) {
     return 2 * a + (comp(m, a) < 0);
 }
 
+// The cell of face F at (u, v) (a point light's u and v are over w), the face's cells widened
+// by `slack` cells and clamped: 1 and *cell set; 0 when (u, v) is beside the cells; -1 when not
+// a number.
+inline int face_cell(const LightFace &F, real u, real v, real slack, int *cell) {
+    real g[2] = {u, v};
+    int i[2];
+    for (int l = 0; l < 2; l++) {
+        real k = (g[l] - F.lo[l]) * F.inv[l];
+        if (k != k) return -1;
+        if (!(k >= -slack && k < (real)F.n[l] + slack)) return 0;
+        i[l] = k < 0 ? 0 : k < (real)F.n[l] ? (int)k : F.n[l] - 1;
+    }
+    *cell = i[1] * F.n[0] + i[0];
+    return 1;
+}
+
 inline int lightbuf_find(const LightBuf &B, int outer, R3 x, real tmax, real *ta, real *tb) {
     if (B.faces == 0) return -1;
     R3 m = x - B.o;
@@ -2775,30 +2791,25 @@ inline int lightbuf_find(const LightBuf &B, int outer, R3 x, real tmax, real *ta
         g[0] *= k;
         g[1] *= k;
     }
-    real k[3];
-    for (int l = 0; l < 3; l++) {
-        k[l] = (g[l] - F.lo[l]) * F.inv[l];
-        if (k[l] != k[l]) return -1;
-        if (l == 2) break;
-        // a point light's zones are widened by a quarter of a cell (eps in lightbuf_build), so
-        // a point rounded just past the edge of a face (u = 1 in one face, -1 in the next) belongs
-        // in the edge cell
-        real slack = B.point ? (real)0.25 : 0;
-        if (!(k[l] >= -slack && k[l] < (real)F.n[l] + slack)) return outer;  // beside the grid's box
-        k[l] = k[l] < 0 ? 0 : k[l] < (real)F.n[l] ? k[l] : (real)(F.n[l] - 1);
-    }
+    // a point light's zones are widened by a quarter of a cell (eps in lightbuf_build), so a
+    // point rounded just past the edge of a face (u = 1 in one face, -1 in the next) belongs in
+    // the edge cell
+    int cell, in = face_cell(F, g[0], g[1], B.point ? (real)0.25 : 0, &cell);
+    if (in <= 0) return in < 0 ? -1 : outer;  // not a number; beside the grid's box
+    real k = (g[2] - F.lo[2]) * F.inv[2];
+    if (k != k) return -1;
     int slab;
     if (!B.point) {  // w grows towards the light
-        if (!(k[2] < (real)F.n[2])) return outer;  // past the box already
+        if (!(k < (real)F.n[2])) return outer;  // past the box already
         *tb = B.top - g[2];
-        slab = k[2] < 0 ? 0 : (int)k[2];
-        if (k[2] < 0) *ta = F.lo[2] - g[2];  // below the box: reaches it there
+        slab = k < 0 ? 0 : (int)k;
+        if (k < 0) *ta = F.lo[2] - g[2];  // below the box: reaches it there
     } else {         // w shrinks towards the light
-        if (k[2] < 0) return outer;  // between the light and the box
-        slab = k[2] < (real)F.n[2] ? (int)k[2] : F.n[2] - 1;
-        if (!(k[2] < (real)F.n[2])) *ta = tmax * ((real)1 - (F.lo[2] + (real)F.n[2] * F.h[2]) / g[2]);  // beyond it
+        if (k < 0) return outer;  // between the light and the box
+        slab = k < (real)F.n[2] ? (int)k : F.n[2] - 1;
+        if (!(k < (real)F.n[2])) *ta = tmax * ((real)1 - (F.lo[2] + (real)F.n[2] * F.h[2]) / g[2]);  // beyond it
     }
-    return B.list[F.base + (slab * F.n[1] + (int)k[1]) * F.n[0] + (int)k[0]];
+    return B.list[F.base + slab * F.n[1] * F.n[0] + cell];
 }
 
 // The zone of voxel (iu, iv, k) of face F, widened by the margin (a point light's cells by
@@ -3227,10 +3238,10 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         double f = (double)(region.hi[l] - region.lo[l]) / ext;
         fill *= f > 1.0 / 16 ? f : 1.0 / 16;
     }
+    // the image's primary rays (samples): they size the grid and decide the buffers
+    double aa = opt_int(c, OPT_ANTIALIAS), rays = (double)opt_int(c, OPT_WIDTH) * opt_int(c, OPT_HEIGHT) * aa * aa;
     int want = opt_int(c, OPT_GRID);
-    if (want < 0)
-        want = auto_grid(bounded, (double)opt_int(c, OPT_WIDTH) * opt_int(c, OPT_HEIGHT) * opt_int(c, OPT_ANTIALIAS) *
-                                      opt_int(c, OPT_ANTIALIAS), fill);
+    if (want < 0) want = auto_grid(bounded, rays, fill);
     if (box_empty(region) || bounded == 0 || s->root < 0) want = 0;
     if (!(ext > 0) || !finite_num(ext)) want = 0;
     // voxels are cubes; the margin keeps classification safe from rounding in the traversal
@@ -3420,7 +3431,6 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     }
     bool lights = opt_int(c, OPT_SHADOWS) && opt_int(c, OPT_LIGHTBUFFER) && s->lights.n > 0;
     bool eye = render && opt_int(c, OPT_EYEBUFFER) && !s->parallel;
-    double aa = opt_int(c, OPT_ANTIALIAS), rays = (double)opt_int(c, OPT_WIDTH) * opt_int(c, OPT_HEIGHT) * aa * aa;
     if (st == PRAY_OK && a->n[0] > 0 && (lights || eye) && !lightbuf_build(b, eff, a->h, (real)margin, lights, eye, rays))
         st = c->status;
     cand.release(c);
@@ -3929,18 +3939,13 @@ void primary_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, Visit &
     }
     const int *run = NULL, *end = NULL;  // the cell's runs; NULL: the ray misses the box
     if (F->n[2] > 0) {
-        real k0 = (dot(ray.d, F->e[0]) / g2 - F->lo[0]) * F->inv[0];
-        real k1 = (dot(ray.d, F->e[1]) / g2 - F->lo[1]) * F->inv[1];
-        const real slack = (real)0.25;  // the zones' widening, as in lightbuf_find
-        bool nan = k0 != k0 || k1 != k1;
-        if (!nan && k0 >= -slack && k0 < (real)F->n[0] + slack && k1 >= -slack && k1 < (real)F->n[1] + slack) {
-            int i0 = k0 < 0 ? 0 : k0 < (real)F->n[0] ? (int)k0 : F->n[0] - 1;
-            int i1 = k1 < 0 ? 0 : k1 < (real)F->n[1] ? (int)k1 : F->n[1] - 1;
-            int cell = F->cbase + i1 * F->n[0] + i0;
-            run = B->runs + B->runs[cell];
-            end = B->runs + B->runs[cell + 1];
+        // (the zones' widening, as in lightbuf_find)
+        int cell, in = face_cell(*F, dot(ray.d, F->e[0]) / g2, dot(ray.d, F->e[1]) / g2, (real)0.25, &cell);
+        if (in > 0) {
+            run = B->runs + B->runs[F->cbase + cell];
+            end = B->runs + B->runs[F->cbase + cell + 1];
         }
-        if (nan || (run && run[0] < 0)) {
+        if (in < 0 || (run && run[0] < 0)) {
             find_hits(s, w, ray, tmax, -1, visit);
             return;
         }

@@ -769,6 +769,11 @@ Render render(pray_ctx *c, pray_object *root, pray_light *lights, const Opts &o,
     return r;
 }
 
+// A generated scene of the image tests: its kind and seed.
+struct Pick {
+    int kind, seed;
+};
+
 pray_light *some_lights(pray_ctx *c) {
     pray_rgb w = {0.7, 0.7, 0.7}, w2 = {0.4, 0.4, 0.4};
     return pray_light_add(c, pray_dirlight(c, w, V(1, 2, -3)), pray_pointlight(c, w2, V(-2, -3, 2)));
@@ -778,9 +783,6 @@ pray_light *some_lights(pray_ctx *c) {
 
 TEST_CASE("accel images: random scenes rendered with every switch combination equal the reference; freezing "
           "never adds intersection tests") {
-    struct Pick {
-        int kind, seed;
-    };
     const Pick picks[] = {{K_RANDOM, 3}, {K_RANDOM, 17}, {K_RANDOM, 42}, {K_RANDOM, 77}, {K_RANDOM, 101},
                           {K_MANY, 2},   {K_MANY, 5},    {K_LATTICE, 1}, {K_LATTICE, 4}, {K_BLOCKS, 3},
                           {K_BLOCKS, 12}, {K_FLOOR, 2},  {K_FLOOR, 9}};
@@ -1045,9 +1047,6 @@ void check_tally(const SwitchTally &t, const char *option) {
 
 TEST_CASE("accel light buffers: shadow rays from the light buffers' lists give the reference's image; they answer "
           "most shadow rays of a field of spheres") {
-    struct Pick {
-        int kind, seed;
-    };
     const Pick picks[] = {{K_RANDOM, 5},  {K_RANDOM, 23}, {K_RANDOM, 64}, {K_MANY, 1},   {K_MANY, 7},
                           {K_LATTICE, 2}, {K_LATTICE, 9}, {K_BLOCKS, 4},  {K_FLOOR, 3},  {K_FLOOR, 11},
                           {K_SCALED, 2},  {K_SCALED, 6},  {K_SCALED, 13}};
@@ -1092,9 +1091,6 @@ TEST_CASE("accel light buffers: shadow rays from the light buffers' lists give t
 
 TEST_CASE("accel eye buffer: primary rays through the eye's buffer give the reference's image from eyes outside, "
           "inside, on the edge of and far from the grid's box; it answers the primary rays of a field of spheres") {
-    struct Pick {
-        int kind, seed;
-    };
     const Pick picks[] = {{K_RANDOM, 4},  {K_RANDOM, 31}, {K_MANY, 3},   {K_MANY, 8},   {K_LATTICE, 5},
                           {K_BLOCKS, 6},  {K_FLOOR, 4},   {K_FLOOR, 13}, {K_SCALED, 3}, {K_SCALED, 9}};
     SwitchTally t;
