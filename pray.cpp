@@ -312,8 +312,8 @@ struct Block {
 enum {
     OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_DEPTH, OPT_EYEBUFFER, OPT_FREEZE,
     OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_LIGHTBUFFER, OPT_MAXLINE, OPT_MAXMEM, OPT_MAXNEST, OPT_MAXPIXELS, OPT_MAXPRIMS,
-    OPT_MAXSTEPS, OPT_MAXSTRING, OPT_MERGE, OPT_OUTPUT, OPT_SHADOWS, OPT_TEXMEM, OPT_THREADS, OPT_WIDTH,
-    OPT_COUNT
+    OPT_MAXSTEPS, OPT_MAXSTRING, OPT_MERGE, OPT_OUTPUT, OPT_SHADOWCACHE, OPT_SHADOWS, OPT_TEXMEM, OPT_THREADS,
+    OPT_WIDTH, OPT_COUNT
 };
 
 struct Options {
@@ -696,6 +696,7 @@ struct pray_model {
     struct pray_texture *tex;
     double amount, dx, dy;
     pray_rgb factor;
+    double clear;  // not M_FLAT: the most any component of its transmit weight can be, in magnitude
 };
 
 // A decoded texture image: RGB floats, rows from the first row of the file.
@@ -1008,6 +1009,14 @@ pray_light *light_union(pray_ctx *c, const pray_light *a, const pray_light *b) {
     return l;
 }
 
+inline double rgb_maxabs(pray_rgb v) {
+    double r = fabs(v.r), g = fabs(v.g), b = fabs(v.b);
+    return r > g ? (r > b ? r : b) : (g > b ? g : b);
+}
+
+// The most any component of the model's transmit weight can be anywhere, in magnitude.
+double model_clear(const pray_model *m) { return m->kind == M_FLAT ? rgb_maxabs(m->transmit) : m->clear; }
+
 // A model node of the given kind over a and b (b may be NULL).
 pray_model *model_node(pray_ctx *c, int kind, pray_model *a, pray_model *b) {
     int depth = 1 + (a->depth > (b ? b->depth : 0) ? a->depth : b->depth);
@@ -1025,6 +1034,8 @@ pray_model *model_node(pray_ctx *c, int kind, pray_model *a, pray_model *b) {
     retain(b);
     m->has_exponent = a->has_exponent || (b && b->has_exponent);
     m->has_index = a->has_index || (b && b->has_index);
+    // (a texture's blend weights are at most 1; M_SCALE multiplies by its factor's largest)
+    m->clear = model_clear(a) + (b ? model_clear(b) : 0);
     return m;
 }
 
@@ -1048,7 +1059,7 @@ pray_model *model_sum(pray_ctx *c, pray_model *a, pray_model *b) {
 pray_model *model_times(pray_ctx *c, pray_model *a, pray_rgb f) {
     if (a->kind != M_FLAT) {
         pray_model *m = model_node(c, M_SCALE, a, NULL);
-        if (m) m->factor = f;
+        if (m) m->factor = f, m->clear *= rgb_maxabs(f);
         return m;
     }
     pray_model *m = model_new(c);
@@ -1097,6 +1108,7 @@ const OptDef OPTS[OPT_COUNT] = {
     {"maxstring", 65536, 1, 16777216, 1, 4096},
     {"merge", 1, 0, 1, 1, 0},
     {"output", 0, 0, 0, 0, 0},
+    {"shadowcache", 1, 0, 1, 1, 0},
     {"shadows", 1, 0, 1, 1, 0},
     {"texmem", 256, 1, 65536, 1, 64},
     {"threads", 0, 0, 1024, 1, 0},
@@ -1935,6 +1947,7 @@ struct Counters {
     double steps, moves, set_in, set_out, checks, frozen;
     double lbuf;  // shadow rays answered by a light buffer
     double ebuf;  // primary rays answered by the eye's buffer
+    double cache; // shadow rays answered by the shadow cache
 };
 enum { RAY_PRIMARY, RAY_SHADOW, RAY_REFLECT, RAY_REFRACT };
 
@@ -1965,6 +1978,7 @@ struct Scratch {
     unsigned *nfixed;               // status known for the rest of this ray ...
     unsigned char *nfixval;         // ... and its value
     int root_fixed;                 // the root's status cannot change any more on this ray
+    long *blocker;                  // per light: the shadow cache's voxel, -1: none (shadow_probe)
 };
 
 // What threads write all the time stays off the cache lines of other threads' data: every
@@ -1986,7 +2000,10 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->nfrozen = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
     w->nfixed = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
     w->nfixval = (unsigned char *)thread_alloc(c, nn);
-    return w->cross && w->hull && w->pstat && w->nstat && w->nfirst && w->cnt && w->span && w->nfrozen && w->nfixed && w->nfixval;
+    w->blocker = (long *)thread_alloc(c, sizeof(long) * (size_t)(s->lights.n + 1));
+    for (int i = 0; w->blocker && i < s->lights.n; i++) w->blocker[i] = -1;
+    return w->blocker && w->cross && w->hull && w->pstat && w->nstat && w->nfirst && w->cnt && w->span &&
+           w->nfrozen && w->nfixed && w->nfixval;
 }
 
 void scratch_release(pray_ctx *c, Scratch *w) {
@@ -1994,6 +2011,7 @@ void scratch_release(pray_ctx *c, Scratch *w) {
     mem_free(c, w->nfrozen);
     mem_free(c, w->nfixed);
     mem_free(c, w->nfixval);
+    mem_free(c, w->blocker);
     mem_free(c, w->cross);
     mem_free(c, w->hull);
     mem_free(c, w->pstat);
@@ -2156,17 +2174,20 @@ struct FirstHit {
 };
 
 // Transmission along a shadow ray: the product of the transmit weights of every surface
-// crossed; stops at the first opaque one.
+// crossed; stops at the first opaque one, at t.
 pray_rgb transmit_at(const Prim &q, R3 x);
 
 struct ShadowHit {
     const Scene *s;
     const Ray *ray;
     pray_rgb f;
+    real t;
     bool operator()(const Hit &x) {
         const Prim &q = s->prims[x.prim];
         f = cmul(f, q.mat->kind == M_FLAT ? q.mat->transmit : transmit_at(q, ray->o + ray->d * x.t));
-        return !czero(f);
+        if (!czero(f)) return true;
+        t = x.t;
+        return false;
     }
 };
 
@@ -2224,6 +2245,7 @@ struct Accel {
     Array<int> plan;
     int outer;         // list of the space outside the grid (everything without a grid)
     int freeze, merge, bounds;
+    int cache;              // option shadowcache
     LightBuf *lbuf;         // per light, then the eye's; or NULL (options lightbuffer, eyebuffer)
     int nlbuf;              // the lights'
     const LightBuf *eye;    // &lbuf[nlbuf] when the eye has a buffer
@@ -3189,6 +3211,10 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     a->plan.init();
     a->freeze = opt_int(c, OPT_FREEZE);
     a->merge = opt_int(c, OPT_MERGE);
+    // (the shadow cache's answer is the reference's when no surface lets more light through
+    // than it receives: see shadow_probe)
+    a->cache = opt_int(c, OPT_SHADOWCACHE);
+    for (int i = 0; a->cache && i < s->prims.n; i++) a->cache = model_clear(s->prims[i].mat) <= 1;
     a->bounds = opt_int(c, OPT_BOUNDS);
     if (!a->off.push(c, 0)) return c->status;  // list 0: nothing can be hit
     for (int i = 0; i < 4; i++)
@@ -3747,6 +3773,15 @@ bool ray_box(const Ray &r, const real *inv, const real *lo, const real *hi, real
     return a <= b;
 }
 
+// The reciprocals of the direction's components for ray_box: 0 for a ray parallel to that axis
+// (1 / 0 is infinite), or so nearly that 1 / d overflows.
+inline void ray_inverse(const Ray &ray, real *inv) {
+    for (int l = 0; l < 3; l++) {
+        real q = (real)1 / comp(ray.d, l);
+        inv[l] = q - q == 0 ? q : 0;
+    }
+}
+
 // The smallest of three distances and its axis, ties to the later axis (selects, not branches:
 // the choice is a coin toss for a branch predictor).
 inline real nearest(const real *v, int *axis) {
@@ -3777,10 +3812,7 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
     if (s->root < 0) return;
     ray_begin(s, w);
     real inv[3];
-    for (int l = 0; l < 3; l++) {  // 0: parallel to the axis (1 / 0 is infinite), or so nearly that 1 / d overflows
-        real q = (real)1 / comp(ray.d, l);
-        inv[l] = q - q == 0 ? q : 0;
-    }
+    ray_inverse(ray, inv);
     if (A->bounds && A->n[0] == 0) {
         // without a grid, a bounded node whose box the ray misses is outside for the whole ray
         for (int j = s->nodes.n - 1; j >= 0; j--) {
@@ -3905,22 +3937,65 @@ void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, 
     else sweep(s, w, ray, tmax, self, visit);
 }
 
-// The hits along a shadow ray towards light `light`: from the list of its light buffer's voxel
-// when the ray starts in one, else as any other ray.
-template <class Visit>
-void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, Visit &visit) {
+// The shadow cache (option shadowcache): the voxel where the last shadow ray towards the same
+// light met an opaque surface (Scratch::blocker) is likely to hold one that stops this ray too.
+// Its list, evaluated on the ray's stretch through it, decides (true) when what it lets through
+// there is zero; else the ray is traced as usual. What the whole ray lets through is a product
+// of the same factors and more, in order. When no factor is more than 1 in magnitude (the
+// cache is off otherwise), rounding is monotonic and the product starts at 1, so the whole
+// ray's product is at most the stretch's at every step: zero too.
+bool shadow_probe(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, ShadowHit &visit) {
     const Accel *A = s->accel;
+    long v = w->blocker[light];
+    if (v < 0) return false;
+    int ix[3] = {(int)(v % A->n[0]), (int)(v / A->n[0] % A->n[1]), (int)(v / A->n[0] / A->n[1])};
+    real lo[3], hi[3], inv[3], ta, tb;
+    for (int l = 0; l < 3; l++) {
+        lo[l] = A->org[l] + (real)ix[l] * A->h;
+        hi[l] = lo[l] + A->h;
+    }
+    ray_inverse(ray, inv);
+    if (!ray_box(ray, inv, lo, hi, &ta, &tb)) return false;
+    ta = ta > 0 ? ta : 0;
+    tb = tb < tmax ? tb : tmax;
+    if (!(ta < tb)) return false;
+    ray_begin(s, w);
+    ShadowHit probe = visit;
+    eval_list(s, A, w, ray, A->voxel[v], ta, tb, tmax, self, probe);
+    if (!czero(probe.f)) return false;
+    w->k.cache += 1;
+    visit.f = probe.f;
+    return true;
+}
+
+// The voxel that holds the point, or -1 when it is outside the grid.
+long voxel_at(const Accel *A, R3 p) {
+    long at = 0;
+    for (int l = 2; l >= 0; l--) {
+        real g = (comp(p, l) - A->org[l]) * A->inv_h;
+        if (!(g >= 0 && g < (real)A->n[l])) return -1;
+        at = at * A->n[l] + (int)g;
+    }
+    return at;
+}
+
+// The hits along a shadow ray towards light `light`: the shadow cache's answer when it has one;
+// else from the list of the light buffer's voxel when the ray starts in one, else as any other ray.
+void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, ShadowHit &visit) {
+    const Accel *A = s->accel;
+    bool cache = A && A->cache && A->n[0] > 0;
+    if (cache && shadow_probe(s, w, ray, tmax, self, light, visit)) return;
     real ta = 0, tb = 0;
     int L = A && A->lbuf ? lightbuf_find(A->lbuf[light], A->outer, ray.o, tmax, &ta, &tb) : -1;
-    if (L < 0) {
-        find_hits(s, w, ray, tmax, self, visit);
-        return;
+    if (L < 0) find_hits(s, w, ray, tmax, self, visit);
+    else {
+        w->k.lbuf += 1;
+        ray_begin(s, w);
+        if (!(ta > 0 && eval_list(s, A, w, ray, A->outer, 0, ta, tmax, self, visit)) &&
+            !eval_list(s, A, w, ray, L, ta, tb, tmax, self, visit) && tb < tmax)
+            eval_list(s, A, w, ray, A->outer, tb, tmax, tmax, self, visit);
     }
-    w->k.lbuf += 1;
-    ray_begin(s, w);
-    if (ta > 0 && eval_list(s, A, w, ray, A->outer, 0, ta, tmax, self, visit)) return;
-    if (eval_list(s, A, w, ray, L, ta, tb, tmax, self, visit)) return;
-    if (tb < tmax) eval_list(s, A, w, ray, A->outer, tb, tmax, tmax, self, visit);
+    if (cache) w->blocker[light] = czero(visit.f) ? voxel_at(A, ray.o + ray.d * visit.t) : -1;
 }
 
 // The hits along a primary ray, which starts at the eye: when the eye has a buffer, the ray
@@ -5471,6 +5546,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
         c->stats.frozen_skips += k.frozen;
         c->stats.rays_lightbuf += k.lbuf;
         c->stats.rays_eyebuf += k.ebuf;
+        c->stats.rays_shadowcache += k.cache;
         scratch_release(c, &worker_at(wbuf, stride, i).w);
         worker_at(wbuf, stride, i).cache.release(c);
     }
@@ -8569,12 +8645,13 @@ void print_stats(pray_ctx *c) {
             "rays: primary %.0f (of %.0f without undersampling), shadow %.0f, reflected %.0f, refracted %.0f\n"
             "light buffers: %ld voxels; shadow rays from them %.0f\n"
             "eye buffer: %ld voxels; primary rays from it %.0f\n"
+            "shadow cache: shadow rays it stopped %.0f\n"
             "traversal: %.0f voxel steps, %.0f area moves\n"
             "actions: set inside %.0f, set outside %.0f, check %.0f (frozen skips %.0f)\n"
             "intersection tests %.0f\n"
             "time: parse %.3f s, prepare %.3f s, render %.3f s on %d thread%s\n",
             s.primitives_declared, s.primitives, s.nodes, s.grid[0], s.grid[1], s.grid[2], s.voxels, s.lists,
-            s.areas, s.memory, s.rays_primary, s.rays_primary_full, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.lightbuf_voxels, s.rays_lightbuf, s.eyebuf_voxels, s.rays_eyebuf, s.voxel_steps,
+            s.areas, s.memory, s.rays_primary, s.rays_primary_full, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.lightbuf_voxels, s.rays_lightbuf, s.eyebuf_voxels, s.rays_eyebuf, s.rays_shadowcache, s.voxel_steps,
             s.area_moves, s.set_inside, s.set_outside, s.checks, s.frozen_skips, s.intersection_tests,
             s.time_parse, s.time_prepare, s.time_render, s.threads, s.threads == 1 ? "" : "s");
 }

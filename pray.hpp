@@ -124,9 +124,10 @@ void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
 /* ---------------------------------------------------------------------------------------------
    Options: the same names as the PRAY `option` statement: width, height (pixels, default 256),
    depth (ray depth, 5), antialias (samples per pixel side, 1), adaptive (0), grid (-1 =
-   automatic), gridmem (MiB for the grid, 64), freeze, merge, bounds, lightbuffer, eyebuffer, shadows (1/0,
-   default 1), brute (1 = the brute-force reference renderer, 0), threads (0 = automatic), maxsteps
-   (statements a program may execute, 10000000; 0 = no limit), texmem (MiB for textures, 256),
+   automatic), gridmem (MiB for the grid, 64), freeze, merge, bounds, lightbuffer, eyebuffer,
+   shadowcache, shadows (1/0, default 1), brute (1 = the brute-force reference renderer, 0),
+   threads (0 = automatic), maxsteps (statements a program may execute, 10000000; 0 = no
+   limit), texmem (MiB for textures, 256),
    bits (8 or 16 per sample in TIFF/PPM files), and the string option output (file name of
    `rendertiff`; its extension picks the format).
 
@@ -263,6 +264,7 @@ typedef struct pray_stats {
     double rays_lightbuf;            /* shadow rays answered by a light buffer's list */
     long eyebuf_voxels;              /* voxels of the eye's buffer (option eyebuffer) */
     double rays_eyebuf;              /* primary rays traced through the eye's buffer */
+    double rays_shadowcache;         /* shadow rays stopped by the shadow cache (option shadowcache) */
     int threads;                     /* threads of the last render */
     double voxel_steps, area_moves;  /* traversal steps; steps inside an area (no evaluation) */
     double set_inside, set_outside, checks; /* actions executed, by kind */
@@ -356,9 +358,10 @@ pray_status pray_render_file(const char *program, const char *const *options, in
    action lists is built (thesis 3.3-3.6: leading-axis traversal, set/check actions, freezing,
    areas), bounding boxes prune what cannot be met, light buffers answer shadow rays from one
    list per voxel around each light, and primary rays walk the lists of the eye's buffer, a
-   grid of pyramids around a perspective camera's eye. Options grid, freeze, merge, bounds,
-   lightbuffer and eyebuffer switch the parts on and off; every setting gives the image of
-   brute=1, byte for byte.
+   grid of pyramids around a perspective camera's eye; a shadow ray first tries the voxel where
+   the last one towards its light was stopped. Options grid, freeze, merge, bounds,
+   lightbuffer, eyebuffer and shadowcache switch the parts on and off; every setting gives the
+   image of brute=1, byte for byte.
    docs/acceleration.md explains the methods, docs/benchmarks.md measures them.
    Secondary rays know the primitive they start on and never meet it again at their origin;
    nor any primitive of exactly the same surface (faces shared by parts, snapped to be equal).

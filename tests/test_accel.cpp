@@ -1089,6 +1089,69 @@ TEST_CASE("accel light buffers: shadow rays from the light buffers' lists give t
     CHECK(on.stats.voxel_steps < off.stats.voxel_steps);
 }
 
+TEST_CASE("accel shadow cache: shadow rays stopped in the voxel of the last ray's blocker give the reference's "
+          "image, through glass and with lights amid the objects; it stops most shadow rays under a table") {
+    const Pick picks[] = {{K_RANDOM, 30}, {K_RANDOM, 41}, {K_RANDOM, 64}, {K_RANDOM, 66}, {K_MANY, 4},  {K_LATTICE, 3},
+                          {K_BLOCKS, 7},  {K_FLOOR, 5},   {K_FLOOR, 12},  {K_SCALED, 2},  {K_SCALED, 6}};
+    pray_rgb w = {0.6, 0.6, 0.6}, w2 = {0.5, 0.4, 0.3};
+    SwitchTally t;
+    for (const Pick &pk : picks) {
+        pray_ctx *c = pray_new();
+        REQUIRE(c);
+        Scene s = make_scene(c, pk.kind, (uint64_t)pk.seed);
+        CAPTURE(s.label);
+        REQUIRE_MESSAGE(s.root, std::string(pray_error(c)));
+        // the sun, a point light outside and one amid the objects, whose shadow rays end
+        // inside voxels that hold surfaces beyond them
+        pray_vec lo = s.lo, hi = s.hi, mid = mul(add(lo, hi), 0.5), size = sub(hi, lo);
+        pray_light *lights = pray_light_add(
+            c, pray_light_add(c, pray_dirlight(c, w, V(1, 2, -3)), pray_pointlight(c, w2, add(hi, size))),
+            pray_pointlight(c, w2, add(mid, mul(size, 0.05))));
+        REQUIRE(lights);
+        Render ref = render(c, s.root, lights, reference(), 64);
+        REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
+        render_switched(c, s.root, lights, ref, "shadowcache", &pray_stats::rays_shadowcache, {3, 8}, 64, s.label, t);
+        pray_free(c);
+    }
+    check_tally(t, "shadowcache");
+
+    // A table, and a pane of coloured glass with a bar across it, over the field of spheres on
+    // a floor, under the sun and a lamp: the shadows of the table and of the bar are answered
+    // from the cache; the pane's are not, though its glass is in the bar's voxels, since it lets
+    // light through. The lamp hangs just over the table, in voxels that hold its top.
+    auto box = [](const char *m, const char *lo, const char *hi) {
+        std::string b;
+        for (int k = 0; k < 6; k++)
+            b += std::string(k ? " & " : "") + "plane(" + m + ", " + (k & 1 ? lo : hi) + ", <" + (k / 2 == 0 ? "1, 0, 0" : k / 2 == 1 ? "0, 1, 0" : "0, 0, 1") + "> * " + (k & 1 ? "-1" : "1") + ")";
+        return b;
+    };
+    std::string program = std::string("perspective") + FIELD_CAMERA + FIELD +
+                          "G = transparent({0.9, 0.6, 0.3}, 1) + phong({0.1}, {0.2}, 10)\n"
+                          "T = " + box("M", "[-0.6, -0.6, 0.4]", "[0.3, 0.5, 0.45]") + "\n" +
+                          "P = " + box("G", "[0.4, -0.9, 0.5]", "[0.9, 0.2, 0.52]") + "\n" +
+                          "B = " + box("M", "[0.62, -0.9, 0.5]", "[0.68, 0.2, 0.52]") + "\n" +
+                          "F = " + box("M", "[-1.2, -1.2, -0.1]", "[1.2, 1.2, -0.04]") + "\n" +
+                          "rendertiff All | T | P | B | F, dirlight({0.7}, <0.3, -1, -1>), pointlight({0.5}, [-0.1, 0, 0.5])\n";
+    // (without light buffers, which would answer them too)
+    Switched r = run_switched(program, {"width=160", "height=160", "shadows=1", "grid=12", "lightbuffer=0"}, "shadowcache");
+    const Run &on = r.on, &off = r.off;
+    INFO("shadowcache=1: ", stats_text(on.stats), "; shadow rays stopped by the cache ", on.stats.rays_shadowcache);
+    CHECK(on.stats.rays_shadow > 10000);
+    CHECK(on.stats.rays_shadowcache > 0.3 * on.stats.rays_shadow);
+    CHECK(off.stats.rays_shadowcache == 0);
+    CHECK(on.stats.voxel_steps < off.stats.voxel_steps);
+
+    // A glass that gives out more light than it takes in (1.5 times) could make the product of
+    // a long shadow ray overflow before it meets the opaque surface: no cache in such a scene.
+    std::string bright = program;
+    const std::string pane = "transparent({0.9, 0.6, 0.3}";
+    bright.replace(bright.find(pane), pane.size(), "transparent({0.9, 1.5, 0.3}");
+    REQUIRE(bright != program);
+    Switched b = run_switched(bright, {"width=160", "height=160", "shadows=1", "grid=12", "lightbuffer=0"}, "shadowcache");
+    CHECK(b.on.stats.rays_shadow > 10000);
+    CHECK(b.on.stats.rays_shadowcache == 0);
+}
+
 TEST_CASE("accel eye buffer: primary rays through the eye's buffer give the reference's image from eyes outside, "
           "inside, on the edge of and far from the grid's box; it answers the primary rays of a field of spheres") {
     const Pick picks[] = {{K_RANDOM, 4},  {K_RANDOM, 31}, {K_MANY, 3},   {K_MANY, 8},   {K_LATTICE, 5},
