@@ -1045,33 +1045,39 @@ void check_tally(const SwitchTally &t, const char *option) {
     CHECK(t.used > t.renders / 4);
 }
 
+// Renders of picked random scenes under four lights, with a switch of shadow rays off and on,
+// tallied against the reference: a directional light, a point light far outside, one inside
+// the grid's box, and one on the scene's centre (amid or inside the objects).
+void shadow_switch_picks(const Pick *picks, size_t n, const char *option, double pray_stats::*counted,
+                         std::initializer_list<int> grids, int size, SwitchTally &t) {
+    pray_rgb w = {0.6, 0.6, 0.6}, w2 = {0.5, 0.4, 0.3};
+    for (size_t i = 0; i < n; i++) {
+        pray_ctx *c = pray_new();
+        REQUIRE(c);
+        Scene s = make_scene(c, picks[i].kind, (uint64_t)picks[i].seed);
+        CAPTURE(s.label);
+        REQUIRE_MESSAGE(s.root, std::string(pray_error(c)));
+        pray_vec lo = s.lo, hi = s.hi, mid = mul(add(lo, hi), 0.5), ext = sub(hi, lo);
+        pray_light *lights = pray_light_add(
+            c, pray_light_add(c, pray_dirlight(c, w, V(1, 2, -3)), pray_pointlight(c, w2, add(hi, ext))),
+            pray_light_add(c, pray_pointlight(c, w2, add(lo, mul(ext, 0.3))), pray_pointlight(c, w2, mid)));
+        REQUIRE(lights);
+        Render ref = render(c, s.root, lights, reference(), size);
+        REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
+        render_switched(c, s.root, lights, ref, option, counted, grids, size, s.label, t);
+        pray_free(c);
+    }
+    check_tally(t, option);
+}
+
 TEST_CASE("accel light buffers: shadow rays from the light buffers' lists give the reference's image; they answer "
           "most shadow rays of a field of spheres") {
     const Pick picks[] = {{K_RANDOM, 5},  {K_RANDOM, 23}, {K_RANDOM, 64}, {K_MANY, 1},   {K_MANY, 7},
                           {K_LATTICE, 2}, {K_LATTICE, 9}, {K_BLOCKS, 4},  {K_FLOOR, 3},  {K_FLOOR, 11},
                           {K_SCALED, 2},  {K_SCALED, 6},  {K_SCALED, 13}};
-    pray_rgb w = {0.6, 0.6, 0.6}, w2 = {0.5, 0.4, 0.3};
     SwitchTally t;
-    for (const Pick &pk : picks) {
-        pray_ctx *c = pray_new();
-        REQUIRE(c);
-        Scene s = make_scene(c, pk.kind, (uint64_t)pk.seed);
-        CAPTURE(s.label);
-        REQUIRE_MESSAGE(s.root, std::string(pray_error(c)));
-        // a directional light, a point light far outside, one inside the grid's box, and one
-        // on the scene's centre (amid or inside the objects)
-        pray_vec lo = s.lo, hi = s.hi, mid = mul(add(lo, hi), 0.5), size = sub(hi, lo);
-        pray_light *lights = pray_light_add(
-            c, pray_light_add(c, pray_dirlight(c, w, V(1, 2, -3)), pray_pointlight(c, w2, add(hi, size))),
-            pray_light_add(c, pray_pointlight(c, w2, add(lo, mul(size, 0.3))), pray_pointlight(c, w2, mid)));
-        REQUIRE(lights);
-        // (128 x 128 and coarse grids: a buffer is built for images with enough pixels per voxel)
-        Render ref = render(c, s.root, lights, reference(), 128);
-        REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
-        render_switched(c, s.root, lights, ref, "lightbuffer", &pray_stats::rays_lightbuf, {3, 5, 8}, 128, s.label, t);
-        pray_free(c);
-    }
-    check_tally(t, "lightbuffer");
+    // (128 x 128 and coarse grids: a buffer is built for images with enough pixels per voxel)
+    shadow_switch_picks(picks, sizeof picks / sizeof *picks, "lightbuffer", &pray_stats::rays_lightbuf, {3, 5, 8}, 128, t);
 
     // A field of spheres lit by the sun and a lamp above: nearly every shadow ray starts in a
     // voxel of a light buffer and is answered from its list.
@@ -1093,27 +1099,9 @@ TEST_CASE("accel shadow cache: shadow rays stopped in the voxel of the last ray'
           "image, through glass and with lights amid the objects; it stops most shadow rays under a table") {
     const Pick picks[] = {{K_RANDOM, 30}, {K_RANDOM, 41}, {K_RANDOM, 64}, {K_RANDOM, 66}, {K_MANY, 4},  {K_LATTICE, 3},
                           {K_BLOCKS, 7},  {K_FLOOR, 5},   {K_FLOOR, 12},  {K_SCALED, 2},  {K_SCALED, 6}};
-    pray_rgb w = {0.6, 0.6, 0.6}, w2 = {0.5, 0.4, 0.3};
     SwitchTally t;
-    for (const Pick &pk : picks) {
-        pray_ctx *c = pray_new();
-        REQUIRE(c);
-        Scene s = make_scene(c, pk.kind, (uint64_t)pk.seed);
-        CAPTURE(s.label);
-        REQUIRE_MESSAGE(s.root, std::string(pray_error(c)));
-        // the sun, a point light outside and one amid the objects, whose shadow rays end
-        // inside voxels that hold surfaces beyond them
-        pray_vec lo = s.lo, hi = s.hi, mid = mul(add(lo, hi), 0.5), size = sub(hi, lo);
-        pray_light *lights = pray_light_add(
-            c, pray_light_add(c, pray_dirlight(c, w, V(1, 2, -3)), pray_pointlight(c, w2, add(hi, size))),
-            pray_pointlight(c, w2, add(mid, mul(size, 0.05))));
-        REQUIRE(lights);
-        Render ref = render(c, s.root, lights, reference(), 64);
-        REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
-        render_switched(c, s.root, lights, ref, "shadowcache", &pray_stats::rays_shadowcache, {3, 8}, 64, s.label, t);
-        pray_free(c);
-    }
-    check_tally(t, "shadowcache");
+    // (the lamps amid the objects end their shadow rays in voxels that hold surfaces beyond them)
+    shadow_switch_picks(picks, sizeof picks / sizeof *picks, "shadowcache", &pray_stats::rays_shadowcache, {3, 8}, 64, t);
 
     // A table, and a pane of coloured glass with a bar across it, over the field of spheres on
     // a floor, under the sun and a lamp: the shadows of the table and of the bar are answered
