@@ -3961,6 +3961,7 @@ bool shadow_probe(const Scene *s, Scratch *w, const Ray &ray, real tmax, int sel
     if (!(ta < tb)) return false;
     ray_begin(s, w);
     ShadowHit probe = visit;
+    probe.f = cmake(1, 1, 1);
     eval_list(s, A, w, ray, A->voxel[v], ta, tb, tmax, self, probe);
     if (!czero(probe.f)) return false;
     w->k.cache += 1;
