@@ -2197,12 +2197,6 @@ struct ShadowHit {
 // Classes of a node against a region of space (thesis 3.4).
 enum { CL_OUT = 0, CL_IN = 1, CL_BD = 2 };
 
-// An action list, stored in Accel::data at off[L]:
-//   [na, np, set_inside, set_outside, na x (node, count, first), np x primitive]
-// The active nodes are listed children first; `count` and `first` are the node's children that
-// are constant in the region, summed up: the thesis' "set inside" / "set outside" actions of
-// one node done at once. Then the "check" actions: the active primitives. List 0 is the empty
-// list of a region where the root is constant, so nothing can be hit there.
 // One face of a light buffer: cells in (u, v), slabs in depth w. A directional light has one,
 // whose frame has e[2] towards the light: u, v, w are a point's coordinates in the frame, and a
 // zone runs from its slab to the buffer's end (`top`). A point light has six, one per axis and
@@ -2233,6 +2227,12 @@ struct LightBuf {
     int *runs, nruns;
 };
 
+// An action list, stored in Accel::data at off[L]:
+//   [na, np, set_inside, set_outside, na x (node, count, first), np x primitive]
+// The active nodes are listed children first; `count` and `first` are the node's children that
+// are constant in the region, summed up: the thesis' "set inside" / "set outside" actions of
+// one node done at once. Then the "check" actions: the active primitives. List 0 is the empty
+// list of a region where the root is constant, so nothing can be hit there.
 struct Accel {
     int n[3];          // voxels per axis; all 0 without a grid
     real org[3], h;    // low corner of the grid and side of a voxel
@@ -2696,6 +2696,16 @@ bool reach_build(pray_ctx *c, Accel *a) {
 // voxel. Such a ray evaluates that one list instead of walking the grid. The zones are classed
 // like the grid's voxels, with a margin for rounding.
 
+// The squared distance from point p to box bx (0 inside it).
+inline real box_dist2(const Box &bx, R3 p) {
+    real d2 = 0;
+    for (int l = 0; l < 3; l++) {
+        real c = comp(p, l), e = bx.lo[l] - c > 0 ? bx.lo[l] - c : c - bx.hi[l] > 0 ? c - bx.hi[l] : 0;
+        d2 += e * e;
+    }
+    return d2;
+}
+
 // A convex zone: {x : n[i].x <= d[i]}, the hull of v[0 .. nv); with a ball of radius r around c
 // joined to it (a point light's neighbourhood, where the pyramids meet; r = 0: none).
 struct Zone {
@@ -2727,12 +2737,7 @@ int classify_zone(const Prim &q, const Box &bx, const Zone &z) {
         }
         out = vhi < bx.lo[l] || bx.hi[l] < vlo;
     }
-    real far2 = 0;  // the box's distance from the ball's centre, squared
-    for (int l = 0; l < 3; l++) {
-        real c = comp(z.c, l), e = bx.lo[l] - c > 0 ? bx.lo[l] - c : c - bx.hi[l] > 0 ? c - bx.hi[l] : 0;
-        far2 += e * e;
-    }
-    bool out_ball = z.r == 0 || far2 > z.r * z.r;
+    bool out_ball = z.r == 0 || box_dist2(bx, z.c) > z.r * z.r;
     bool in = true;  // every vertex inside the solid (then all of the polytope, which is convex)
     switch (q.kind) {
     case O_SPHERE: {
@@ -2771,10 +2776,6 @@ int classify_zone(const Prim &q, const Box &bx, const Zone &z) {
     return in ? CL_IN : CL_BD;
 }
 
-// The list for a shadow ray from x towards the buffer's light, and the part (*ta, *tb] of the
-// ray in that list's zone; before and after it the ray is outside the grid's box, where the
-// outer list holds. `outer` alone when the ray misses the grid's box; -1 when x is in no voxel's
-// reach (then the grid is walked).
 // The face of a point light's buffer that holds direction m (from the light): its largest
 // component's axis and sign.
 inline int cube_face(R3 m) {
@@ -2799,6 +2800,10 @@ inline int face_cell(const LightFace &F, real u, real v, real slack, int *cell) 
     return 1;
 }
 
+// The list for a shadow ray from x towards the buffer's light, and the part (*ta, *tb] of the
+// ray in that list's zone; before and after it the ray is outside the grid's box, where the
+// outer list holds. `outer` alone when the ray misses the grid's box; -1 when x is in no voxel's
+// reach (then the grid is walked).
 inline int lightbuf_find(const LightBuf &B, int outer, R3 x, real tmax, real *ta, real *tb) {
     if (B.faces == 0) return -1;
     R3 m = x - B.o;
@@ -2920,9 +2925,6 @@ bool face_extent(const LightBuf &B, const LightFace &F, const Box &bx, real *lo,
     return behind;
 }
 
-// Build the light buffers: cells and slabs about `cell` wide where the grid's box is, and lists
-// for the space between each voxel and its light. `eff`: where bounds place each primitive;
-// `margin`: how far rounding may move a point (the grid's).
 // A voxel whose zone meets more primitives than this is left to the grid, which stops at the
 // first blocker instead of testing everything between the point and the light. A piece of the
 // eye's buffer may meet half as many: a primary ray evaluates several (beyond that the Room's
@@ -2965,6 +2967,9 @@ bool eye_runs(pray_ctx *c, LightBuf &B, int cells) {
 // were even, and at 1024 x 1024 they save a fifth.
 const int RAYS_PER_VOXEL = 8;
 
+// Build the light buffers: cells and slabs about `cell` wide where the grid's box is, and lists
+// for the space between each voxel and its light. `eff`: where bounds place each primitive;
+// `margin`: how far rounding may move a point (the grid's).
 // `lights`, `eye`: which buffers to build; `rays`: the primary rays of the image.
 bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool lights, bool eye, double rays) {
     pray_ctx *c = b.c;
@@ -3082,12 +3087,7 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
                     continue;
                 }
                 if (!box_finite(bx)) continue;
-                real d2 = 0;
-                for (int l = 0; l < 3; l++) {
-                    real cl = comp(B.o, l), e = bx.lo[l] - cl > 0 ? bx.lo[l] - cl : cl - bx.hi[l] > 0 ? cl - bx.hi[l] : 0;
-                    d2 += e * e;
-                }
-                if (B.point && d2 <= r * r) continue;
+                if (B.point && box_dist2(bx, B.o) <= r * r) continue;
                 real lo[3], hi[3];
                 bool behind = face_extent(B, F, bx, lo, hi);
                 if (B.point && !(hi[2] > 0)) {  // behind the face: no zone reaches it
