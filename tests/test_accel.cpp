@@ -779,6 +779,20 @@ pray_light *some_lights(pray_ctx *c) {
     return pray_light_add(c, pray_dirlight(c, w, V(1, 2, -3)), pray_pointlight(c, w2, V(-2, -3, 2)));
 }
 
+// fn(c, s) for each picked scene, made in a context of its own, with the scene's label in the
+// message of every check fn makes.
+template <size_t N, class Fn> void each_pick(const Pick (&picks)[N], Fn fn) {
+    for (const Pick &pk : picks) {
+        pray_ctx *c = pray_new();
+        REQUIRE(c);
+        Scene s = make_scene(c, pk.kind, (uint64_t)pk.seed);
+        CAPTURE(s.label);
+        REQUIRE_MESSAGE(s.root, std::string(pray_error(c)));
+        fn(c, s);
+        pray_free(c);
+    }
+}
+
 } // namespace
 
 TEST_CASE("accel images: random scenes rendered with every switch combination equal the reference; freezing "
@@ -789,12 +803,7 @@ TEST_CASE("accel images: random scenes rendered with every switch combination eq
     auto t0 = std::chrono::steady_clock::now();
     long renders = 0, image_mismatches = 0, freeze_violations = 0;
     std::vector<std::string> problems;
-    for (const Pick &pk : picks) {
-        pray_ctx *c = pray_new();
-        REQUIRE(c);
-        Scene s = make_scene(c, pk.kind, (uint64_t)pk.seed);
-        CAPTURE(s.label);
-        REQUIRE_MESSAGE(s.root, std::string(pray_error(c)));
+    each_pick(picks, [&](pray_ctx *c, const Scene &s) {
         pray_light *lights = some_lights(c);
         REQUIRE(lights);
         Render ref = render(c, s.root, lights, reference(), 40);
@@ -823,8 +832,7 @@ TEST_CASE("accel images: random scenes rendered with every switch combination eq
                                       s.label.c_str(), GRIDS[g], m, b, tests[g][m][b][1], tests[g][m][b][0]);
                         if (problems.size() < 40) problems.push_back(buf);
                     }
-        pray_free(c);
-    }
+    });
     double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::string all;
     for (auto &p : problems) all += "\n  - " + p;
@@ -1048,15 +1056,11 @@ void check_tally(const SwitchTally &t, const char *option) {
 // Renders of picked random scenes under four lights, with a switch of shadow rays off and on,
 // tallied against the reference: a directional light, a point light far outside, one inside
 // the grid's box, and one on the scene's centre (amid or inside the objects).
-void shadow_switch_picks(const Pick *picks, size_t n, const char *option, double pray_stats::*counted,
+template <size_t N>
+void shadow_switch_picks(const Pick (&picks)[N], const char *option, double pray_stats::*counted,
                          std::initializer_list<int> grids, int size, SwitchTally &t) {
     pray_rgb w = {0.6, 0.6, 0.6}, w2 = {0.5, 0.4, 0.3};
-    for (size_t i = 0; i < n; i++) {
-        pray_ctx *c = pray_new();
-        REQUIRE(c);
-        Scene s = make_scene(c, picks[i].kind, (uint64_t)picks[i].seed);
-        CAPTURE(s.label);
-        REQUIRE_MESSAGE(s.root, std::string(pray_error(c)));
+    each_pick(picks, [&](pray_ctx *c, const Scene &s) {
         pray_vec lo = s.lo, hi = s.hi, mid = mul(add(lo, hi), 0.5), ext = sub(hi, lo);
         pray_light *lights = pray_light_add(
             c, pray_light_add(c, pray_dirlight(c, w, V(1, 2, -3)), pray_pointlight(c, w2, add(hi, ext))),
@@ -1065,8 +1069,7 @@ void shadow_switch_picks(const Pick *picks, size_t n, const char *option, double
         Render ref = render(c, s.root, lights, reference(), size);
         REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
         render_switched(c, s.root, lights, ref, option, counted, grids, size, s.label, t);
-        pray_free(c);
-    }
+    });
     check_tally(t, option);
 }
 
@@ -1077,7 +1080,7 @@ TEST_CASE("accel light buffers: shadow rays from the light buffers' lists give t
                           {K_SCALED, 2},  {K_SCALED, 6},  {K_SCALED, 13}};
     SwitchTally t;
     // (128 x 128 and coarse grids: a buffer is built for images with enough pixels per voxel)
-    shadow_switch_picks(picks, sizeof picks / sizeof *picks, "lightbuffer", &pray_stats::rays_lightbuf, {3, 5, 8}, 128, t);
+    shadow_switch_picks(picks, "lightbuffer", &pray_stats::rays_lightbuf, {3, 5, 8}, 128, t);
 
     // A field of spheres lit by the sun and a lamp above: nearly every shadow ray starts in a
     // voxel of a light buffer and is answered from its list.
@@ -1101,7 +1104,7 @@ TEST_CASE("accel shadow cache: shadow rays stopped in the voxel of the last ray'
                           {K_BLOCKS, 7},  {K_FLOOR, 5},   {K_FLOOR, 12},  {K_SCALED, 2},  {K_SCALED, 6}};
     SwitchTally t;
     // (the lamps amid the objects end their shadow rays in voxels that hold surfaces beyond them)
-    shadow_switch_picks(picks, sizeof picks / sizeof *picks, "shadowcache", &pray_stats::rays_shadowcache, {3, 8}, 64, t);
+    shadow_switch_picks(picks, "shadowcache", &pray_stats::rays_shadowcache, {3, 8}, 64, t);
 
     // A table, and a pane of coloured glass with a bar across it, over the field of spheres on
     // a floor, under the sun and a lamp: the shadows of the table and of the bar are answered
@@ -1145,12 +1148,7 @@ TEST_CASE("accel eye buffer: primary rays through the eye's buffer give the refe
     const Pick picks[] = {{K_RANDOM, 4},  {K_RANDOM, 31}, {K_MANY, 3},   {K_MANY, 8},   {K_LATTICE, 5},
                           {K_BLOCKS, 6},  {K_FLOOR, 4},   {K_FLOOR, 13}, {K_SCALED, 3}, {K_SCALED, 9}};
     SwitchTally t;
-    for (const Pick &pk : picks) {
-        pray_ctx *c = pray_new();
-        REQUIRE(c);
-        Scene s = make_scene(c, pk.kind, (uint64_t)pk.seed);
-        CAPTURE(s.label);
-        REQUIRE_MESSAGE(s.root, std::string(pray_error(c)));
+    each_pick(picks, [&](pray_ctx *c, const Scene &s) {
         pray_light *lights = some_lights(c);
         REQUIRE(lights);
         pray_vec lo = s.lo, hi = s.hi, mid = mul(add(lo, hi), 0.5), size = sub(hi, lo);
@@ -1176,8 +1174,7 @@ TEST_CASE("accel eye buffer: primary rays through the eye's buffer give the refe
             render_switched(c, s.root, lights, ref, "eyebuffer", &pray_stats::rays_eyebuf, {3, 8}, 64,
                             s.label + ", eye " + e.name, t);
         }
-        pray_free(c);
-    }
+    });
     check_tally(t, "eyebuffer");
 
     // A field of spheres seen from above: every primary ray walks its cell of the eye's buffer,
