@@ -1981,6 +1981,12 @@ struct Scratch {
     long *blocker;                  // per light: the shadow cache's voxel, -1: none (shadow_probe)
 };
 
+// Empty the shadow cache. Each band of the image starts with it empty, so that what the cache
+// does (and so the statistics) does not depend on which thread rendered the band before.
+void shadow_cache_clear(const Scene *s, Scratch *w) {
+    for (int i = 0; i < s->lights.n; i++) w->blocker[i] = -1;
+}
+
 // What threads write all the time stays off the cache lines of other threads' data: every
 // per-thread block gets this much slack behind it.
 const size_t LINE_SLACK = 128;
@@ -2001,7 +2007,7 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->nfixed = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
     w->nfixval = (unsigned char *)thread_alloc(c, nn);
     w->blocker = (long *)thread_alloc(c, sizeof(long) * (size_t)(s->lights.n + 1));
-    for (int i = 0; w->blocker && i < s->lights.n; i++) w->blocker[i] = -1;
+    if (w->blocker) shadow_cache_clear(s, w);
     return w->blocker && w->cross && w->hull && w->pstat && w->nstat && w->nfirst && w->cnt && w->span &&
            w->nfrozen && w->nfixed && w->nfixval;
 }
@@ -5448,6 +5454,7 @@ void render_band(Worker &k, int band) {
     int W = s->width, H = s->height;
     int y0 = band * job->band_rows, y1 = y0 + job->band_rows;
     if (y1 > H) y1 = H;
+    shadow_cache_clear(s, k.tr.w);
     if (job->adaptive > 0) {
         adaptive_band(k, y0, y1);
         return;
