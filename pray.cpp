@@ -1957,17 +1957,18 @@ struct Span {
     int kind;
 };
 
-// An intersection as one solid along the ray (see eval_list's plain evaluation).
+// An intersection as one solid along the ray (eval_list's plain evaluation, eval_flat).
 struct Hull {
     real t0, t1;  // its latest entry and earliest exit so far
     int prim;     // the member entered last, -1: none yet
     int enter;    // 0: that member is a half-space turned inside out (the ray leaves the half-space)
     int tie;      // two members entered at that same t
+    int need, have;  // the flat sweep: its members, and those the ray is in
 };
 
 struct Scratch {
     Cross *cross;
-    Hull *hull;  // per solid of a plain list (at most one per node)
+    Hull *hull;  // per solid of a list with a plan (at most one per node)
     unsigned char *pstat, *nstat, *nfirst;
     int *cnt;
     Counters k;
@@ -2247,7 +2248,7 @@ struct Accel {
     int *voxel;        // list of each voxel, x fastest
     unsigned char *reach;  // per voxel: how far around it every voxel has its list (see reach_build)
     Array<int> data, off;
-    Array<int> plan_at;  // per list: where its plan starts in `plan`, -1 when it is not plain (list_plan)
+    Array<int> plan_at;  // per list: where its plan starts in `plan`, -1 when it has none (list_plan)
     Array<int> plan;
     int outer;         // list of the space outside the grid (everything without a grid)
     int freeze, merge, bounds;
@@ -2543,18 +2544,20 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
     return lb_store(b);
 }
 
-// A list is plain when its root, in the list's region, is a union of solids that a ray enters
-// and leaves once: primitives, half-spaces turned inside out, and intersections of them (boxes,
-// slabs, capped cylinders, a wall: the inside of a room's box taken from a solid block). Each
-// primitive is followed up to the root. A node with one active child passes it on, turned inside
+// A list has a plan when its root, in the list's region, is a union of solids, each a primitive
+// or an intersection of primitives, any of them turned inside out (eval_flat). It is plain when
+// only half-spaces are turned inside out: then a ray enters and leaves each solid once (boxes,
+// slabs, capped cylinders, a wall: the inside of a room's box taken from a solid block); else
+// it is holed (a shell: a ball minus a smaller ball). Each primitive is followed up to the root. A node with one active child passes it on, turned inside
 // out by a complement, or by a difference when the child is not the first (the first child is
 // then inside for the whole region: an active node is on its boundary). A node with more is a
 // union or an intersection (a difference: its first child and the others turned inside out), the
 // one turned into the other by an odd number of inversions above it. A union may not stand under
 // an intersection; an intersection right under the unions starts a solid, which the
-// intersections under it join. Appends to `plan` the number of solids and, per primitive of the
-// list, (solid + 1) * 2 + (1 when turned inside out), solid -1 standing alone. Returns where
-// that starts, or -1 (appending nothing) when the list is not plain, -2 when out of memory.
+// intersections under it join. Appends to `plan` the number of solids, 1 when holed, and per
+// primitive of the list, (solid + 1) * 2 + (1 when turned inside out), solid -1 standing alone.
+// Returns where that starts, or -1 (appending nothing) when the list has no plan, -2 when out of
+// memory.
 // `kids`, `solid`: per node scratch, 0 and -1 on entry and left so.
 const int PLAN_DEPTH = 64;  // deeper trees are evaluated in full
 
@@ -2566,7 +2569,8 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
     for (int i = 0; i < np; i++)
         if (s->prims[prims[i]].parent >= 0) kids[s->prims[prims[i]].parent]++;
     int base = plan->n, ns = 0;
-    bool mem = np == 0 || plan->push(c, 0), ok = np > 0 && mem;
+    bool holed = false;
+    bool mem = np == 0 || (plan->push(c, 0) && plan->push(c, 0)), ok = np > 0 && mem;
     for (int i = 0; ok && i < np; i++) {
         int path[PLAN_DEPTH], n = 0;  // the ancestors, the root last
         for (int p = s->prims[prims[i]].parent; ok && p >= 0; p = s->nodes[p].parent) {
@@ -2590,7 +2594,7 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
             }
             if (nd.op == O_COMPL || (nd.op == O_DIFF && !first)) inv = !inv;
         }
-        ok = ok && (!inv || s->prims[prims[i]].kind == O_PLANE);
+        holed = holed || (inv && s->prims[prims[i]].kind != O_PLANE);
         mem = !ok || plan->push(c, (k + 1) * 2 + inv);
         ok = ok && mem;
     }
@@ -2604,8 +2608,12 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
         return mem ? -1 : -2;
     }
     plan->p[base] = ns;
+    plan->p[base + 1] = holed;
     return base;
 }
+
+// A plain list: one with a plan and no holes (list_plan).
+inline bool list_plain(const Accel *A, int L) { return A->plan_at[L] >= 0 && !A->plan.p[A->plan_at[L] + 1]; }
 
 // Voxels along the longest axis when the grid option is automatic. Measured on the benchmark
 // scenes (docs/benchmarks.md): about 4 voxels per primitive plus a floor of 4096 voxels is near
@@ -3497,7 +3505,7 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         for (long v = 0; v < nv; v++) {
             // a list answers a shadow ray in one evaluation when it is plain; else walking
             // the grid, which stops at the first blocker, is cheaper
-            if (B.list[v] > 0 && a->plan_at[B.list[v]] < 0) B.list[v] = -1;
+            if (B.list[v] > 0 && !list_plain(a, B.list[v])) B.list[v] = -1;
             any = any || B.list[v] >= 0;
         }
         if (!any) B.faces = 0;
@@ -3594,8 +3602,72 @@ inline void bump(const Scene *s, Scratch *w, int e) {
     else w->cnt[p]++;
 }
 
-// Evaluate list L on the part (a, b] of the ray (and t < tmax): initialise the active part of
-// the status tree at a, then sweep the crossings inside. Returns true when `visit` stopped.
+// The flat sweep of a list with a plan (list_plan), holed or not, on the part (a, b] of the ray
+// (and t < tmax): each solid is inside where the ray is in all of its members, the root where
+// it is in one solid or more. The crossings are taken in order, and each changes one member,
+// perhaps its solid, perhaps the root. Returns true when `visit` stopped.
+template <class Visit>
+bool eval_flat(const Scene *s, Scratch *w, const Ray &ray, const int *prims, int np, const int *plan, real a, real b,
+              real tmax, int self, Visit &visit) {
+    int ns = plan[0];
+    plan += 2;
+    for (int k = 0; k < ns; k++) w->hull[k].need = w->hull[k].have = 0;
+    int in = 0, nc = 0;  // solids (and primitives standing alone) the ray is in
+    for (int i = 0; i < np; i++) {
+        const Span &sp = span_get(s, w, ray, prims[i], self);
+        bool st = (sp.kind == SPAN_ALL || (sp.kind == SPAN && sp.t0 <= a && a < sp.t1)) != (plan[i] & 1);
+        int k = (plan[i] >> 1) - 1;
+        if (k < 0) in += st;
+        else w->hull[k].need++, w->hull[k].have += st;
+        if (sp.kind != SPAN) continue;
+        for (int e = 1; e >= 0; e--) {
+            real t = e ? sp.t0 : sp.t1;
+            if (!(t > a && t <= b && t < tmax)) continue;
+            w->cross[nc].t = t;
+            w->cross[nc].prim = i;  // (the list's position: its plan)
+            w->cross[nc].enter = e;
+            nc++;
+        }
+    }
+    w->k.checks += np;
+    if (nc == 0) return false;
+    for (int k = 0; k < ns; k++) in += w->hull[k].need == w->hull[k].have;
+    // (the list's primitives are in the order of their numbers, so the crossings sort as the
+    // full evaluation's do)
+    if (nc > 1) sort_crossings(w->cross, nc);
+    bool root = in > 0;
+    for (int j = 0; j < nc;) {
+        real t = w->cross[j].t;
+        bool before = root;
+        int last = -1;  // crossings at the same t together, as in the full evaluation
+        for (; j < nc && w->cross[j].t == t; j++) {
+            const Cross &x = w->cross[j];
+            int i = x.prim, k = (plan[i] >> 1) - 1, st = (x.enter != 0) != (plan[i] & 1) ? 1 : -1;
+            if (k < 0) in += st;
+            else {
+                Hull &u = w->hull[k];
+                bool was = u.have == u.need;
+                u.have += st;
+                if (was != (u.have == u.need)) in += was ? -1 : 1;
+            }
+            if ((in > 0) != root) root = !root, last = j;
+        }
+        if (root == before || last < 0) continue;
+        Hit h;
+        h.t = t;
+        h.prim = prims[w->cross[last].prim];
+        h.prim_enter = w->cross[last].enter;
+        h.root_enter = root;
+        if (!visit(h)) return true;
+    }
+    return false;
+}
+
+// Evaluate list L on the part (a, b] of the ray (and t < tmax). A list with a plan takes its
+// shortcuts: the nearest entry when it is plain, else (or when the visitor goes on from there)
+// the flat sweep. Any other is evaluated in full: initialise the active part of the status tree
+// at a, then sweep the crossings inside, freezing what settles. Returns true when `visit`
+// stopped.
 template <class Visit>
 bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L, real a, real b, real tmax,
                int self, Visit &visit) {
@@ -3605,15 +3677,15 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
     const int *nodes = d + 4, *prims = d + 4 + 3 * na;
     w->k.set_in += d[2];
     w->k.set_out += d[3];
-    if (A->plan_at[L] >= 0) {
+    if (list_plain(A, L)) {
         // A union of solids (plain lists, list_plan: the common lists of a scene of many
         // objects), none inside for the whole region: while the ray is outside them all, the
         // first visible surface is the nearest entry. An intersection is entered at the latest
         // entry of its members and left at the earliest exit; a half-space turned inside out is
         // entered where the ray leaves the half-space. Anything less plain (a solid inside at a,
-        // entries at the same t, a grazing touch) is left to the full evaluation.
-        const int *plan = A->plan.p + A->plan_at[L] + 1;
-        int ns = plan[-1];
+        // entries at the same t, a grazing touch) is left to the flat sweep.
+        const int *plan = A->plan.p + A->plan_at[L] + 2;
+        int ns = plan[-2];
         for (int k = 0; k < ns; k++) {
             Hull &u = w->hull[k];
             u.t0 = -REAL_INF;
@@ -3676,9 +3748,10 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
             h.prim_enter = first_enter;
             h.root_enter = 1;
             if (!visit(h)) return true;
-            a = tf;  // the visitor goes on through the solid: the rest in full
+            a = tf;  // the visitor goes on through the solid: the rest by the flat sweep
         }
     }
+    if (A->plan_at[L] >= 0) return eval_flat(s, w, ray, prims, np, A->plan.p + A->plan_at[L], a, b, tmax, self, visit);
     for (int i = na - 1; i >= 0; i--) {  // parents first: pass freezing down
         int j = nodes[3 * i];
         w->cnt[j] = nodes[3 * i + 1];
