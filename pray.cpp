@@ -2548,16 +2548,16 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
 // or an intersection of primitives, any of them turned inside out (eval_flat). It is plain when
 // only half-spaces are turned inside out: then a ray enters and leaves each solid once (boxes,
 // slabs, capped cylinders, a wall: the inside of a room's box taken from a solid block); else
-// it is holed (a shell: a ball minus a smaller ball). Each primitive is followed up to the root. A node with one active child passes it on, turned inside
-// out by a complement, or by a difference when the child is not the first (the first child is
-// then inside for the whole region: an active node is on its boundary). A node with more is a
-// union or an intersection (a difference: its first child and the others turned inside out), the
-// one turned into the other by an odd number of inversions above it. A union may not stand under
-// an intersection; an intersection right under the unions starts a solid, which the
-// intersections under it join. Appends to `plan` the number of solids, 1 when holed, and per
-// primitive of the list, (solid + 1) * 2 + (1 when turned inside out), solid -1 standing alone.
-// Returns where that starts, or -1 (appending nothing) when the list has no plan, -2 when out of
-// memory.
+// it is holed (a shell: a ball minus a smaller ball). Each primitive is followed up to the root.
+// A node with one active child passes it on, turned inside out by a complement, or by a
+// difference when the child is not the first (the first child is then inside for the whole
+// region: an active node is on its boundary). A node with more is a union or an intersection (a
+// difference: its first child and the others turned inside out), the one turned into the other
+// by an odd number of inversions above it. A union may not stand under an intersection; an
+// intersection right under the unions starts a solid, which the intersections under it join.
+// Appends to `plan` the number of solids, 1 when holed, and per primitive of the list,
+// (solid + 1) * 2 + (1 when turned inside out), solid -1 standing alone. Returns where that
+// starts, or -1 (appending nothing) when the list has no plan, -2 when out of memory.
 // `kids`, `solid`: per node scratch, 0 and -1 on entry and left so.
 const int PLAN_DEPTH = 64;  // deeper trees are evaluated in full
 
@@ -3608,7 +3608,7 @@ inline void bump(const Scene *s, Scratch *w, int e) {
 // perhaps its solid, perhaps the root. Returns true when `visit` stopped.
 template <class Visit>
 bool eval_flat(const Scene *s, Scratch *w, const Ray &ray, const int *prims, int np, const int *plan, real a, real b,
-              real tmax, int self, Visit &visit) {
+               real tmax, int self, Visit &visit) {
     int ns = plan[0];
     plan += 2;
     for (int k = 0; k < ns; k++) w->hull[k].need = w->hull[k].have = 0;
@@ -3751,7 +3751,8 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
             a = tf;  // the visitor goes on through the solid: the rest by the flat sweep
         }
     }
-    if (A->plan_at[L] >= 0) return eval_flat(s, w, ray, prims, np, A->plan.p + A->plan_at[L], a, b, tmax, self, visit);
+    if (A->plan_at[L] >= 0)
+        return eval_flat(s, w, ray, prims, np, A->plan.p + A->plan_at[L], a, b, tmax, self, visit);
     for (int i = na - 1; i >= 0; i--) {  // parents first: pass freezing down
         int j = nodes[3 * i];
         w->cnt[j] = nodes[3 * i + 1];
