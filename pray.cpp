@@ -1946,6 +1946,7 @@ struct Counters {
     double tests;
     double steps, moves, set_in, set_out, checks, frozen;
     double lbuf;  // shadow rays answered by a light buffer
+    double core;  // shadow rays that ended in a light's core
     double ebuf;  // primary rays answered by the eye's buffer
     double cache; // shadow rays answered by the shadow cache
 };
@@ -1979,13 +1980,13 @@ struct Scratch {
     unsigned *nfixed;               // status known for the rest of this ray ...
     unsigned char *nfixval;         // ... and its value
     int root_fixed;                 // the root's status cannot change any more on this ray
-    long *blocker;                  // per light: the shadow cache's voxel, -1: none (shadow_probe)
+    int *blocker;                   // per light: the shadow cache's voxel, x y z; x -1: none (shadow_probe)
 };
 
 // Empty the shadow cache. Each band of the image starts with it empty, so that what the cache
 // does (and so the statistics) does not depend on which thread rendered the band before.
 void shadow_cache_clear(const Scene *s, Scratch *w) {
-    for (int i = 0; i < s->lights.n; i++) w->blocker[i] = -1;
+    for (int i = 0; i < s->lights.n; i++) w->blocker[3 * i] = -1;
 }
 
 // What threads write all the time stays off the cache lines of other threads' data: every
@@ -2007,7 +2008,7 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->nfrozen = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
     w->nfixed = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
     w->nfixval = (unsigned char *)thread_alloc(c, nn);
-    w->blocker = (long *)thread_alloc(c, sizeof(long) * (size_t)(s->lights.n + 1));
+    w->blocker = (int *)thread_alloc(c, sizeof(int) * 3 * (size_t)(s->lights.n + 1));
     if (w->blocker) shadow_cache_clear(s, w);
     return w->blocker && w->cross && w->hull && w->pstat && w->nstat && w->nfirst && w->cnt && w->span &&
            w->nfrozen && w->nfixed && w->nfixval;
@@ -2232,6 +2233,11 @@ struct LightBuf {
     // end); then the runs, each a list and the slab where it ends, in order from the eye. A cell
     // whose primary rays walk the grid has one run of list -1.
     int *runs, nruns;
+    // A point light's core: a box of voxels around the light whose list has no more primitives
+    // than the light's voxel. A shadow ray not answered by a voxel's list walks the grid only to
+    // the core, then evaluates the core's list.
+    real core_lo[3], core_hi[3];
+    int core;  // the core's list; -1: none
 };
 
 // An action list, stored in Accel::data at off[L]:
@@ -2275,6 +2281,17 @@ void accel_release(pray_ctx *c, Accel *a) {
     mem_free(c, a->lbuf);
     mem_free(c, a);
 }
+
+// The voxel that holds the point: its coordinates in ix; false when it is outside the grid.
+bool voxel_of(const Accel *A, R3 p, int *ix) {
+    for (int l = 0; l < 3; l++) {
+        real g = (comp(p, l) - A->org[l]) * A->inv_h;
+        if (!(g >= 0 && g < (real)A->n[l])) return false;
+        ix[l] = (int)g;
+    }
+    return true;
+}
+inline long voxel_index(const Accel *A, const int *ix) { return ((long)ix[2] * A->n[1] + ix[1]) * A->n[0] + ix[0]; }
 
 // Class of a primitive against a closed box.
 int classify_prim(const Prim &q, const real *lo, const real *hi) {
@@ -2981,8 +2998,50 @@ bool eye_runs(pray_ctx *c, LightBuf &B, int cells) {
 // were even, and at 1024 x 1024 they save a fifth.
 const int RAYS_PER_VOXEL = 8;
 
+// A point light's core reaches at most LB_CORE voxels beyond the light's on each side, and holds
+// at most LB_CORE_PRIMS primitives, or as many as the light's voxel.
+const int LB_CORE = 8, LB_CORE_PRIMS = 8;
+
+// The core of point light B (LightBuf::core): the largest cube of voxels centred on the light's
+// voxel, clipped to the grid, whose list is small (LB_CORE_PRIMS). A lamp in its shade gets the
+// shade's box, and a light in empty space the empty space around it. Its list is built as a
+// voxel's (`margin`: the grid's; `eff`: where bounds place each primitive).
+bool light_core(ListBuilder &b, const Box *eff, real margin, LightBuf &B, Array<int> &prims,
+                Array<unsigned char> &cls) {
+    const Accel *a = b.a;
+    const Scene *s = b.s;
+    int ix[3];
+    if (!voxel_of(a, B.o, ix)) return true;
+    int most = a->data[a->off[a->voxel[voxel_index(a, ix)]] + 1];
+    most = most > LB_CORE_PRIMS ? most : LB_CORE_PRIMS;
+    bool whole = false;
+    for (int k = 1; k <= LB_CORE && !whole; k++) {
+        Box bx;
+        whole = true;
+        for (int l = 0; l < 3; l++) {
+            int i0 = ix[l] - k > 0 ? ix[l] - k : 0, i1 = ix[l] + k + 1 < a->n[l] ? ix[l] + k + 1 : a->n[l];
+            bx.lo[l] = (real)((double)a->org[l] + i0 * (double)a->h - margin);
+            bx.hi[l] = (real)((double)a->org[l] + i1 * (double)a->h + margin);
+            whole = whole && i0 == 0 && i1 == a->n[l];
+        }
+        prims.n = 0;
+        cls.n = 0;
+        for (int i = 0; i < s->prims.n; i++) {
+            if (!box_overlap(eff[i], bx)) continue;
+            if (!prims.push(b.c, i) || !cls.push(b.c, (unsigned char)classify_prim(s->prims[i], bx.lo, bx.hi)))
+                return false;
+        }
+        int L = lb_list(b, prims.p, cls.p, prims.n);
+        if (L < 0) return false;
+        if (a->data[a->off[L] + 1] > most) break;
+        B.core = L;
+        for (int l = 0; l < 3; l++) B.core_lo[l] = bx.lo[l], B.core_hi[l] = bx.hi[l];
+    }
+    return true;
+}
+
 // Build the light buffers: cells and slabs about `cell` wide where the grid's box is, and lists
-// for the space between each voxel and its light. `eff`: where bounds place each primitive;
+// for the space between each voxel and its light, and the point lights' cores. `eff`: where bounds place each primitive;
 // `margin`: how far rounding may move a point (the grid's).
 // `lights`, `eye`: which buffers to build; `rays`: the primary rays of the image.
 bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool lights, bool eye, double rays) {
@@ -2993,6 +3052,7 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
     a->lbuf = (LightBuf *)mem_zalloc(c, sizeof(LightBuf) * (size_t)(nl + 1));
     if (!a->lbuf) return false;
     a->nlbuf = nl;
+    for (int li = 0; li <= nl; li++) a->lbuf[li].core = -1;
     Array<int> start, cand, prims, seen;
     Array<unsigned char> cls, seen_cls;
     Array<real> key;
@@ -3013,6 +3073,10 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
         B.point = B.pieces || s->lights[li].point;
         B.faces = B.point ? 6 : 1;
         B.o = B.pieces ? s->eye : B.point ? s->lights[li].v : r3(0, 0, 0);
+        if (!B.pieces && B.point && !light_core(b, eff, margin, B, prims, cls)) {
+            ok = false;
+            break;
+        }
         long total = 0, cells = 0;
         real eps = 0, r = 0;
         for (int fi = 0; fi < B.faces; fi++) {
@@ -3491,12 +3555,13 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         mem_free(c, kids);
         mem_free(c, solid);
     }
-    long lbv = 0, ebv = 0, eruns = 0;  // the light buffers' voxels, the eye's, its runs' numbers
+    long lbv = 0, ebv = 0, eruns = 0, cores = 0;  // the light buffers' voxels, the eye's, its runs' numbers
     for (int i = 0; st == PRAY_OK && a->lbuf && i <= a->nlbuf; i++) {
         LightBuf &B = a->lbuf[i];
         long nv = 0;
         for (int f = 0; f < B.faces; f++) nv += (long)B.f[f].n[0] * B.f[f].n[1] * B.f[f].n[2];
         (B.pieces ? ebv : lbv) += nv;
+        cores += B.core >= 0;
         if (B.pieces) {
             eruns += B.nruns;
             continue;
@@ -3516,6 +3581,7 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
                 (double)a->off.cap * sizeof(int) + (double)(a->plan_at.cap + a->plan.cap) * sizeof(int) +
                 (double)(a->lbuf ? a->nlbuf + 1 : 0) * sizeof(LightBuf) + (double)(lbv + eruns) * sizeof(int);
     c->stats.lightbuf_voxels = lbv;
+    c->stats.lightbuf_cores = cores;
     c->stats.eyebuf_voxels = ebv;
     c->stats.grid[0] = a->n[0];
     c->stats.grid[1] = a->n[1];
@@ -3885,14 +3951,15 @@ void ray_begin(const Scene *s, Scratch *w) {
     w->root_fixed = 0;
 }
 
-// The accelerated counterpart of `sweep`: the same hits, in the same order.
+// The accelerated counterpart of `sweep`: the same hits, in the same order, up to tstop (tmax, or
+// where a shadow ray reaches its light's core); `inv`: the direction's reciprocals (ray_inverse).
+// Returns true when the visitor stopped or nothing further can be hit.
 template <class Visit>
-void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
+bool trace_accel(const Scene *s, Scratch *w, const Ray &ray, const real *inv, real tmax, real tstop, int self,
+                 Visit &visit) {
     const Accel *A = s->accel;
-    if (s->root < 0) return;
+    if (s->root < 0) return true;
     ray_begin(s, w);
-    real inv[3];
-    ray_inverse(ray, inv);
     if (A->bounds && A->n[0] == 0) {
         // without a grid, a bounded node whose box the ray misses is outside for the whole ray
         for (int j = s->nodes.n - 1; j >= 0; j--) {
@@ -3909,18 +3976,13 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
             if (A->freeze) settle(s, w, 2 * j + 1, false);
         }
     }
-    if (A->n[0] == 0) {
-        eval_list(s, A, w, ray, A->outer, 0, tmax, tmax, self, visit);
-        return;
-    }
+    if (A->n[0] == 0) return eval_list(s, A, w, ray, A->outer, 0, tstop, tmax, self, visit);
     real tin, tout;
-    if (!ray_box(ray, inv, A->org, A->top, &tin, &tout) || tout <= 0 || tin >= tmax) {
-        eval_list(s, A, w, ray, A->outer, 0, tmax, tmax, self, visit);
-        return;
-    }
+    if (!ray_box(ray, inv, A->org, A->top, &tin, &tout) || tout <= 0 || tin >= tstop)
+        return eval_list(s, A, w, ray, A->outer, 0, tstop, tmax, self, visit);
     real t = tin > 0 ? tin : 0;
-    if (t > 0 && eval_list(s, A, w, ray, A->outer, 0, t, tmax, self, visit)) return;
-    real tend = tout < tmax ? tout : tmax;
+    if (t > 0 && eval_list(s, A, w, ray, A->outer, 0, t, tmax, self, visit)) return true;
+    real tend = tout < tstop ? tout : tstop;
     // Leading-axis traversal (3.3): the boundaries of the three axes come at regular intervals
     // along the ray; the next voxel is across the nearest one. Distances are kept as ray
     // parameters (the leading-axis distance over the leading component of the direction), so a
@@ -4003,18 +4065,21 @@ void trace_accel(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
     }
     w->k.steps += (double)steps;
     w->k.moves += (double)moves;
-    if (stopped) return;
+    if (stopped) return true;
     // the last stretch ends where the ray leaves the grid's box, whatever rounding the stepping
     // gathered, so that it meets the stretch after the grid without a gap
-    if (run > 0 && eval_list(s, A, w, ray, run, run_a, tend, tmax, self, visit)) return;
-    if (tend < tmax) eval_list(s, A, w, ray, A->outer, tend, tmax, tmax, self, visit);
+    if (run > 0 && eval_list(s, A, w, ray, run, run_a, tend, tmax, self, visit)) return true;
+    return tend < tstop && eval_list(s, A, w, ray, A->outer, tend, tstop, tmax, self, visit);
 }
 
 // All hits along the ray in (0, tmax), by the reference or the accelerated path.
 template <class Visit>
 void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
-    if (s->accel) trace_accel(s, w, ray, tmax, self, visit);
-    else sweep(s, w, ray, tmax, self, visit);
+    if (s->accel) {
+        real inv[3];
+        ray_inverse(ray, inv);
+        trace_accel(s, w, ray, inv, tmax, tmax, self, visit);
+    } else sweep(s, w, ray, tmax, self, visit);
 }
 
 // The shadow cache (option shadowcache): the voxel where the last shadow ray towards the same
@@ -4023,18 +4088,17 @@ void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, 
 // there is zero; else the ray is traced as usual. What the whole ray lets through is a product
 // of the same factors and more, in order. When no factor is more than 1 in magnitude (the
 // cache is off otherwise), rounding is monotonic and the product starts at 1, so the whole
-// ray's product is at most the stretch's at every step: zero too.
-bool shadow_probe(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, ShadowHit &visit) {
+// ray's product is at most the stretch's at every step: zero too. (Called when the light has a
+// voxel in the cache; `inv`: the direction's reciprocals.)
+bool shadow_probe(const Scene *s, Scratch *w, const Ray &ray, const real *inv, real tmax, int self, int light,
+                  ShadowHit &visit) {
     const Accel *A = s->accel;
-    long v = w->blocker[light];
-    if (v < 0) return false;
-    int ix[3] = {(int)(v % A->n[0]), (int)(v / A->n[0] % A->n[1]), (int)(v / A->n[0] / A->n[1])};
-    real lo[3], hi[3], inv[3], ta, tb;
+    const int *ix = w->blocker + 3 * light;
+    real lo[3], hi[3], ta, tb;
     for (int l = 0; l < 3; l++) {
         lo[l] = A->org[l] + (real)ix[l] * A->h;
         hi[l] = lo[l] + A->h;
     }
-    ray_inverse(ray, inv);
     if (!ray_box(ray, inv, lo, hi, &ta, &tb)) return false;
     ta = ta > 0 ? ta : 0;
     tb = tb < tmax ? tb : tmax;
@@ -4042,41 +4106,51 @@ bool shadow_probe(const Scene *s, Scratch *w, const Ray &ray, real tmax, int sel
     ray_begin(s, w);
     ShadowHit probe = visit;
     probe.f = cmake(1, 1, 1);
-    eval_list(s, A, w, ray, A->voxel[v], ta, tb, tmax, self, probe);
+    eval_list(s, A, w, ray, A->voxel[voxel_index(A, ix)], ta, tb, tmax, self, probe);
     if (!czero(probe.f)) return false;
     w->k.cache += 1;
     visit.f = probe.f;
     return true;
 }
 
-// The voxel that holds the point, or -1 when it is outside the grid.
-long voxel_at(const Accel *A, R3 p) {
-    long at = 0;
-    for (int l = 2; l >= 0; l--) {
-        real g = (comp(p, l) - A->org[l]) * A->inv_h;
-        if (!(g >= 0 && g < (real)A->n[l])) return -1;
-        at = at * A->n[l] + (int)g;
-    }
-    return at;
-}
-
 // The hits along a shadow ray towards light `light`: the shadow cache's answer when it has one;
-// else from the list of the light buffer's voxel when the ray starts in one, else as any other ray.
+// else from the list of the light buffer's voxel when the ray starts in one; else along the grid
+// to the light's core and from the core's list when the light has one; else as any other ray.
 void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, ShadowHit &visit) {
     const Accel *A = s->accel;
-    bool cache = A && A->cache && A->n[0] > 0;
-    if (cache && shadow_probe(s, w, ray, tmax, self, light, visit)) return;
-    real ta = 0, tb = 0;
-    int L = A && A->lbuf ? lightbuf_find(A->lbuf[light], A->outer, ray.o, tmax, &ta, &tb) : -1;
-    if (L < 0) find_hits(s, w, ray, tmax, self, visit);
-    else {
+    if (!A) {
+        find_hits(s, w, ray, tmax, self, visit);
+        return;
+    }
+    real inv[3], ta = 0, tb = 0;  // (the reciprocals only when needed: not for a light buffer's voxel)
+    bool cache = A->cache && A->n[0] > 0, probe = cache && w->blocker[3 * light] >= 0;
+    if (probe) {
+        ray_inverse(ray, inv);
+        if (shadow_probe(s, w, ray, inv, tmax, self, light, visit)) return;
+    }
+    const LightBuf *B = A->lbuf ? &A->lbuf[light] : NULL;
+    int L = B ? lightbuf_find(*B, A->outer, ray.o, tmax, &ta, &tb) : -1;
+    if (L < 0 && !probe) ray_inverse(ray, inv);
+    // (a ray that misses the core's box, by rounding, walks the grid)
+    bool core = L < 0 && B && B->core >= 0 && ray_box(ray, inv, B->core_lo, B->core_hi, &ta, &tb) && ta < tmax;
+    if (L >= 0) {
         w->k.lbuf += 1;
         ray_begin(s, w);
         if (!(ta > 0 && eval_list(s, A, w, ray, A->outer, 0, ta, tmax, self, visit)) &&
             !eval_list(s, A, w, ray, L, ta, tb, tmax, self, visit) && tb < tmax)
             eval_list(s, A, w, ray, A->outer, tb, tmax, tmax, self, visit);
-    }
-    if (cache) w->blocker[light] = czero(visit.f) ? voxel_at(A, ray.o + ray.d * visit.t) : -1;
+    } else if (core) {  // the grid to the core, then the core's list to the light
+        w->k.core += 1;
+        if (ta > 0) {
+            if (!trace_accel(s, w, ray, inv, tmax, ta, self, visit))
+                eval_list(s, A, w, ray, B->core, ta, tmax, tmax, self, visit);
+        } else {
+            ray_begin(s, w);
+            eval_list(s, A, w, ray, B->core, 0, tmax, tmax, self, visit);
+        }
+    } else trace_accel(s, w, ray, inv, tmax, tmax, self, visit);
+    int *ix = w->blocker + 3 * light;
+    if (cache && !(czero(visit.f) && voxel_of(A, ray.o + ray.d * visit.t, ix))) ix[0] = -1;
 }
 
 // The hits along a primary ray, which starts at the eye: when the eye has a buffer, the ray
@@ -5627,6 +5701,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
         c->stats.checks += k.checks;
         c->stats.frozen_skips += k.frozen;
         c->stats.rays_lightbuf += k.lbuf;
+        c->stats.rays_lightcore += k.core;
         c->stats.rays_eyebuf += k.ebuf;
         c->stats.rays_shadowcache += k.cache;
         scratch_release(c, &worker_at(wbuf, stride, i).w);
@@ -8725,7 +8800,7 @@ void print_stats(pray_ctx *c) {
             "primitives: %ld declared, %ld kept; nodes %ld\n"
             "grid: %d x %d x %d = %ld voxels, %ld distinct lists, %ld areas, %.0f bytes\n"
             "rays: primary %.0f (of %.0f without undersampling), shadow %.0f, reflected %.0f, refracted %.0f\n"
-            "light buffers: %ld voxels; shadow rays from them %.0f\n"
+            "light buffers: %ld voxels, %ld cores; shadow rays from them %.0f, through a core %.0f\n"
             "eye buffer: %ld voxels; primary rays from it %.0f\n"
             "shadow cache: shadow rays it stopped %.0f\n"
             "traversal: %.0f voxel steps, %.0f area moves\n"
@@ -8733,7 +8808,7 @@ void print_stats(pray_ctx *c) {
             "intersection tests %.0f\n"
             "time: parse %.3f s, prepare %.3f s, render %.3f s on %d thread%s\n",
             s.primitives_declared, s.primitives, s.nodes, s.grid[0], s.grid[1], s.grid[2], s.voxels, s.lists,
-            s.areas, s.memory, s.rays_primary, s.rays_primary_full, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.lightbuf_voxels, s.rays_lightbuf, s.eyebuf_voxels, s.rays_eyebuf, s.rays_shadowcache, s.voxel_steps,
+            s.areas, s.memory, s.rays_primary, s.rays_primary_full, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.lightbuf_voxels, s.lightbuf_cores, s.rays_lightbuf, s.rays_lightcore, s.eyebuf_voxels, s.rays_eyebuf, s.rays_shadowcache, s.voxel_steps,
             s.area_moves, s.set_inside, s.set_outside, s.checks, s.frozen_skips, s.intersection_tests,
             s.time_parse, s.time_prepare, s.time_render, s.threads, s.threads == 1 ? "" : "s");
 }

@@ -262,6 +262,8 @@ typedef struct pray_stats {
     double rays_primary_full;        /* primary rays without undersampling (option adaptive) */
     long lightbuf_voxels;            /* voxels of the light buffers (option lightbuffer) */
     double rays_lightbuf;            /* shadow rays answered by a light buffer's list */
+    long lightbuf_cores;             /* point lights' cores: boxes around the lights with one list */
+    double rays_lightcore;           /* shadow rays that walked the grid only to a light's core */
     long eyebuf_voxels;              /* voxels of the eye's buffer (option eyebuffer) */
     double rays_eyebuf;              /* primary rays traced through the eye's buffer */
     double rays_shadowcache;         /* shadow rays stopped by the shadow cache (option shadowcache) */
@@ -357,9 +359,10 @@ pray_status pray_render_file(const char *program, const char *const *options, in
    the reference. By default the scene is simplified, a uniform grid of voxels with per-voxel
    action lists is built (thesis 3.3-3.6: leading-axis traversal, set/check actions, freezing,
    areas), bounding boxes prune what cannot be met, light buffers answer shadow rays from one
-   list per voxel around each light, and primary rays walk the lists of the eye's buffer, a
-   grid of pyramids around a perspective camera's eye; a shadow ray first tries the voxel where
-   the last one towards its light was stopped. Options grid, freeze, merge, bounds,
+   list per voxel around each light (and from one list for the box around a point light where
+   its shadow rays end), and primary rays walk the lists of the eye's buffer, a grid of
+   pyramids around a perspective camera's eye; a shadow ray first tries the voxel where the
+   last one towards its light was stopped. Options grid, freeze, merge, bounds,
    lightbuffer, eyebuffer and shadowcache switch the parts on and off; every setting gives the
    image of brute=1, byte for byte.
    docs/acceleration.md explains the methods, docs/benchmarks.md measures them.

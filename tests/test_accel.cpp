@@ -761,6 +761,7 @@ Render render(pray_ctx *c, pray_object *root, pray_light *lights, const Opts &o,
     r.stats.rays_primary = after.rays_primary - before.rays_primary;
     r.stats.rays_shadow = after.rays_shadow - before.rays_shadow;
     r.stats.rays_lightbuf = after.rays_lightbuf - before.rays_lightbuf;
+    r.stats.rays_lightcore = after.rays_lightcore - before.rays_lightcore;
     r.stats.rays_eyebuf = after.rays_eyebuf - before.rays_eyebuf;
     r.stats.rays_shadowcache = after.rays_shadowcache - before.rays_shadowcache;
     if (r.status != PRAY_OK) {
@@ -1097,6 +1098,38 @@ TEST_CASE("accel light buffers: shadow rays from the light buffers' lists give t
     CHECK(off.stats.lightbuf_voxels == 0);
     CHECK(off.stats.rays_lightbuf == 0);
     CHECK(on.stats.voxel_steps < off.stats.voxel_steps);
+}
+
+TEST_CASE("accel light cores: shadow rays that walk the grid only to a point light's core and take its list from "
+          "there give the reference's image; a lamp in a translucent shade ends its shadow rays in its core") {
+    const Pick picks[] = {{K_RANDOM, 5},  {K_RANDOM, 9},  {K_RANDOM, 11}, {K_MANY, 1},   {K_LATTICE, 2}, {K_LATTICE, 3},
+                          {K_BLOCKS, 2},  {K_BLOCKS, 7},  {K_FLOOR, 2},   {K_FLOOR, 3},  {K_FLOOR, 11},  {K_SCALED, 2}};
+    SwitchTally t;
+    // (small images: the cores are built whatever the image's size; grids fine enough that a
+    // core holds few primitives)
+    shadow_switch_picks(picks, "lightbuffer", &pray_stats::rays_lightcore, {8, 20}, 48, t);
+
+    // The field of spheres under a lamp like the Room's: a ball minus a smaller ball minus the
+    // half-space under its middle, of thin fabric, with a clear bulb and the light in it. The
+    // shade is a holed list, so no voxel of the light buffer answers; the core holds the shade.
+    std::string program = std::string("perspective") + FIELD_CAMERA + FIELD +
+                          "Shade = transparent({0.6, 0.5, 0.4}, 1) + phong({0.5}, {0.1}, 5)\n"
+                          "S = [0.2, 0.1, 0.6]\n"
+                          "Lamp = sphere(Shade, S, 0.26) - sphere(Shade, S, 0.245) - plane(Shade, S, <0, 0, 1>)"
+                          " | sphere(color({1}) + transparent({1}, 1), S, 0.05)\n"
+                          "rendertiff All | Lamp, pointlight({0.8}, S)\n";
+    Switched r = run_switched(program, {"width=160", "height=160", "shadows=1", "grid=24"}, "lightbuffer");
+    const Run &on = r.on, &off = r.off;
+    INFO("lightbuffer=1: ", stats_text(on.stats), "; shadow rays through the core ", on.stats.rays_lightcore);
+    CHECK(on.stats.lightbuf_cores == 1);
+    CHECK(on.stats.rays_lightbuf == 0);
+    CHECK(on.stats.rays_shadow > 4000);
+    // (those the shadow cache stops do not get that far)
+    CHECK(on.stats.rays_lightcore + on.stats.rays_shadowcache == on.stats.rays_shadow);
+    CHECK(off.stats.lightbuf_cores == 0);
+    CHECK(off.stats.rays_lightcore == 0);
+    // (each ray through the core skips at least the voxel steps across the shade's middle)
+    CHECK(off.stats.voxel_steps - on.stats.voxel_steps > 2 * on.stats.rays_lightcore);
 }
 
 TEST_CASE("accel shadow cache: shadow rays stopped in the voxel of the last ray's blocker give the reference's "
