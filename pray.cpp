@@ -1212,6 +1212,7 @@ inline R3 r3(real x, real y, real z) {
     v.z = z;
     return v;
 }
+typedef real R3::*Axis;  // one of a vector's components
 inline R3 r3of(pray_vec v) { return r3((real)v.x, (real)v.y, (real)v.z); }
 inline R3 operator+(R3 a, R3 b) { return r3(a.x + b.x, a.y + b.y, a.z + b.z); }
 inline R3 operator-(R3 a, R3 b) { return r3(a.x - b.x, a.y - b.y, a.z - b.z); }
@@ -1238,6 +1239,7 @@ struct Box {
 
 struct Prim {
     int kind;           // O_SPHERE, O_PLANE, O_CYLINDER
+    Axis axis;          // a plane whose normal lies along an axis: that component; else none
     Box box;            // contains the solid
     R3 p;               // centre, point on the plane, point on the axis
     R3 n;               // unit outward normal of a plane, unit axis of a cylinder
@@ -1506,6 +1508,14 @@ bool add_kid(pray_ctx *c, Scene *s, Array<int> *kids, int op, int e) {
     return kids->push(c, e);
 }
 
+// The component a plane's normal has alone (the normal lies along that axis), or none.
+Axis plane_axis(R3 n) {
+    if (n.y == 0 && n.z == 0) return &R3::x;
+    if (n.x == 0 && n.z == 0) return &R3::y;
+    if (n.x == 0 && n.y == 0) return &R3::z;
+    return 0;
+}
+
 // Flatten the object into the scene's arrays in post-order (children before parents), folding
 // `one` and `nothing` away and merging chains; with s->prune, also dropping what bounds prove
 // cannot matter. Parts left out stay in the arrays without a parent until scene_compact.
@@ -1517,8 +1527,7 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
     case O_SPHERE:
     case O_PLANE:
     case O_CYLINDER: {
-        Prim q;
-        memset(&q, 0, sizeof q);
+        Prim q = Prim();  // zeros, and no axis
         q.kind = o->kind;
         q.p = r3of(o->p);
         q.mat = o->mat;
@@ -1533,6 +1542,7 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
         } else if (o->kind == O_PLANE) {
             q.n = r3of(vunit(o->v));
             q.d = dot(q.n, q.p);
+            q.axis = plane_axis(q.n);
         } else {
             q.n = r3of(vunit(o->v));
             q.r = (real)o->r;
@@ -1749,6 +1759,7 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
             b.r2 = a.r2;
             b.n = a.n * (real)f;
             b.d = a.d * (real)f;
+            b.axis = a.axis;
         }
         i = j;
     }
@@ -1873,14 +1884,21 @@ inline int prim_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t
         return SPAN;
     }
     case O_PLANE: {
-        real dn = dot(q.n, ray.d);
+        // (a normal along an axis: the dot products' only term that is not zero, the same value)
+        real dn, s0;
+        if (q.axis) {
+            dn = q.n.*q.axis * ray.d.*q.axis;
+            s0 = q.n.*q.axis * ray.o.*q.axis - q.d;
+        } else {
+            dn = dot(q.n, ray.d);
+            s0 = dot(q.n, ray.o) - q.d;
+        }
         if (self) {
             if (dn >= 0) return SPAN_NONE;
             *t0 = 0;
             *t1 = REAL_INF;
             return SPAN;
         }
-        real s0 = dot(q.n, ray.o) - q.d;
         if (dn == 0) return s0 < 0 ? SPAN_ALL : SPAN_NONE;
         real t = -s0 / dn;
         if (dn < 0) {
@@ -3988,13 +4006,14 @@ bool trace_accel(const Scene *s, Scratch *w, const Ray &ray, const real *inv, re
     // parameters (the leading-axis distance over the leading component of the direction), so a
     // step is two comparisons and one addition.
     R3 p = ray.o + ray.d * t;
-    int ix[3], step[3];
+    int ix[3], step[3], left[3];       // left: voxels ahead along each axis inside the grid
     real next[3], delta[3], slope[3];  // slope: voxels per unit of t along each axis
     for (int l = 0; l < 3; l++) {
         real dd = inv[l] == 0 ? 0 : comp(ray.d, l);
         real g = (comp(p, l) - A->org[l]) * A->inv_h;  // clamped before the cast
         ix[l] = !(g > 0) ? 0 : g >= (real)A->n[l] ? A->n[l] - 1 : (int)g;
         step[l] = dd > 0 ? 1 : dd < 0 ? -1 : 0;
+        left[l] = dd > 0 ? A->n[l] - 1 - ix[l] : dd < 0 ? ix[l] : 0;
         next[l] = dd == 0 ? REAL_INF : (A->org[l] + (real)(ix[l] + (dd > 0)) * A->h - comp(ray.o, l)) * inv[l];
         delta[l] = A->h * (inv[l] < 0 ? -inv[l] : inv[l]);
         slope[l] = (dd < 0 ? -dd : dd) * A->inv_h;
@@ -4029,8 +4048,7 @@ bool trace_accel(const Scene *s, Scratch *w, const Ray &ray, const real *inv, re
             real exit = near < tend ? near : tend;
             t = exit > t ? exit : t;
             if (exit >= tend) break;
-            ix[ax] += step[ax];
-            if (ix[ax] < 0 || ix[ax] >= A->n[ax]) break;
+            if (--left[ax] < 0) break;
             at += stride[ax];
             next[ax] += delta[ax];
             continue;
@@ -4040,8 +4058,7 @@ bool trace_accel(const Scene *s, Scratch *w, const Ray &ray, const real *inv, re
         int m[3];
         real e[3];
         for (int l = 0; l < 3; l++) {
-            int room = step[l] > 0 ? A->n[l] - 1 - ix[l] : ix[l];
-            m[l] = room < r ? room : r;
+            m[l] = left[l] < r ? left[l] : r;
             // (delta may be infinite for a direction of ~1e-308: no 0 x infinity)
             e[l] = m[l] > 0 ? next[l] + (real)m[l] * delta[l] : next[l];  // no step along l: infinite
         }
@@ -4057,11 +4074,11 @@ bool trace_accel(const Scene *s, Scratch *w, const Ray &ray, const real *inv, re
                 k = step[l] == 0 || !(f >= 0) ? 0 : f < (real)m[l] ? (int)f + 1 : m[l];
             }
             if (k == 0) continue;
-            ix[l] += step[l] * k;
+            left[l] -= k;
+            at += stride[l] * k;
             next[l] += (real)k * delta[l];
         }
-        if (ix[ax] < 0 || ix[ax] >= A->n[ax]) break;
-        at = ((long)ix[2] * A->n[1] + ix[1]) * A->n[0] + ix[0];
+        if (left[ax] < 0) break;
     }
     w->k.steps += (double)steps;
     w->k.moves += (double)moves;
