@@ -3059,8 +3059,8 @@ bool light_core(ListBuilder &b, const Box *eff, real margin, LightBuf &B, Array<
 }
 
 // Build the light buffers: cells and slabs about `cell` wide where the grid's box is, and lists
-// for the space between each voxel and its light, and the point lights' cores. `eff`: where bounds place each primitive;
-// `margin`: how far rounding may move a point (the grid's).
+// for the space between each voxel and its light, and the point lights' cores. `eff`: where
+// bounds place each primitive; `margin`: how far rounding may move a point (the grid's).
 // `lights`, `eye`: which buffers to build; `rays`: the primary rays of the image.
 bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool lights, bool eye, double rays) {
     pray_ctx *c = b.c;
