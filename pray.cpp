@@ -2251,9 +2251,9 @@ struct LightBuf {
     // end); then the runs, each a list and the slab where it ends, in order from the eye. A cell
     // whose primary rays walk the grid has one run of list -1.
     int *runs, nruns;
-    // A point light's core: a box of voxels around the light whose list has no more primitives
-    // than the light's voxel. A shadow ray not answered by a voxel's list walks the grid only to
-    // the core, then evaluates the core's list.
+    // A point light's core: a box of voxels around the light with one small list (light_core).
+    // A shadow ray not answered by a voxel's list walks the grid only to the core, then
+    // evaluates the core's list.
     real core_lo[3], core_hi[3];
     int core;  // the core's list; -1: none
 };
@@ -2310,6 +2310,14 @@ bool voxel_of(const Accel *A, R3 p, int *ix) {
     return true;
 }
 inline long voxel_index(const Accel *A, const int *ix) { return ((long)ix[2] * A->n[1] + ix[1]) * A->n[0] + ix[0]; }
+
+// The box of the voxels from i0 to i1 - 1 along each axis, widened by the margin.
+void voxels_box(const Accel *a, const int *i0, const int *i1, double margin, real *lo, real *hi) {
+    for (int l = 0; l < 3; l++) {
+        lo[l] = (real)((double)a->org[l] + i0[l] * (double)a->h - margin);
+        hi[l] = (real)((double)a->org[l] + i1[l] * (double)a->h + margin);
+    }
+}
 
 // Class of a primitive against a closed box.
 int classify_prim(const Prim &q, const real *lo, const real *hi) {
@@ -3035,13 +3043,14 @@ bool light_core(ListBuilder &b, const Box *eff, real margin, LightBuf &B, Array<
     bool whole = false;
     for (int k = 1; k <= LB_CORE && !whole; k++) {
         Box bx;
+        int i0[3], i1[3];
         whole = true;
         for (int l = 0; l < 3; l++) {
-            int i0 = ix[l] - k > 0 ? ix[l] - k : 0, i1 = ix[l] + k + 1 < a->n[l] ? ix[l] + k + 1 : a->n[l];
-            bx.lo[l] = (real)((double)a->org[l] + i0 * (double)a->h - margin);
-            bx.hi[l] = (real)((double)a->org[l] + i1 * (double)a->h + margin);
-            whole = whole && i0 == 0 && i1 == a->n[l];
+            i0[l] = ix[l] - k > 0 ? ix[l] - k : 0;
+            i1[l] = ix[l] + k + 1 < a->n[l] ? ix[l] + k + 1 : a->n[l];
+            whole = whole && i0[l] == 0 && i1[l] == a->n[l];
         }
+        voxels_box(a, i0, i1, margin, bx.lo, bx.hi);
         prims.n = 0;
         cls.n = 0;
         for (int i = 0; i < s->prims.n; i++) {
@@ -3483,14 +3492,11 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         for (int z = 0; z < a->n[2] && st == PRAY_OK; z++)
             for (int y = 0; y < a->n[1] && st == PRAY_OK; y++)
                 for (int x = 0; x < a->n[0] && st == PRAY_OK; x++) {
-                    long v = ((long)z * a->n[1] + y) * a->n[0] + x;
+                    int ix[3] = {x, y, z}, ix1[3] = {x + 1, y + 1, z + 1};
+                    long v = voxel_index(a, ix);
                     int k0 = start[(int)v], k1 = start[(int)v + 1];
                     real lo[3], hi[3];
-                    int ix[3] = {x, y, z};
-                    for (int l = 0; l < 3; l++) {
-                        lo[l] = (real)((double)a->org[l] + ix[l] * (double)a->h - margin);
-                        hi[l] = (real)((double)a->org[l] + (ix[l] + 1) * (double)a->h + margin);
-                    }
+                    voxels_box(a, ix, ix1, margin, lo, hi);
                     cls.n = 0;
                     if (!cls.reserve(c, k1 - k0 + 1)) {
                         st = c->status;
@@ -3522,7 +3528,7 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
                         if (nb[k][0] < 0 || nb[k][1] < 0 || nb[k][2] < 0 || nb[k][0] >= a->n[0] ||
                             nb[k][1] >= a->n[1] || nb[k][2] >= a->n[2])
                             continue;
-                        long u = ((long)nb[k][2] * a->n[1] + nb[k][1]) * a->n[0] + nb[k][0];
+                        long u = voxel_index(a, nb[k]);
                         if (seen[u] || a->voxel[u] != a->voxel[v0]) continue;
                         seen[u] = 1;
                         if (!q.push(c, (int)u)) st = c->status;
@@ -4020,7 +4026,7 @@ bool trace_accel(const Scene *s, Scratch *w, const Ray &ray, const real *inv, re
     }
     int run = -1;  // the list of the area being crossed
     real run_a = t;
-    long at = ((long)ix[2] * A->n[1] + ix[1]) * A->n[0] + ix[0];  // the voxel the ray is in
+    long at = voxel_index(A, ix);  // the voxel the ray is in
     long stride[3];  // a step along each axis, in cells
     stride[0] = step[0];
     stride[1] = (long)step[1] * A->n[0];
