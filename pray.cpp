@@ -2256,6 +2256,10 @@ struct LightBuf {
     // evaluates the core's list.
     real core_lo[3], core_hi[3];
     int core;  // the core's list; -1: none
+    // The core divided by direction (core_cells): per face and cell, the list of the pyramid from
+    // the light to the core's side.
+    LightFace cf[6];
+    int *cells;
 };
 
 // An action list, stored in Accel::data at off[L]:
@@ -2274,6 +2278,7 @@ struct Accel {
     Array<int> data, off;
     Array<int> plan_at;  // per list: where its plan starts in `plan`, -1 when it has none (list_plan)
     Array<int> plan;
+    Array<unsigned char> clear;  // per list: all its surfaces let all light through (list_passes)
     int outer;         // list of the space outside the grid (everything without a grid)
     int freeze, merge, bounds;
     int cache;              // option shadowcache
@@ -2292,9 +2297,11 @@ void accel_release(pray_ctx *c, Accel *a) {
     a->off.release(c);
     a->plan_at.release(c);
     a->plan.release(c);
+    a->clear.release(c);
     for (int i = 0; a->lbuf && i <= a->nlbuf; i++) {
         mem_free(c, a->lbuf[i].list);
         mem_free(c, a->lbuf[i].runs);
+        mem_free(c, a->lbuf[i].cells);
     }
     mem_free(c, a->lbuf);
     mem_free(c, a);
@@ -2654,6 +2661,23 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
     plan->p[base + 1] = holed;
     return base;
 }
+
+// Whether every primitive of list d is of one colour and lets all light through: a shadow ray
+// crosses it unchanged, whatever surfaces of it are visible (a lamp's clear bulb).
+bool list_clear(const Scene *s, const int *d) {
+    const int *prims = d + 4 + 3 * d[0];
+    for (int i = 0; i < d[1]; i++) {
+        const pray_model *m = s->prims[prims[i]].mat;
+        if (m->kind != M_FLAT || m->transmit.r != 1 || m->transmit.g != 1 || m->transmit.b != 1) return false;
+    }
+    return true;
+}
+
+// Lists a visitor may pass over: none in general; a shadow ray's, those that are clear
+// (list_clear: each factor would be exactly 1).
+template <class Visit>
+inline bool list_passes(const Accel *, int, const Visit &) { return false; }
+inline bool list_passes(const Accel *A, int L, const ShadowHit &) { return A->clear[L] != 0; }
 
 // A plain list: one with a plan and no holes (list_plan).
 inline bool list_plain(const Accel *A, int L) { return A->plan_at[L] >= 0 && !A->plan.p[A->plan_at[L] + 1]; }
@@ -3028,6 +3052,93 @@ const int RAYS_PER_VOXEL = 8;
 // at most LB_CORE_PRIMS primitives, or as many as the light's voxel.
 const int LB_CORE = 8, LB_CORE_PRIMS = 8;
 
+// Face fi of a point light's cube of directions: e[2] along axis fi / 2, away from the light
+// (towards -1 for odd fi), e[0] and e[1] the next two axes.
+void point_face(int fi, LightFace *F) {
+    int ax = fi / 2;
+    real sg = fi & 1 ? (real)-1 : (real)1;
+    R3 unitv[3] = {r3(1, 0, 0), r3(0, 1, 0), r3(0, 0, 1)};
+    F->e[2] = unitv[ax] * sg;
+    F->e[0] = unitv[(ax + 1) % 3];
+    F->e[1] = unitv[(ax + 2) % 3];
+}
+
+// A point light's core is divided by direction like a light buffer's faces, into CORE_CELLS x
+// CORE_CELLS cells per face, one slab deep: the pyramid of each cell from the light to the
+// core's side gets its own list, which holds only what that pyramid meets. A lamp's shadow ray
+// from below then leaves out the shade above the light.
+const int CORE_CELLS = 16;
+
+// The lists of the cells of B's core (LightBuf::cells): of the primitives that meet the core's
+// box, those that meet the cell's pyramid. `cand`, `prims`, `cls`: scratch.
+bool core_cells(ListBuilder &b, const Box *eff, real margin, LightBuf &B, Array<int> &cand, Array<int> &prims,
+                Array<unsigned char> &cls) {
+    const Scene *s = b.s;
+    const int per = CORE_CELLS * CORE_CELLS;
+    B.cells = (int *)mem_alloc(b.c, sizeof(int) * 6 * per);
+    if (!B.cells) return false;
+    Box core;
+    for (int l = 0; l < 3; l++) core.lo[l] = B.core_lo[l], core.hi[l] = B.core_hi[l];
+    // the candidates, each followed by its class in the core's box
+    cand.n = 0;
+    for (int i = 0; i < s->prims.n; i++)
+        if (box_overlap(eff[i], core) &&
+            !(cand.push(b.c, i) && cand.push(b.c, classify_prim(s->prims[i], core.lo, core.hi))))
+            return false;
+    // the cells widened by a quarter, and the ball that takes over near the light (lightbuf_build)
+    real eps = (real)2 / CORE_CELLS / 4, r = margin * (real)2.6 / eps;
+    r = r > margin ? r : margin;
+    for (int fi = 0; fi < 6; fi++) {
+        LightFace &F = B.cf[fi];
+        point_face(fi, &F);
+        int ax = fi / 2;
+        for (int l = 0; l < 2; l++) {
+            F.lo[l] = -1;
+            F.h[l] = (real)2 / CORE_CELLS;
+            F.inv[l] = (real)CORE_CELLS / 2;
+            F.n[l] = CORE_CELLS;
+        }
+        F.lo[2] = 0;
+        F.h[2] = fi & 1 ? comp(B.o, ax) - B.core_lo[ax] : B.core_hi[ax] - comp(B.o, ax);
+        F.inv[2] = 0;
+        F.n[2] = 1;
+        F.base = fi * per;
+        F.cbase = 0;
+        for (int cel = 0; cel < per; cel++) {
+            Zone z;
+            lightbuf_zone(B, F, cel % CORE_CELLS, cel / CORE_CELLS, 0, margin, eps, r, &z);
+            prims.n = 0;
+            cls.n = 0;
+            for (int j = 0; j < cand.n; j += 2) {
+                // the part of the pyramid inside the core's box: outside it where either says
+                // so, inside where either says so
+                int i = cand[j], in_box = cand[j + 1];
+                int cl = in_box == CL_OUT ? CL_OUT : classify_zone(s->prims[i], eff[i], z);
+                if (cl == CL_BD && in_box == CL_IN) cl = CL_IN;
+                if (cl != CL_OUT && !(prims.push(b.c, i) && cls.push(b.c, (unsigned char)cl))) return false;
+            }
+            int L = lb_list(b, prims.p, cls.p, prims.n);
+            if (L < 0) return false;
+            B.cells[F.base + cel] = L;
+        }
+    }
+    return true;
+}
+
+// The list for the part inside B's core of a shadow ray from x to the light: its cell's; the
+// whole core's when x is at the light.
+inline int core_list(const LightBuf &B, R3 x) {
+    R3 m = x - B.o;
+    const LightFace &F = B.cf[cube_face(m)];
+    real g = dot(m, F.e[2]);
+    if (!(g > 0)) return B.core;
+    real k = (real)1 / g;
+    int cell;
+    // (widened by a quarter of a cell, as lightbuf_find)
+    if (face_cell(F, dot(m, F.e[0]) * k, dot(m, F.e[1]) * k, (real)0.25, &cell) <= 0) return B.core;
+    return B.cells[F.base + cell];
+}
+
 // The core of point light B (LightBuf::core): the largest cube of voxels centred on the light's
 // voxel, clipped to the grid, whose list is small (LB_CORE_PRIMS). A lamp in its shade gets the
 // shade's box, and a light in empty space the empty space around it. Its list is built as a
@@ -3100,7 +3211,9 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
         B.point = B.pieces || s->lights[li].point;
         B.faces = B.point ? 6 : 1;
         B.o = B.pieces ? s->eye : B.point ? s->lights[li].v : r3(0, 0, 0);
-        if (!B.pieces && B.point && !light_core(b, eff, margin, B, prims, cls)) {
+        if (!B.pieces && B.point &&
+            !(light_core(b, eff, margin, B, prims, cls) &&
+              (B.core < 0 || core_cells(b, eff, margin, B, cand, prims, cls)))) {
             ok = false;
             break;
         }
@@ -3115,14 +3228,7 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
                 R3 least = ax <= ay && ax <= az ? r3(1, 0, 0) : ay <= az ? r3(0, 1, 0) : r3(0, 0, 1);
                 F.e[0] = unit(cross(F.e[2], least));
                 F.e[1] = cross(F.e[2], F.e[0]);
-            } else {
-                int ax = fi / 2;
-                real sg = fi & 1 ? (real)-1 : (real)1;
-                R3 unitv[3] = {r3(1, 0, 0), r3(0, 1, 0), r3(0, 0, 1)};
-                F.e[2] = unitv[ax] * sg;
-                F.e[0] = unitv[(ax + 1) % 3];
-                F.e[1] = unitv[(ax + 2) % 3];
-            }
+            } else point_face(fi, &F);
             // the grid's box in the face's coordinates
             Box grid;
             for (int l = 0; l < 3; l++) grid.lo[l] = a->org[l], grid.hi[l] = a->top[l];
@@ -3314,6 +3420,7 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     a->off.init();
     a->plan_at.init();
     a->plan.init();
+    a->clear.init();
     a->freeze = opt_int(c, OPT_FREEZE);
     a->merge = opt_int(c, OPT_MERGE);
     // (the shadow cache's answer is the reference's when no surface lets more light through
@@ -3574,7 +3681,8 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         for (int j = 0; st == PRAY_OK && j < nn; j++) solid[j] = -1;
         for (int L = 0; st == PRAY_OK && L < a->off.n; L++) {
             int where = list_plan(c, s, a->data.p + a->off[L], kids, solid, &a->plan);
-            if (where == -2 || !a->plan_at.push(c, where)) st = c->status;
+            if (where == -2 || !a->plan_at.push(c, where) || !a->clear.push(c, list_clear(s, a->data.p + a->off[L])))
+                st = c->status;
         }
         mem_free(c, kids);
         mem_free(c, solid);
@@ -3603,7 +3711,8 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     nv = (long)a->n[0] * a->n[1] * a->n[2];
     a->memory = (double)sizeof(Accel) + (double)nv * (sizeof(int) + 1) + (double)a->data.cap * sizeof(int) +
                 (double)a->off.cap * sizeof(int) + (double)(a->plan_at.cap + a->plan.cap) * sizeof(int) +
-                (double)(a->lbuf ? a->nlbuf + 1 : 0) * sizeof(LightBuf) + (double)(lbv + eruns) * sizeof(int);
+                (double)a->clear.cap + (double)(a->lbuf ? a->nlbuf + 1 : 0) * sizeof(LightBuf) +
+                (double)(lbv + eruns + cores * 6 * CORE_CELLS * CORE_CELLS) * sizeof(int);
     c->stats.lightbuf_voxels = lbv;
     c->stats.lightbuf_cores = cores;
     c->stats.eyebuf_voxels = ebv;
@@ -3761,7 +3870,7 @@ bool eval_flat(const Scene *s, Scratch *w, const Ray &ray, const int *prims, int
 template <class Visit>
 bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L, real a, real b, real tmax,
                int self, Visit &visit) {
-    if (L == 0) return false;
+    if (L == 0 || list_passes(A, L, visit)) return false;
     const int *d = A->data.p + A->off[L];
     int na = d[0], np = d[1];
     const int *nodes = d + 4, *prims = d + 4 + 3 * na;
@@ -4166,10 +4275,10 @@ void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
         w->k.core += 1;
         if (ta > 0) {
             if (!trace_accel(s, w, ray, inv, tmax, ta, self, visit))
-                eval_list(s, A, w, ray, B->core, ta, tmax, tmax, self, visit);
+                eval_list(s, A, w, ray, core_list(*B, ray.o), ta, tmax, tmax, self, visit);
         } else {
             ray_begin(s, w);
-            eval_list(s, A, w, ray, B->core, 0, tmax, tmax, self, visit);
+            eval_list(s, A, w, ray, core_list(*B, ray.o), 0, tmax, tmax, self, visit);
         }
     } else trace_accel(s, w, ray, inv, tmax, tmax, self, visit);
     int *ix = w->blocker + 3 * light;

@@ -359,8 +359,9 @@ pray_status pray_render_file(const char *program, const char *const *options, in
    the reference. By default the scene is simplified, a uniform grid of voxels with per-voxel
    action lists is built (thesis 3.3-3.6: leading-axis traversal, set/check actions, freezing,
    areas), bounding boxes prune what cannot be met, light buffers answer shadow rays from one
-   list per voxel around each light (and from one list for the box around a point light where
-   its shadow rays end), and primary rays walk the lists of the eye's buffer, a grid of
+   list per voxel around each light (and, in the box around a point light where its shadow
+   rays end, from one list per direction; a shadow ray passes over lists of clear surfaces
+   only), and primary rays walk the lists of the eye's buffer, a grid of
    pyramids around a perspective camera's eye; a shadow ray first tries the voxel where the
    last one towards its light was stopped. Options grid, freeze, merge, bounds,
    lightbuffer, eyebuffer and shadowcache switch the parts on and off; every setting gives the

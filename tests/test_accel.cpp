@@ -1132,6 +1132,36 @@ TEST_CASE("accel light cores: shadow rays that walk the grid only to a point lig
     CHECK(off.stats.voxel_steps - on.stats.voxel_steps > 2 * on.stats.rays_lightcore);
 }
 
+TEST_CASE("accel light cores by direction: a lamp in a room, lit from every side; its cells' lists give the "
+          "reference's image, and shadow rays pass over the lists of its clear bulb") {
+    // The lamp of the case above inside a room: a hollow ball around everything, so that shadow
+    // rays come to the lamp from above (through the shade), from the sides and from below
+    // (through the shade's opening: only the bulb is in their cells' lists). The same with a
+    // bulb that dims the light a little: then its lists are evaluated.
+    auto lamp = [](const char *bulb) {
+        return std::string("perspective") + FIELD_CAMERA + FIELD +
+               "Shade = transparent({0.6, 0.5, 0.4}, 1) + phong({0.5}, {0.1}, 5)\n"
+               "S = [0.2, 0.1, 0.6]\n"
+               "Lamp = sphere(Shade, S, 0.26) - sphere(Shade, S, 0.245) - plane(Shade, S, <0, 0, 1>)"
+               " | sphere(color({1}) + transparent(" + bulb + ", 1), S, 0.05)\n"
+               "Room = -sphere(phong({0.6, 0.6, 0.5}, {0}, 1), [0, 0, 0.5], 5)\n"
+               "rendertiff All | Lamp | Room, pointlight({0.8}, S)\n";
+    };
+    std::vector<std::string> opts = {"width=120", "height=120", "shadows=1", "grid=24"};
+    Switched clear = run_switched(lamp("{1}"), opts, "lightbuffer");
+    Switched dim = run_switched(lamp("{0.97}"), opts, "lightbuffer");
+    INFO("clear bulb: ", stats_text(clear.on.stats), "; dim bulb: ", stats_text(dim.on.stats));
+    CHECK(clear.on.stats.lightbuf_cores == 1);
+    CHECK(clear.on.stats.rays_lightcore > 4000);
+    // the same rays, but fewer intersections: those the clear bulb's lists would have made, in
+    // the core's cells under the lamp and in the grid's voxels that hold only the bulb
+    for (const Switched *r : {&clear, &dim}) CHECK(r->on.stats.rays_shadow == r->off.stats.rays_shadow);
+    CHECK(clear.on.stats.rays_shadow == dim.on.stats.rays_shadow);
+    CHECK(clear.on.stats.rays_lightcore == dim.on.stats.rays_lightcore);
+    CHECK(clear.on.stats.intersection_tests < dim.on.stats.intersection_tests);
+    CHECK(clear.off.stats.intersection_tests < dim.off.stats.intersection_tests);
+}
+
 TEST_CASE("accel shadow cache: shadow rays stopped in the voxel of the last ray's blocker give the reference's "
           "image, through glass and with lights amid the objects; it stops most shadow rays under a table") {
     const Pick picks[] = {{K_RANDOM, 30}, {K_RANDOM, 41}, {K_RANDOM, 64}, {K_RANDOM, 66}, {K_MANY, 4},  {K_LATTICE, 3},
