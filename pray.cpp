@@ -2595,7 +2595,9 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
 }
 
 // A list has a plan when its root, in the list's region, is a union of solids, each a primitive
-// or an intersection of primitives, any of them turned inside out (eval_flat). It is plain when
+// or an intersection of members, any of them turned inside out (eval_flat); a member is a
+// primitive or a group: a union of primitives (a wall with a window: the wall's block minus the
+// opening's box, which turned inside out is a union). It is plain when
 // only half-spaces are turned inside out: then a ray enters and leaves each solid once (boxes,
 // slabs, capped cylinders, a wall: the inside of a room's box taken from a solid block); else
 // it is holed (a shell: a ball minus a smaller ball). Each primitive is followed up to the root.
@@ -2603,13 +2605,17 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
 // difference when the child is not the first (the first child is then inside for the whole
 // region: an active node is on its boundary). A node with more is a union or an intersection (a
 // difference: its first child and the others turned inside out), the one turned into the other
-// by an odd number of inversions above it. A union may not stand under an intersection; an
-// intersection right under the unions starts a solid, which the intersections under it join.
-// Appends to `plan` the number of solids, 1 when holed, and per primitive of the list,
-// (solid + 1) * 2 + (1 when turned inside out), solid -1 standing alone. Returns where that
-// starts, or -1 (appending nothing) when the list has no plan, -2 when out of memory.
-// `kids`, `solid`: per node scratch, 0 and -1 on entry and left so.
+// by an odd number of inversions above it. An intersection right under the unions starts a
+// solid, which the intersections under it join; a union under it starts a group, which the
+// unions under it join; an intersection may not stand under a group. A solid with a group is
+// holed. Appends to `plan` the number of solids, 1 when holed, the number of groups; per
+// primitive of the list, (solid + 1) * 2 + (1 when turned inside out), solid -1 standing alone;
+// when there are groups, per primitive its group or -1, then per group its solid. Returns where
+// that starts, or -1 (appending nothing) when the list has no plan, -2 when out of memory.
+// `kids`, `solid`: per node scratch, 0 and -1 on entry and left so (a group's node keeps its
+// group in `solid`).
 const int PLAN_DEPTH = 64;  // deeper trees are evaluated in full
+const int PLAN_HEAD = 3;    // a plan's numbers before the primitives'
 
 int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, Array<int> *plan) {
     int na = d[0], np = d[1];
@@ -2618,9 +2624,12 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
         if (s->nodes[nodes[3 * i]].parent >= 0) kids[s->nodes[nodes[3 * i]].parent]++;
     for (int i = 0; i < np; i++)
         if (s->prims[prims[i]].parent >= 0) kids[s->prims[prims[i]].parent]++;
-    int base = plan->n, ns = 0;
+    int base = plan->n, ns = 0, ng = 0;
     bool holed = false;
-    bool mem = np == 0 || (plan->push(c, 0) && plan->push(c, 0)), ok = np > 0 && mem;
+    Array<int> group, gsolid;  // per primitive, per group
+    group.init();
+    gsolid.init();
+    bool mem = np == 0 || (plan->push(c, 0) && plan->push(c, 0) && plan->push(c, 0)), ok = np > 0 && mem;
     for (int i = 0; ok && i < np; i++) {
         int path[PLAN_DEPTH], n = 0;  // the ancestors, the root last
         for (int p = s->prims[prims[i]].parent; ok && p >= 0; p = s->nodes[p].parent) {
@@ -2628,7 +2637,7 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
             if (ok) path[n++] = p;
         }
         bool inv = false;
-        int k = -1;  // the solid, -1 while under unions only
+        int k = -1, g = -1;  // the solid, -1 while under unions only; the group
         for (int m = n - 1; ok && m >= 0; m--) {
             int j = path[m];
             const Node &nd = s->nodes[j];
@@ -2636,18 +2645,35 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
             bool first = elem_first(s, child);
             if (kids[j] > 1) {
                 bool inter = (nd.op != O_UNION) != inv;
-                ok = inter || k < 0;
+                ok = !(inter && g >= 0);
                 if (inter && k < 0) {
                     if (solid[j] < 0) solid[j] = ns++;
                     k = solid[j];
+                } else if (!inter && k >= 0 && g < 0) {
+                    if (solid[j] < 0) {
+                        solid[j] = ng++;
+                        mem = gsolid.push(c, k);
+                        ok = ok && mem;
+                    }
+                    g = solid[j];
                 }
             }
             if (nd.op == O_COMPL || (nd.op == O_DIFF && !first)) inv = !inv;
         }
         holed = holed || (inv && s->prims[prims[i]].kind != O_PLANE);
-        mem = !ok || plan->push(c, (k + 1) * 2 + inv);
+        mem = !ok || (plan->push(c, (k + 1) * 2 + inv) && group.push(c, g));
         ok = ok && mem;
     }
+    for (int i = 0; ok && ng > 0 && i < np; i++) {
+        mem = plan->push(c, group[i]);
+        ok = mem;
+    }
+    for (int i = 0; ok && i < ng; i++) {
+        mem = plan->push(c, gsolid[i]);
+        ok = mem;
+    }
+    group.release(c);
+    gsolid.release(c);
     for (int i = 0; i < na; i++) {
         int j = nodes[3 * i];
         solid[j] = -1;
@@ -2658,7 +2684,8 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
         return mem ? -1 : -2;
     }
     plan->p[base] = ns;
-    plan->p[base + 1] = holed;
+    plan->p[base + 1] = holed || ng > 0;
+    plan->p[base + 2] = ng;
     return base;
 }
 
@@ -3808,15 +3835,19 @@ inline void bump(const Scene *s, Scratch *w, int e) {
 template <class Visit>
 bool eval_flat(const Scene *s, Scratch *w, const Ray &ray, const int *prims, int np, const int *plan, real a, real b,
                real tmax, int self, Visit &visit) {
-    int ns = plan[0];
-    plan += 2;
-    for (int k = 0; k < ns; k++) w->hull[k].need = w->hull[k].have = 0;
+    int ns = plan[0], ng = plan[2];
+    plan += PLAN_HEAD;
+    // (the groups' counts after the solids': a group is in when one of its members is)
+    const int *group = ng ? plan + np : NULL, *gsolid = plan + 2 * np;
+    Hull *gh = w->hull + ns;
+    for (int k = 0; k < ns + ng; k++) w->hull[k].need = w->hull[k].have = 0;
     int in = 0, nc = 0;  // solids (and primitives standing alone) the ray is in
     for (int i = 0; i < np; i++) {
         const Span &sp = span_get(s, w, ray, prims[i], self);
         bool st = (sp.kind == SPAN_ALL || (sp.kind == SPAN && sp.t0 <= a && a < sp.t1)) != (plan[i] & 1);
         int k = (plan[i] >> 1) - 1;
-        if (k < 0) in += st;
+        if (group && group[i] >= 0) gh[group[i]].have += st;
+        else if (k < 0) in += st;
         else w->hull[k].need++, w->hull[k].have += st;
         if (sp.kind != SPAN) continue;
         for (int e = 1; e >= 0; e--) {
@@ -3830,6 +3861,7 @@ bool eval_flat(const Scene *s, Scratch *w, const Ray &ray, const int *prims, int
     }
     w->k.checks += np;
     if (nc == 0) return false;
+    for (int g = 0; g < ng; g++) w->hull[gsolid[g]].need++, w->hull[gsolid[g]].have += gh[g].have > 0;
     for (int k = 0; k < ns; k++) in += w->hull[k].need == w->hull[k].have;
     // (the list's primitives are in the order of their numbers, so the crossings sort as the
     // full evaluation's do)
@@ -3842,6 +3874,13 @@ bool eval_flat(const Scene *s, Scratch *w, const Ray &ray, const int *prims, int
         for (; j < nc && w->cross[j].t == t; j++) {
             const Cross &x = w->cross[j];
             int i = x.prim, k = (plan[i] >> 1) - 1, st = (x.enter != 0) != (plan[i] & 1) ? 1 : -1;
+            if (group && group[i] >= 0) {  // the group's member: the group changes, or nothing
+                Hull &G = gh[group[i]];
+                bool was = G.have > 0;
+                G.have += st;
+                if (was == (G.have > 0)) continue;
+                st = was ? -1 : 1;
+            }
             if (k < 0) in += st;
             else {
                 Hull &u = w->hull[k];
@@ -3883,8 +3922,8 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
         // entry of its members and left at the earliest exit; a half-space turned inside out is
         // entered where the ray leaves the half-space. Anything less plain (a solid inside at a,
         // entries at the same t, a grazing touch) is left to the flat sweep.
-        const int *plan = A->plan.p + A->plan_at[L] + 2;
-        int ns = plan[-2];
+        const int *plan = A->plan.p + A->plan_at[L] + PLAN_HEAD;
+        int ns = plan[-PLAN_HEAD];
         for (int k = 0; k < ns; k++) {
             Hull &u = w->hull[k];
             u.t0 = -REAL_INF;

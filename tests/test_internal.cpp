@@ -760,6 +760,51 @@ struct TNotch {
     }
 };
 
+TEST_CASE("list plans: a wall with a window, the window's box turned inside out as a group of the wall") {
+    // A slab minus a box through it. Around the opening's edges a voxel holds two or three of the
+    // box's planes, turned inside out: a union under the slab's intersection, which the flat
+    // sweep takes as a group. Every list then has a plan, and rays through the wall at random
+    // see what the reference sees.
+    TCtx k;
+    REQUIRE(pray_option(k.c, "grid", 6) == PRAY_OK);
+    pray_ctx *c = k.c;
+    auto box = [&](double x, double y, double z, pray_model *m) {
+        pray_object *b = pray_plane(c, m, t_vec(x, y, z), t_vec(1, 0, 0));
+        b = pray_csg(c, PRAY_INTERSECTION, b, pray_plane(c, m, t_vec(-x, -y, -z), t_vec(-1, 0, 0)));
+        b = pray_csg(c, PRAY_INTERSECTION, b, pray_plane(c, m, t_vec(x, y, z), t_vec(0, 1, 0)));
+        b = pray_csg(c, PRAY_INTERSECTION, b, pray_plane(c, m, t_vec(-x, -y, -z), t_vec(0, -1, 0)));
+        b = pray_csg(c, PRAY_INTERSECTION, b, pray_plane(c, m, t_vec(x, y, z), t_vec(0, 0, 1)));
+        return pray_csg(c, PRAY_INTERSECTION, b, pray_plane(c, m, t_vec(-x, -y, -z), t_vec(0, 0, -1)));
+    };
+    pray_object *wall = pray_csg(c, PRAY_DIFFERENCE, box(1, 0.1, 1, k.mat(1)), box(0.35, 0.5, 0.25, k.mat(2)));
+    TScene B(c, wall);
+    REQUIRE(B.ok);
+    REQUIRE(B.s.accel);
+    const Accel *A = B.s.accel;
+    int with_groups = 0, without_plan = 0;
+    for (int L = 1; L < A->off.n; L++) {
+        if (A->plan_at[L] < 0) without_plan++;
+        else if (A->plan[A->plan_at[L] + 2] > 0) with_groups++;
+    }
+    CHECK(without_plan == 0);
+    CHECK(with_groups > 0);
+    TRng g(5);
+    int wrong = 0;
+    for (int i = 0; i < 400; i++) {
+        double o[3] = {g.uni(-1.2, 1.2), -3, g.uni(-1.2, 1.2)}, d[3] = {g.uni(-0.3, 0.3), 1, g.uni(-0.3, 0.3)};
+        Ray r = t_ray(o[0], o[1], o[2], d[0], d[1], d[2]);
+        B.accelerated = false;
+        std::vector<Hit> want = B.hits(r);
+        B.accelerated = true;
+        std::vector<Hit> got = B.hits(r);
+        bool same = want.size() == got.size();
+        for (size_t j = 0; same && j < want.size(); j++)
+            same = want[j].t == got[j].t && want[j].prim == got[j].prim && want[j].root_enter == got[j].root_enter;
+        wrong += !same;
+    }
+    CHECK(wrong == 0);
+}
+
 TEST_CASE("difference: a face shared with the subtracted box is not visible") {
     TCtx k;
     SUBCASE("axis-aligned") {
