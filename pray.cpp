@@ -3829,9 +3829,10 @@ inline void bump(const Scene *s, Scratch *w, int e) {
 }
 
 // The flat sweep of a list with a plan (list_plan), holed or not, on the part (a, b] of the ray
-// (and t < tmax): each solid is inside where the ray is in all of its members, the root where
-// it is in one solid or more. The crossings are taken in order, and each changes one member,
-// perhaps its solid, perhaps the root. Returns true when `visit` stopped.
+// (and t < tmax): each group is inside where the ray is in one of its primitives, each solid
+// where it is in all of its members, the root where it is in one solid or more. The crossings
+// are taken in order, and each changes one primitive, perhaps its group, perhaps its solid,
+// perhaps the root. Returns true when `visit` stopped.
 template <class Visit>
 bool eval_flat(const Scene *s, Scratch *w, const Ray &ray, const int *prims, int np, const int *plan, real a, real b,
                real tmax, int self, Visit &visit) {
