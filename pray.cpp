@@ -2892,6 +2892,18 @@ inline int cube_face(R3 m) {
     return 2 * a + (comp(m, a) < 0);
 }
 
+// A point light's zones (and the eye's) are widened by this share of a cell, and a point is
+// looked up in the cells widened by as much: so a point rounded just past a cell's edge (u = 1
+// in one face, -1 in the next) still belongs to the cell it is given.
+const real CELL_SLACK = (real)0.25;
+
+// Near a point light, where that widening is less than the rounding of a point, a ball around
+// the light of this radius joins every zone (`eps`: the widening in u and v).
+inline real tip_ball(real margin, real eps) {
+    real r = margin * (real)2.6 / eps;
+    return r > margin ? r : margin;
+}
+
 // The cell of face F at (u, v) (a point light's u and v are over w), the face's cells widened
 // by `slack` cells and clamped: 1 and *cell set; 0 when (u, v) is beside the cells; -1 when not
 // a number.
@@ -2926,10 +2938,8 @@ inline int lightbuf_find(const LightBuf &B, int outer, R3 x, real tmax, real *ta
         g[0] *= k;
         g[1] *= k;
     }
-    // a point light's zones are widened by a quarter of a cell (eps in lightbuf_build), so a
-    // point rounded just past the edge of a face (u = 1 in one face, -1 in the next) belongs in
-    // the edge cell
-    int cell, in = face_cell(F, g[0], g[1], B.point ? (real)0.25 : 0, &cell);
+    // (a point light's zones are widened: CELL_SLACK)
+    int cell, in = face_cell(F, g[0], g[1], B.point ? CELL_SLACK : 0, &cell);
     if (in <= 0) return in < 0 ? -1 : outer;  // not a number; beside the grid's box
     real k = (g[2] - F.lo[2]) * F.inv[2];
     if (k != k) return -1;
@@ -3112,9 +3122,8 @@ bool core_cells(ListBuilder &b, const Box *eff, real margin, LightBuf &B, Array<
         if (box_overlap(eff[i], core) &&
             !(cand.push(b.c, i) && cand.push(b.c, classify_prim(s->prims[i], core.lo, core.hi))))
             return false;
-    // the cells widened by a quarter, and the ball that takes over near the light (lightbuf_build)
-    real eps = (real)2 / CORE_CELLS / 4, r = margin * (real)2.6 / eps;
-    r = r > margin ? r : margin;
+    // the cells widened, and the ball that takes over near the light
+    real eps = (real)2 / CORE_CELLS * CELL_SLACK, r = tip_ball(margin, eps);
     for (int fi = 0; fi < 6; fi++) {
         LightFace &F = B.cf[fi];
         point_face(fi, &F);
@@ -3161,8 +3170,7 @@ inline int core_list(const LightBuf &B, R3 x) {
     if (!(g > 0)) return B.core;
     real k = (real)1 / g;
     int cell;
-    // (widened by a quarter of a cell, as lightbuf_find)
-    if (face_cell(F, dot(m, F.e[0]) * k, dot(m, F.e[1]) * k, (real)0.25, &cell) <= 0) return B.core;
+    if (face_cell(F, dot(m, F.e[0]) * k, dot(m, F.e[1]) * k, CELL_SLACK, &cell) <= 0) return B.core;
     return B.cells[F.base + cell];
 }
 
@@ -3293,7 +3301,7 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
             F.cbase = (int)cells;
             cells += (long)F.n[0] * F.n[1];
         }
-        // (a point light's cells are widened by a quarter; near the light, where that is less
+        // (a point light's cells are widened by CELL_SLACK; near the light, where that is less
         // than the margin, the ball takes over)
         if ((double)total * RAYS_PER_VOXEL > rays) {  // a small image: not worth it
             B.faces = 0;
@@ -3302,9 +3310,8 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
         if (B.point) {
             eps = REAL_BIG;
             for (int fi = 0; fi < 6; fi++)
-                if (B.f[fi].n[2] > 0 && B.f[fi].h[0] / 4 < eps) eps = B.f[fi].h[0] / 4;
-            r = margin * (real)2.6 / eps;
-            r = r > margin ? r : margin;
+                if (B.f[fi].n[2] > 0 && B.f[fi].h[0] * CELL_SLACK < eps) eps = B.f[fi].h[0] * CELL_SLACK;
+            r = tip_ball(margin, eps);
         }
         B.list = (int *)mem_alloc(c, sizeof(int) * (size_t)(total + 1));
         ok = B.list != NULL;
@@ -4341,8 +4348,7 @@ void primary_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, Visit &
     }
     const int *run = NULL, *end = NULL;  // the cell's runs; NULL: the ray misses the box
     if (F->n[2] > 0) {
-        // (the zones' widening, as in lightbuf_find)
-        int cell, in = face_cell(*F, dot(ray.d, F->e[0]) / g2, dot(ray.d, F->e[1]) / g2, (real)0.25, &cell);
+        int cell, in = face_cell(*F, dot(ray.d, F->e[0]) / g2, dot(ray.d, F->e[1]) / g2, CELL_SLACK, &cell);
         if (in > 0) {
             run = B->runs + B->runs[F->cbase + cell];
             end = B->runs + B->runs[F->cbase + cell + 1];
