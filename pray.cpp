@@ -2822,28 +2822,33 @@ struct Zone {
     real d[6];
     R3 c;
     real r;
+    real lo[3], hi[3];  // the hull's box (zone_hull)
 };
+
+// Sets the box of zone z's hull from its vertices.
+void zone_hull(Zone *z) {
+    for (int l = 0; l < 3; l++) {
+        z->lo[l] = REAL_BIG, z->hi[l] = -REAL_BIG;
+        for (int k = 0; k < z->nv; k++) {
+            real x = comp(z->v[k], l);
+            z->lo[l] = x < z->lo[l] ? x : z->lo[l];
+            z->hi[l] = x > z->hi[l] ? x : z->hi[l];
+        }
+    }
+}
 
 // Class of primitive q, which bounds place in box bx, against a zone: conservative, like
 // classify_prim (outside only when it misses the zone, inside only when it holds all of it).
 int classify_zone(const Prim &q, const Box &bx, const Zone &z) {
-    bool out = false;  // beyond one of the polytope's planes or clear of the hull's box
+    bool out = false;  // clear of the hull's box or beyond one of the polytope's planes
+    for (int l = 0; l < 3 && !out; l++) out = z.hi[l] < bx.lo[l] || bx.hi[l] < z.lo[l];
     for (int i = 0; i < z.np && !out; i++) {
         real lo = 0;  // the least n.x over the box
         for (int l = 0; l < 3; l++) {
-            real nl = comp(z.n[i], l);
-            if (nl != 0) lo += nl * (nl > 0 ? bx.lo[l] : bx.hi[l]);
+            real nl = comp(z.n[i], l);  // (no 0 x infinity: a box may be unbounded)
+            lo += nl * (nl > 0 ? bx.lo[l] : nl < 0 ? bx.hi[l] : 0);
         }
         out = lo > z.d[i];
-    }
-    for (int l = 0; l < 3 && !out; l++) {
-        real vlo = REAL_BIG, vhi = -REAL_BIG;
-        for (int k = 0; k < z.nv; k++) {
-            real x = comp(z.v[k], l);
-            vlo = x < vlo ? x : vlo;
-            vhi = x > vhi ? x : vhi;
-        }
-        out = vhi < bx.lo[l] || bx.hi[l] < vlo;
     }
     bool out_ball = z.r == 0 || box_dist2(bx, z.c) > z.r * z.r;
     bool in = true;  // every vertex inside the solid (then all of the polytope, which is convex)
@@ -2981,6 +2986,7 @@ void lightbuf_zone(const LightBuf &B, const LightFace &F, int iu, int iv, int k,
         for (int i = 0; i < 8; i++) z->v[i] = e[0] * u[i & 1] + e[1] * v[i >> 1 & 1] + e[2] * w[i >> 2];
         z->c = r3(0, 0, 0);
         z->r = 0;
+        zone_hull(z);
         return;
     }
     u[0] = F.lo[0] + (real)iu * F.h[0] - eps;
@@ -3002,7 +3008,10 @@ void lightbuf_zone(const LightBuf &B, const LightFace &F, int iu, int iv, int k,
     z->c = B.o;
     z->r = r;
     real near = F.lo[2] + (real)k * F.h[2] - margin;
-    if (!B.pieces || !(near > 0)) return;
+    if (!B.pieces || !(near > 0)) {
+        zone_hull(z);
+        return;
+    }
     z->np = 6;
     z->n[5] = e[2] * (real)-1;
     z->d[5] = -(dot(e[2], B.o) + near);
@@ -3013,6 +3022,7 @@ void lightbuf_zone(const LightBuf &B, const LightFace &F, int iu, int iv, int k,
         z->v[4 + i] = B.o + edge * far;
     }
     z->r = 0;
+    zone_hull(z);
 }
 
 // The depths w between which zone k of face F lies, widened by the margin: its slab's for a
@@ -3383,13 +3393,14 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
             for (int cel = 0; ok && cel < ncell; cel++) {
                 int *col = B.list + F.base + cel, stride = F.n[0] * F.n[1];  // the cell's voxels
                 bool whole = true;  // first the zones that meet few enough primitives: -2
-                for (int k = 0; k < F.n[2]; k++) {
+                int most = B.pieces ? LB_MAX_CAND / 2 : LB_MAX_CAND;
+                for (int k = 0; k < F.n[2] && (whole || !B.pieces); k++) {
                     real w0, w1;
                     zone_depths(B, F, k, margin, &w0, &w1);
-                    int many = 0;
-                    for (int j = start[cel]; !crowded && j < start[cel + 1]; j++)
+                    int many = 0;  // (counted only up to the limit)
+                    for (int j = start[cel]; !crowded && many <= most && j < start[cel + 1]; j++)
                         many += key[2 * cand[j]] <= w1 && key[2 * cand[j] + 1] >= w0;
-                    col[k * stride] = crowded || many > (B.pieces ? LB_MAX_CAND / 2 : LB_MAX_CAND) ? -1 : -2;
+                    col[k * stride] = crowded || many > most ? -1 : -2;
                     whole = whole && col[k * stride] == -2;
                 }
                 if (B.pieces && !whole) {  // a primary ray walks all of its cell's pieces, or the grid
@@ -4099,6 +4110,11 @@ bool ray_box(const Ray &r, const real *inv, const real *lo, const real *hi, real
     return a <= b;
 }
 
+// Point p in the box [lo, hi] (false when not a number).
+inline bool in_box(R3 p, const real *lo, const real *hi) {
+    return p.x >= lo[0] && p.x <= hi[0] && p.y >= lo[1] && p.y <= hi[1] && p.z >= lo[2] && p.z <= hi[2];
+}
+
 // The reciprocals of the direction's components for ray_box: 0 for a ray parallel to that axis
 // (1 / 0 is infinite), or so nearly that 1 / d overflows.
 inline void ray_inverse(const Ray &ray, real *inv) {
@@ -4157,8 +4173,15 @@ bool trace_accel(const Scene *s, Scratch *w, const Ray &ray, const real *inv, re
         }
     }
     if (A->n[0] == 0) return eval_list(s, A, w, ray, A->outer, 0, tstop, tmax, self, visit);
-    real tin, tout;
-    if (!ray_box(ray, inv, A->org, A->top, &tin, &tout) || tout <= 0 || tin >= tstop)
+    real tin = 0, tout = REAL_INF;
+    if (in_box(ray.o, A->org, A->top)) {  // ray_box's exit, and an entry of at most 0
+        for (int l = 0; l < 3; l++) {
+            real f = ((inv[l] > 0 ? A->top[l] : A->org[l]) - comp(ray.o, l)) * inv[l];
+            tout = inv[l] != 0 && f < tout ? f : tout;
+        }
+    } else if (!ray_box(ray, inv, A->org, A->top, &tin, &tout))
+        tout = 0;
+    if (tout <= 0 || tin >= tstop)
         return eval_list(s, A, w, ray, A->outer, 0, tstop, tmax, self, visit);
     real t = tin > 0 ? tin : 0;
     if (t > 0 && eval_list(s, A, w, ray, A->outer, 0, t, tmax, self, visit)) return true;
