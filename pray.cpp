@@ -3096,8 +3096,11 @@ bool eye_runs(pray_ctx *c, LightBuf &B, int cells) {
 const int RAYS_PER_VOXEL = 8;
 
 // A point light's core reaches at most LB_CORE voxels beyond the light's on each side, and holds
-// at most LB_CORE_PRIMS primitives, or as many as the light's voxel.
-const int LB_CORE = 8, LB_CORE_PRIMS = 8;
+// at most LB_CORE_PRIMS primitives, or as many as the light's voxel. (A ray evaluates only its
+// cell's part of the core's list, so the whole list may be longer than a voxel's: in the Room,
+// 12 instead of 8 lets the lamps' cores reach 4 and 3 voxels instead of 2, and saves a tenth of
+// the voxel steps.)
+const int LB_CORE = 8, LB_CORE_PRIMS = 12;
 
 // Face fi of a point light's cube of directions: e[2] along axis fi / 2, away from the light
 // (towards -1 for odd fi), e[0] and e[1] the next two axes.
