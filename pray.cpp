@@ -4118,6 +4118,17 @@ inline bool in_box(R3 p, const real *lo, const real *hi) {
     return p.x >= lo[0] && p.x <= hi[0] && p.y >= lo[1] && p.y <= hi[1] && p.z >= lo[2] && p.z <= hi[2];
 }
 
+// Where a ray that starts in the box [lo, hi] (in_box) leaves it: ray_box's *t1, the same float,
+// without its call; its *t0 is at most 0 then.
+inline real box_exit(const Ray &r, const real *inv, const real *lo, const real *hi) {
+    real b = REAL_INF;
+    for (int l = 0; l < 3; l++) {
+        real f = ((inv[l] > 0 ? hi[l] : lo[l]) - comp(r.o, l)) * inv[l];
+        b = inv[l] != 0 && f < b ? f : b;
+    }
+    return b;
+}
+
 // The reciprocals of the direction's components for ray_box: 0 for a ray parallel to that axis
 // (1 / 0 is infinite), or so nearly that 1 / d overflows.
 inline void ray_inverse(const Ray &ray, real *inv) {
@@ -4176,14 +4187,9 @@ bool trace_accel(const Scene *s, Scratch *w, const Ray &ray, const real *inv, re
         }
     }
     if (A->n[0] == 0) return eval_list(s, A, w, ray, A->outer, 0, tstop, tmax, self, visit);
-    real tin = 0, tout = REAL_INF;
-    if (in_box(ray.o, A->org, A->top)) {  // ray_box's exit, and an entry of at most 0
-        for (int l = 0; l < 3; l++) {
-            real f = ((inv[l] > 0 ? A->top[l] : A->org[l]) - comp(ray.o, l)) * inv[l];
-            tout = inv[l] != 0 && f < tout ? f : tout;
-        }
-    } else if (!ray_box(ray, inv, A->org, A->top, &tin, &tout))
-        tout = 0;
+    real tin = 0, tout;
+    if (in_box(ray.o, A->org, A->top)) tout = box_exit(ray, inv, A->org, A->top);
+    else if (!ray_box(ray, inv, A->org, A->top, &tin, &tout)) tout = 0;
     if (tout <= 0 || tin >= tstop)
         return eval_list(s, A, w, ray, A->outer, 0, tstop, tmax, self, visit);
     real t = tin > 0 ? tin : 0;

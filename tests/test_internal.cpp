@@ -1080,6 +1080,53 @@ TEST_CASE("folding of nothing and one") {
     }
 }
 
+TEST_CASE("box_exit: the same float as ray_box's exit for rays that start in the box, on its faces and corners too") {
+    // The walk takes a ray that starts in the grid's box out of it with box_exit instead of
+    // ray_box; the voxels it steps through end there, so the two must agree bit for bit.
+    int checked = 0, on_face = 0, parallel = 0;
+    for (uint64_t seed = 1; seed <= 4000; seed++) {
+        CAPTURE(seed);
+        TRng g(seed * 104729ull);
+        real lo[3], hi[3];
+        for (int l = 0; l < 3; l++) {
+            lo[l] = (real)g.uni(-50, 50);
+            hi[l] = lo[l] + (real)(g.below(8) == 0 ? 0 : g.uni(1e-3, 80));  // some boxes flat
+        }
+        double o[3], d[3];
+        g.dir(d);
+        bool face = false;
+        for (int l = 0; l < 3; l++) {
+            int k = g.below(6);  // on the low face, the high face, or between
+            o[l] = k == 0 ? (double)lo[l] : k == 1 ? (double)hi[l] : (double)lo[l] + ((double)hi[l] - (double)lo[l]) * g.u01();
+            face = face || k < 2;
+            if (g.below(5) == 0) d[l] = 0;  // along a face
+            else if (g.below(9) == 0) d[l] *= 1e-300;  // so nearly parallel that 1 / d overflows
+        }
+        if (d[0] == 0 && d[1] == 0 && d[2] == 0) d[seed % 3] = 1;
+        Ray r;
+        r.o = r3((real)o[0], (real)o[1], (real)o[2]);
+        r.d = r3((real)d[0], (real)d[1], (real)d[2]);
+        if (!in_box(r.o, lo, hi)) continue;  // (rounded out of a flat box's face)
+        real inv[3], t0 = 0, t1 = 0;
+        ray_inverse(r, inv);
+        REQUIRE(ray_box(r, inv, lo, hi, &t0, &t1));
+        CHECK(t0 <= 0);
+        real e = box_exit(r, inv, lo, hi);
+        CHECK(memcmp(&e, &t1, sizeof e) == 0);
+        checked++;
+        on_face += face;
+        parallel += inv[0] == 0 || inv[1] == 0 || inv[2] == 0;
+    }
+    CHECK(checked > 3500);
+    CHECK(on_face > 1000);
+    CHECK(parallel > 1000);
+    // a point outside, or not a number, is in no box
+    real lo[3] = {0, 0, 0}, hi[3] = {1, 1, 1};
+    CHECK(in_box(r3(1, 1, 1), lo, hi));
+    CHECK_FALSE(in_box(r3(1, 1, (real)1.0001), lo, hi));
+    CHECK_FALSE(in_box(r3(0, (real)NAN, 0), lo, hi));
+}
+
 TEST_CASE("reach: every voxel's cube of its list, exactly as large as it can be (against counting)") {
     // Random grids of boxes of lists: the reach of each voxel is compared with a direct search,
     // the largest r such that every voxel within chessboard distance r (inside the grid) has
