@@ -2268,6 +2268,10 @@ struct LightBuf {
 // are constant in the region, summed up: the thesis' "set inside" / "set outside" actions of
 // one node done at once. Then the "check" actions: the active primitives. List 0 is the empty
 // list of a region where the root is constant, so nothing can be hit there.
+const int LIST_HEAD = 4;  // the numbers before the nodes
+inline const int *list_prims(const int *d) { return d + LIST_HEAD + 3 * d[0]; }
+inline int list_len(const int *d) { return LIST_HEAD + 3 * d[0] + d[1]; }
+
 struct Accel {
     int n[3];          // voxels per axis; all 0 without a grid
     real org[3], h;    // low corner of the grid and side of a voxel
@@ -2491,7 +2495,7 @@ int lb_store(ListBuilder &b) {
         memset(nh.p, 0, sizeof(int) * (size_t)size);
         for (int L = 1; L < a->off.n; L++) {
             const int *d = a->data.p + a->off[L];
-            int len = 4 + 3 * d[0] + d[1];
+            int len = list_len(d);
             unsigned g = 2166136261u;
             for (int i = 0; i < len; i++) g = (g ^ (unsigned)d[i]) * 16777619u;
             unsigned k = g & (unsigned)(size - 1);
@@ -2505,7 +2509,7 @@ int lb_store(ListBuilder &b) {
     for (; b.hash[(int)k]; k = (k + 1) & (unsigned)(b.hash.n - 1)) {
         int L = b.hash[(int)k];
         const int *d = a->data.p + a->off[L];
-        if (4 + 3 * d[0] + d[1] == n && memcmp(d, b.out.p, sizeof(int) * (size_t)n) == 0) return L;
+        if (list_len(d) == n && memcmp(d, b.out.p, sizeof(int) * (size_t)n) == 0) return L;
     }
     if (!a->off.push(b.c, a->data.n) || !a->data.reserve(b.c, a->data.n + n)) return -1;
     memcpy(a->data.p + a->data.n, b.out.p, sizeof(int) * (size_t)n);
@@ -2546,8 +2550,8 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
     if (root_cls != CL_BD) return 0;
     // the active part: boundary nodes reached from the root through boundary nodes
     b.out.n = 0;
-    int h[4] = {0, 0, 0, 0};
-    for (int i = 0; i < 4; i++)
+    int h[LIST_HEAD] = {0, 0, 0, 0};  // na, np, set inside, set outside
+    for (int i = 0; i < LIST_HEAD; i++)
         if (!b.out.push(b.c, 0)) return -1;
     Array<int> &stk = b.touched;  // reused: the touched nodes are done with
     stk.n = 0;
@@ -2590,7 +2594,7 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
     nodes.release(b.c);
     prims_out.release(b.c);
     if (!ok) return -1;
-    for (int i = 0; i < 4; i++) b.out[i] = h[i];
+    for (int i = 0; i < LIST_HEAD; i++) b.out[i] = h[i];
     return lb_store(b);
 }
 
@@ -2619,7 +2623,7 @@ const int PLAN_HEAD = 3;    // a plan's numbers before the primitives'
 
 int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, Array<int> *plan) {
     int na = d[0], np = d[1];
-    const int *nodes = d + 4, *prims = d + 4 + 3 * na;
+    const int *nodes = d + LIST_HEAD, *prims = list_prims(d);
     for (int i = 0; i < na; i++)
         if (s->nodes[nodes[3 * i]].parent >= 0) kids[s->nodes[nodes[3 * i]].parent]++;
     for (int i = 0; i < np; i++)
@@ -2692,7 +2696,7 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
 // Whether every primitive of list d is of one colour and lets all light through: a shadow ray
 // crosses it unchanged, whatever surfaces of it are visible (a lamp's clear bulb).
 bool list_clear(const Scene *s, const int *d) {
-    const int *prims = d + 4 + 3 * d[0];
+    const int *prims = list_prims(d);
     for (int i = 0; i < d[1]; i++) {
         const pray_model *m = s->prims[prims[i]].mat;
         if (m->kind != M_FLAT || m->transmit.r != 1 || m->transmit.g != 1 || m->transmit.b != 1) return false;
@@ -3934,7 +3938,7 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
     if (L == 0 || list_passes(A, L, visit)) return false;
     const int *d = A->data.p + A->off[L];
     int na = d[0], np = d[1];
-    const int *nodes = d + 4, *prims = d + 4 + 3 * na;
+    const int *nodes = d + LIST_HEAD, *prims = list_prims(d);
     w->k.set_in += d[2];
     w->k.set_out += d[3];
     if (list_plain(A, L)) {
