@@ -310,9 +310,9 @@ struct Block {
 
 // Options by index; the table in section 6 has their names, defaults and ranges.
 enum {
-    OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_DEPTH, OPT_EYEBUFFER, OPT_FREEZE,
+    OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_CUTOFF, OPT_DEPTH, OPT_EYEBUFFER, OPT_FREEZE,
     OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_LIGHTBUFFER, OPT_MAXLINE, OPT_MAXMEM, OPT_MAXNEST, OPT_MAXPIXELS, OPT_MAXPRIMS,
-    OPT_MAXSTEPS, OPT_MAXSTRING, OPT_MERGE, OPT_OUTPUT, OPT_SHADOWCACHE, OPT_SHADOWS, OPT_TEXMEM, OPT_THREADS,
+    OPT_MAXRAYS, OPT_MAXSTEPS, OPT_MAXSTRING, OPT_MERGE, OPT_OUTPUT, OPT_SHADOWCACHE, OPT_SHADOWS, OPT_TEXMEM, OPT_THREADS,
     OPT_WIDTH, OPT_COUNT
 };
 
@@ -552,6 +552,14 @@ bool vfinite(pray_vec a) {
     return a.x - a.x == 0 && a.y - a.y == 0 && a.z - a.z == 0;  // false for NaN and infinity
 }
 bool finite_num(double x) { return x - x == 0; }
+// The lengths a texture map's vectors (and a text's axes) may have: their squared lengths stay
+// normal finite numbers in the renderer's precision, which texture coordinates divide by.
+const double MAP_LEN_MIN = sizeof(real) < sizeof(double) ? 1e-18 : 1e-150;
+const double MAP_LEN_MAX = 1 / MAP_LEN_MIN;
+bool map_len_ok(pray_vec a) {
+    double m = vmaxabs(a);
+    return m >= MAP_LEN_MIN && m <= MAP_LEN_MAX;
+}
 // NaN without its sign, so that messages say "nan" on every C library.
 double nan_clean(double x) { return x != x ? fabs(x) : x; }
 
@@ -670,6 +678,9 @@ enum ModelKind { M_FLAT, M_TEX, M_BUMP, M_MOVE, M_SUM, M_SCALE };
 // Texture coordinates of a primitive: none, a plane's, a sphere's.
 enum MapKind { MAP_NONE, MAP_PLANE, MAP_SPHERE };
 const int MAX_MODEL_DEPTH = 256;
+// The parts a model is evaluated through, each use of a shared part counted: what shading one
+// point costs at most (`M = M + M` forty times would otherwise be 2^40 parts).
+const int MAX_MODEL_PARTS = 4096;
 struct Handle {
     int refs;
     int kind;
@@ -696,7 +707,13 @@ struct pray_model {
     struct pray_texture *tex;
     double amount, dx, dy;
     pray_rgb factor;
-    double clear;  // not M_FLAT: the most any component of its transmit weight can be, in magnitude
+    // Not M_FLAT: the most any component of its transmit weight can be, in magnitude; the
+    // parts it is evaluated through (MAX_MODEL_PARTS); the most its texture coordinates are
+    // shifted along any path of moves; no mirror and no transparency anywhere (model_lit_only);
+    // the pyramids of its textures are built (model_pyramids).
+    double clear, parts, shift;
+    int lit_only, pyramids;
+    double most[3];  // not M_FLAT: model_most
 };
 
 // A decoded texture image: RGB floats, rows from the first row of the file.
@@ -947,9 +964,11 @@ pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
     }
     o->map = a->map;
     o->mirrored = a->mirrored ^ (xf_scale_of(f) < 0);
+    bool map_ok = true;
     if (a->map) {  // texture coordinates go with the solid, scale included
         o->mu = xf_dir(f, a->mu);
         o->mv = xf_dir(f, a->mv);
+        map_ok = map_len_ok(o->mu) && map_len_ok(o->mv);
     }
     switch (a->kind) {
     case O_CYLINDER:
@@ -960,7 +979,7 @@ pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
     default: break;
     }
     if (a->kind <= O_CYLINDER &&
-        (!vfinite(o->p) || !vfinite(o->v) || !finite_num(o->r) || (a->kind != O_PLANE && !(o->r > 0)) ||
+        (!map_ok || !vfinite(o->p) || !vfinite(o->v) || !finite_num(o->r) || (a->kind != O_PLANE && !(o->r > 0)) ||
          (a->kind != O_SPHERE && vlen(o->v) == 0))) {
         release_handle(c, o);
         fail(c, PRAY_ERR_ARG, "the transformation takes a primitive out of the range of numbers");
@@ -1017,11 +1036,45 @@ inline double rgb_maxabs(pray_rgb v) {
 // The most any component of the model's transmit weight can be anywhere, in magnitude.
 double model_clear(const pray_model *m) { return m->kind == M_FLAT ? rgb_maxabs(m->transmit) : m->clear; }
 
-// A model node of the given kind over a and b (b may be NULL).
-pray_model *model_node(pray_ctx *c, int kind, pray_model *a, pray_model *b) {
+// The most a model's coefficients can be anywhere, in magnitude, in any channel: MOST_OWN the
+// light of its own (emit + ambient), MOST_LIT what it makes of a light's (diffuse + specular),
+// MOST_PASS what it passes on to the rays it spawns (reflect + transmit). A texture's blend
+// weights lie between 0 and 1, so a blend is at most the larger of its two models.
+enum { MOST_OWN, MOST_LIT, MOST_PASS };
+double model_most(const pray_model *m, int i) {
+    if (m->kind != M_FLAT) return m->most[i];
+    if (i == MOST_OWN) return rgb_maxabs(m->emit) + rgb_maxabs(m->ambient);
+    if (i == MOST_LIT) return rgb_maxabs(m->diffuse) + rgb_maxabs(m->specular);
+    return rgb_maxabs(m->reflect) + rgb_maxabs(m->transmit);
+}
+
+double model_parts(const pray_model *m) { return m->kind == M_FLAT ? 1 : m->parts; }
+double model_shift(const pray_model *m) { return m->kind == M_FLAT ? 0 : m->shift; }
+
+// Whether a model's look at a point follows from the light arriving there and the model's
+// coefficients at the point's texture coordinates: no mirror and no transparency (their rays
+// would see other parts of the scene). Bump maps are fine: they only turn the normal.
+bool model_lit_only(const pray_model *m) {
+    if (m->kind == M_FLAT) return czero(m->reflect) && czero(m->transmit);
+    return m->lit_only != 0;
+}
+
+// A model node of the given kind over a and b (b may be NULL); `shift`: how far an M_MOVE moves.
+pray_model *model_node(pray_ctx *c, int kind, pray_model *a, pray_model *b, double shift = 0) {
     int depth = 1 + (a->depth > (b ? b->depth : 0) ? a->depth : b->depth);
     if (depth > MAX_MODEL_DEPTH) {
         fail(c, PRAY_ERR_LIMIT, "model nested deeper than %d levels", MAX_MODEL_DEPTH);
+        return NULL;
+    }
+    double parts = 1 + model_parts(a) + (b ? model_parts(b) : 0);
+    if (parts > MAX_MODEL_PARTS) {
+        fail(c, PRAY_ERR_LIMIT, "model made of more than %d parts (each use of a shared part counts)", MAX_MODEL_PARTS);
+        return NULL;
+    }
+    double sa = model_shift(a), sb = b ? model_shift(b) : 0;
+    shift += sa > sb ? sa : sb;
+    if (!finite_num(shift)) {
+        fail(c, PRAY_ERR_ARG, "move: the shifts of nested moves add up to more than the range of numbers");
         return NULL;
     }
     pray_model *m = model_new(c);
@@ -1036,7 +1089,25 @@ pray_model *model_node(pray_ctx *c, int kind, pray_model *a, pray_model *b) {
     m->has_index = a->has_index || (b && b->has_index);
     // (a texture's blend weights are at most 1; M_SCALE multiplies by its factor's largest)
     m->clear = model_clear(a) + (b ? model_clear(b) : 0);
+    m->parts = parts;
+    m->shift = shift;
+    m->lit_only = model_lit_only(a) && (!b || model_lit_only(b));
+    for (int i = 0; i < 3; i++) {
+        double ma = model_most(a, i), mb = b ? model_most(b, i) : 0;
+        m->most[i] = kind == M_SUM ? ma + mb : ma > mb ? ma : mb;
+    }
     return m;
+}
+
+// A flat model made by a sum or a scale whose coefficients left the range of numbers: freed,
+// and the error. Returns m when it is good.
+pray_model *flat_checked(pray_ctx *c, pray_model *m, const char *what) {
+    if (!m || (cfinite(m->diffuse) && cfinite(m->specular) && cfinite(m->ambient) && cfinite(m->emit) &&
+               cfinite(m->reflect) && cfinite(m->transmit)))
+        return m;
+    release_handle(c, m);
+    fail(c, PRAY_ERR_ARG, "%s: the coefficients are not finite", what);
+    return NULL;
 }
 
 pray_model *model_sum(pray_ctx *c, pray_model *a, pray_model *b) {
@@ -1053,13 +1124,16 @@ pray_model *model_sum(pray_ctx *c, pray_model *a, pray_model *b) {
     m->exponent = a->has_exponent ? a->exponent : b->exponent;
     m->has_index = a->has_index || b->has_index;
     m->index = a->has_index ? a->index : b->index;
-    return m;
+    return flat_checked(c, m, "model sum");
 }
 
 pray_model *model_times(pray_ctx *c, pray_model *a, pray_rgb f) {
     if (a->kind != M_FLAT) {
         pray_model *m = model_node(c, M_SCALE, a, NULL);
-        if (m) m->factor = f, m->clear *= rgb_maxabs(f);
+        if (!m) return NULL;
+        m->factor = f;
+        m->clear *= rgb_maxabs(f);
+        for (int i = 0; i < 3; i++) m->most[i] *= rgb_maxabs(f);
         return m;
     }
     pray_model *m = model_new(c);
@@ -1072,7 +1146,7 @@ pray_model *model_times(pray_ctx *c, pray_model *a, pray_rgb f) {
     m->emit = cmul(a->emit, f);
     m->reflect = cmul(a->reflect, f);
     m->transmit = cmul(a->transmit, f);
-    return m;
+    return flat_checked(c, m, "model scale");
 }
 
 // =============================================================================================
@@ -1092,6 +1166,7 @@ const OptDef OPTS[OPT_COUNT] = {
     {"bits", 8, 8, 16, 1, 0},
     {"bounds", 1, 0, 1, 1, 0},
     {"brute", 0, 0, 1, 1, 0},
+    {"cutoff", 1, 0, 1, 1, 0},
     {"depth", 5, 1, 64, 1, 16},
     {"eyebuffer", 1, 0, 1, 1, 0},
     {"freeze", 1, 0, 1, 1, 0},
@@ -1104,6 +1179,7 @@ const OptDef OPTS[OPT_COUNT] = {
     {"maxnest", 256, 1, MAX_NESTING, 1, 64},
     {"maxpixels", 1073741824.0, 1, 1e15, 1, 16777216.0},
     {"maxprims", MAX_PRIMITIVES, 1, MAX_PRIMITIVES, 1, 1048576},
+    {"maxrays", 65536, 1, 1e9, 1, 256},
     {"maxsteps", 1e7, 0, 1e15, 1, 1e6},
     {"maxstring", 65536, 1, 16777216, 1, 4096},
     {"merge", 1, 0, 1, 1, 0},
@@ -1286,6 +1362,11 @@ struct Scene {
     R3 keye, kpoint, kcx, kcy;  // the perspective camera scaled by a power of two near 1/size
     int width, height, depth, shadows, antialias;
     pray_rgb bg_top, bg_bottom;
+    // The ray tree's cut-off (ray_most): the most a ray with k levels left can bring back, for
+    // k = 0 .. depth, and the least a ray must be able to add to its sample to be traced (0:
+    // every ray is traced). maxrays: the rays one sample may take.
+    double most[65], cut;
+    long maxrays;
 };
 
 // Does primitive p have the surface of primitive `self` (the one a secondary ray starts on)?
@@ -4928,9 +5009,16 @@ void texture_cache_clear(pray_ctx *c) {
     }
 }
 
+// The place of coordinate u within the repeating image, in [0, 1); 0 for a coordinate that is
+// not a finite number, so that no coordinate whatever reaches beyond the texels.
+inline double tex_wrap(double u) {
+    double f = u - floor(u);
+    return f >= 0 && f < 1 ? f : 0;
+}
+
 // Colour of the texture at (s, t): bilinear between texel centres, the image repeating.
 pray_rgb tex_lookup(const pray_texture *tx, double s, double t) {
-    double x = (s - floor(s)) * tx->w - 0.5, y = (t - floor(t)) * tx->hgt - 0.5;
+    double x = tex_wrap(s) * tx->w - 0.5, y = tex_wrap(t) * tx->hgt - 0.5;
     double fx0 = floor(x), fy0 = floor(y);
     double fx = x - fx0, fy = y - fy0;
     int x0 = (int)fx0, y0 = (int)fy0;
@@ -5154,6 +5242,9 @@ struct Tracer {
     const Scene *s;
     Scratch *w;
     pray_rgb bg;  // background of the current pixel's row
+    long left;    // rays the current sample may still take (Scene::maxrays)
+    double lost;  // the most the rays left out of the current sample could have added
+    int over;     // a sample wanted more: the render fails
 };
 
 // ---- textured surfaces ----
@@ -5297,11 +5388,13 @@ bool model_varies(const pray_model *m, const double *s, const double *t, int n, 
     }
 }
 
-// The textures of the model, with what tex_spread needs.
-bool model_pyramids(pray_ctx *c, const pray_model *m) {
-    if (!m) return true;
+// The textures of the model, with what tex_spread needs; each part visited once.
+bool model_pyramids(pray_ctx *c, pray_model *m) {
+    if (!m || m->kind == M_FLAT || m->pyramids) return true;
     if (m->tex && !tex_pyramid(c, m->tex)) return false;
-    return model_pyramids(c, m->a) && model_pyramids(c, m->b);
+    if (!model_pyramids(c, m->a) || !model_pyramids(c, m->b)) return false;
+    m->pyramids = 1;
+    return true;
 }
 
 pray_rgb transmit_at(const Prim &q, R3 x) {
@@ -5311,15 +5404,6 @@ pray_rgb transmit_at(const Prim &q, R3 x) {
     Shade sh;
     shade_of(q.mat, s, t, &sh);
     return sh.transmit;
-}
-
-// Whether a model's look at a point follows from the light arriving there and the model's
-// coefficients at the point's texture coordinates: no mirror and no transparency (their rays
-// would see other parts of the scene). Bump maps are fine: they only turn the normal.
-bool model_lit_only(const pray_model *m) {
-    if (!m) return true;
-    if (m->kind == M_FLAT) return czero(m->reflect) && czero(m->transmit);
-    return model_lit_only(m->a) && model_lit_only(m->b);
 }
 
 // What a primary ray saw, for undersampling: the primitive (-1: none) and the texture
@@ -5388,11 +5472,28 @@ R3 shading_normal(const Prim &q, R3 x, const Shade &sh, R3 ds, R3 dt, bool outwa
     return n;
 }
 
-// The colour a ray brings back; `seen`, when given, receives what it saw.
-pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *seen = NULL) {
+// Whether a ray spawned by a ray of the given level, which passes on `weight` of what it brings
+// back to the sample, is traced: unless what it could add (Scene::most) fits in what is left of
+// the sample's allowance for rays left out (Scene::cut), which it then takes.
+inline bool worth_tracing(Tracer &tr, int level, double weight) {
+    const Scene *s = tr.s;
+    double most = weight * s->most[s->depth - level - 1];
+    if (!(tr.lost + most < s->cut)) return true;  // (NaN: traced)
+    tr.lost += most;
+    return false;
+}
+
+// The colour a ray brings back; `seen`, when given, receives what it saw; `weight`: how much of
+// it reaches the sample, at most, in any channel.
+pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *seen = NULL, double weight = 1) {
     const Scene *s = tr.s;
     if (seen) seen->hit = -1, seen->lit_only = 0, seen->st[0] = seen->st[1] = 0;
     if (level > s->depth) return cmake(0, 0, 0);
+    if (kind == RAY_PRIMARY) tr.left = s->maxrays, tr.lost = 0;
+    if (--tr.left < 0) {
+        tr.over = 1;
+        return cmake(0, 0, 0);
+    }
     tr.w->k.rays[kind] += 1;
     FirstHit fh;
     fh.found = false;
@@ -5456,20 +5557,22 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
         double eta = h.root_enter ? 1.0 / m->index : m->index;
         real ci = -dot(n, ray.d);
         double k = 1.0 - eta * eta * (1.0 - (double)ci * ci);
+        double wt = weight * rgb_maxabs(m->transmit);
         if (k < 0) {
             refl = cadd(refl, m->transmit);  // total internal reflection
-        } else {
+        } else if (worth_tracing(tr, level, wt)) {
             Ray rr;
             rr.o = x;
             rr.d = unit(ray.d * (real)eta + n * (real)(eta * ci - sqrt(k)));
-            col = cadd(col, cmul(m->transmit, trace(tr, rr, level + 1, h.prim, RAY_REFRACT)));
+            col = cadd(col, cmul(m->transmit, trace(tr, rr, level + 1, h.prim, RAY_REFRACT, NULL, wt)));
         }
     }
-    if (!czero(refl) && level < s->depth) {
+    double wr = weight * rgb_maxabs(refl);
+    if (!czero(refl) && level < s->depth && worth_tracing(tr, level, wr)) {
         Ray rr;
         rr.o = x;
         rr.d = unit(ray.d - n * (2 * dot(n, ray.d)));
-        col = cadd(col, cmul(refl, trace(tr, rr, level + 1, h.prim, RAY_REFLECT)));
+        col = cadd(col, cmul(refl, trace(tr, rr, level + 1, h.prim, RAY_REFLECT, NULL, wr)));
     }
     return col;
 }
@@ -5485,6 +5588,35 @@ Ray camera_ray(const Scene *s, real u, real v) {
         r.d = unit(s->kpoint + s->kcx * u + s->kcy * v - s->keye);
     }
     return r;
+}
+
+// The ray tree's cut-off (option cutoff). A ray with k levels left brings back at most most[k]:
+// the background, or a surface's own light, plus what it makes of every light, plus what it
+// passes on from the rays it spawns, each bounded by the largest coefficients of the scene's
+// models. A sample leaves out rays while the most they could have added together stays below
+// CUT_SHARE of a step of the output (1/255 or 1/65535): each sample, and so each pixel, is
+// within that of the whole ray tree's value, and its output differs by one step at most.
+// Besides, a sample may take maxrays rays at most.
+const double CUT_SHARE = 0.5;
+
+void ray_most(const pray_ctx *c, Scene *s) {
+    double own = 0, lit = 0, pass = 0, lights = 0;
+    for (int i = 0; i < s->prims.n; i++) {
+        const pray_model *m = s->prims[i].mat;
+        double a = model_most(m, MOST_OWN), b = model_most(m, MOST_LIT), p = model_most(m, MOST_PASS);
+        own = a > own ? a : own;
+        lit = b > lit ? b : lit;
+        pass = p > pass ? p : pass;
+    }
+    for (int i = 0; i < s->lights.n; i++) lights += rgb_maxabs(s->lights[i].intensity);
+    double bg = rgb_maxabs(s->bg_top) > rgb_maxabs(s->bg_bottom) ? rgb_maxabs(s->bg_top) : rgb_maxabs(s->bg_bottom);
+    double local = own + lit * lights;
+    for (int k = 0; k <= s->depth; k++) {
+        double v = local + (k ? pass * s->most[k - 1] : 0);
+        s->most[k] = v > bg ? v : bg;
+    }
+    s->cut = opt_int(c, OPT_CUTOFF) ? CUT_SHARE / ((1 << opt_int(c, OPT_BITS)) - 1) : 0;
+    s->maxrays = (long)c->cur.opt.v[OPT_MAXRAYS];
 }
 
 // The scene as the renderer sees it: primitives, nodes, lights, camera and the acceleration
@@ -5536,6 +5668,7 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     s->antialias = opt_int(c, OPT_ANTIALIAS);
     s->bg_top = c->cur.bg_top;
     s->bg_bottom = c->cur.bg_bottom;
+    ray_most(c, s);
     return PRAY_OK;
 }
 
@@ -5565,6 +5698,7 @@ struct Job {
     Mutex mu;
     int next_band, bands, band_rows, rows_done;
     int cancelled;
+    int over;  // a sample wanted more rays than maxrays
     double adaptive;  // undersampling threshold, 0 = off
     int step;         // undersampling: spacing of the coarse lattice, in samples
     int tile;         // undersampling: side of a tile, in samples (a multiple of step)
@@ -5846,6 +5980,7 @@ void worker_main(void *arg) {
         if (band >= job->bands) return;
         render_band(k, band);
         job->mu.lock();
+        if (k.tr.over) job->cancelled = job->over = 1;
         int y0 = band * job->band_rows;
         int rows = y0 + job->band_rows > job->s->height ? job->s->height - y0 : job->band_rows;
         job->rows_done += rows;
@@ -5873,7 +6008,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
     job.tile = job.step * (ADAPT_TILE > job.step ? ADAPT_TILE / job.step : 1);
     job.band_rows = job.adaptive > 0 ? job.tile / s->antialias : 4;
     for (int i = 0; job.adaptive > 0 && i < s->prims.n; i++)  // undersampling looks into textures
-        if (!model_pyramids(c, s->prims[i].mat)) return c->status;
+        if (!model_pyramids(c, (pray_model *)s->prims[i].mat)) return c->status;  // (marks the parts done)
     job.bands = (s->height + job.band_rows - 1) / job.band_rows;
     if (nt > job.bands) nt = job.bands;
     // everything a thread needs is allocated here, before any starts: the context's allocator
@@ -5899,7 +6034,9 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
         job.mu.init();
         run_parallel(nt, worker_main, args, starts);
         job.mu.destroy();
-        if (job.cancelled) st = fail(c, PRAY_ERR_LIMIT, "render cancelled");
+        if (job.over)
+            st = fail(c, PRAY_ERR_LIMIT, "a sample of the image needs more than %ld rays (option maxrays)", s->maxrays);
+        else if (job.cancelled) st = fail(c, PRAY_ERR_LIMIT, "render cancelled");
     }
     for (int i = 0; wbuf && i < made; i++) {
         const Counters &k = worker_at(wbuf, stride, i).w.k;
@@ -6384,6 +6521,10 @@ pray_object *pray_one(pray_ctx *c, pray_model *m) { return m ? obj_new(c, O_ONE,
 namespace {
 bool bad_pair(pray_ctx *c, pray_vec u, pray_vec v, const char *what) {
     if (bad_vec(c, u, what, true) || bad_vec(c, v, what, true)) return true;
+    if (!map_len_ok(u) || !map_len_ok(v)) {
+        fail(c, PRAY_ERR_ARG, "%s: the vectors' lengths must lie between %g and %g", what, MAP_LEN_MIN, MAP_LEN_MAX);
+        return true;
+    }
     if (vlen(vcross(vunit(u), vunit(v))) <= 1e-12) {
         fail(c, PRAY_ERR_ARG, "%s: the two vectors must not be parallel", what);
         return true;
@@ -6467,7 +6608,8 @@ pray_model *pray_move(pray_ctx *c, pray_model *a, double x, double y) {
         fail(c, PRAY_ERR_ARG, "move: the shift is not finite");
         return NULL;
     }
-    pray_model *m = model_node(c, M_MOVE, a, NULL);
+    if (a->kind == M_FLAT) return retain(a), a;  // no texture to move
+    pray_model *m = model_node(c, M_MOVE, a, NULL, fabs(x) > fabs(y) ? fabs(x) : fabs(y));
     if (m) {
         m->dx = x;
         m->dy = y;

@@ -123,7 +123,8 @@ void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
 
 /* ---------------------------------------------------------------------------------------------
    Options: the same names as the PRAY `option` statement: width, height (pixels, default 256),
-   depth (ray depth, 5), antialias (samples per pixel side, 1), adaptive (0), grid (-1 =
+   depth (ray depth, 5), cutoff (1: leave out rays that, all together, could move no sample by
+   half a step of the output; 0: the whole ray tree), antialias (samples per pixel side, 1), adaptive (0), grid (-1 =
    automatic), gridmem (MiB for the grid, 64), freeze, merge, bounds, lightbuffer, eyebuffer,
    shadowcache, shadows (1/0, default 1), brute (1 = the brute-force reference renderer, 0),
    threads (0 = automatic), maxsteps (statements a program may execute, 10000000; 0 = no
@@ -135,8 +136,9 @@ void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
    maxsteps, depth, gridmem, texmem as above; maxline (characters on one line of a program,
    65536), maxnest (nesting of blocks and of expressions, 256, at most 1024), maxstring (bytes
    of a string, literal or built, 65536), maxprims (primitives one object stands for, 16777216),
-   maxpixels (samples of one image: width x height x antialias^2, 1073741824), maxmem (MiB a
-   context may hold, 0 = no cap). maxline and maxnest apply when a program is read, so only the
+   maxpixels (samples of one image: width x height x antialias^2, 1073741824), maxrays (rays one
+   sample may take, primary, reflected and refracted, 65536), maxmem (MiB a context may hold,
+   0 = no cap). maxline and maxnest apply when a program is read, so only the
    host or the command line can change them for that program.
 
    What the host sets here (options, camera, background) is where every program run starts;
@@ -393,12 +395,14 @@ pray_status pray_render_file(const char *program, const char *const *options, in
        maxstring  bytes of one string (literal or built by +)    65536        4096
        maxprims   primitives one object stands for               16777216     1048576
        maxpixels  samples of an image (width*height*antialias^2) 1073741824   16777216
+       maxrays    rays of one sample (eye, reflected, refracted) 65536        256
        depth      ray recursion depth                            5 (at most 64)  16
        gridmem    MiB for the grid's tables                      64           64
        texmem     MiB for the textures of a run                  256          64
        maxmem     MiB the context may hold (0 = no cap)          0            1024
    maxline and maxnest are read when a program is read. Fixed limits besides: images up to
-   65536 pixels a side and 2^28 pixels, CSG trees up to 2000 levels, models up to 256.
+   65536 pixels a side and 2^28 pixels, CSG trees up to 2000 levels, models up to 256 levels
+   and, with textures, 4096 parts (each use of a shared part counted).
    pray_set_memory_limit caps a context's bytes as maxmem does; over a cap, calls fail with
    PRAY_ERR_NOMEM ("out of memory"), never abort, and leave the context usable.
    pray_set_untrusted (--untrusted) turns the last column into ceilings and keeps a program's

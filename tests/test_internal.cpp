@@ -1223,3 +1223,31 @@ TEST_CASE("texture pyramid: the range over texels holds every value a lookup bet
     }
     pray_free(c);
 }
+
+TEST_CASE("texture lookups are total: coordinates that are not finite numbers read texels, never beyond") {
+    pray_ctx *c = pray_new();
+    pray_texture tx;
+    memset(&tx, 0, sizeof tx);
+    tx.w = 3;
+    tx.hgt = 5;
+    std::vector<float> rgb((size_t)tx.w * tx.hgt * 3);
+    for (size_t i = 0; i < rgb.size(); i++) rgb[i] = (float)(0.1 + 0.8 * (double)i / rgb.size());
+    tx.rgb = rgb.data();
+    REQUIRE(tex_pyramid(c, &tx));
+    const double odd[] = {NAN, -NAN, INFINITY, -INFINITY, 1e308, -1e308, 1e300, -1e-20, 1 - 1e-17, 0, 2.5};
+    for (double s : odd)
+        for (double t : odd) {
+            CAPTURE(s);
+            CAPTURE(t);
+            pray_rgb v = tex_lookup(&tx, s, t);
+            double ch[3] = {v.r, v.g, v.b};
+            for (int l = 0; l < 3; l++) CHECK((ch[l] >= 0.1 - 1e-6 && ch[l] <= 0.9 + 1e-6));
+            double ss[4] = {s, s, s, s}, tt[4] = {t, t, t, t};
+            (void)tex_beyond(&tx, ss, tt, 4, 0.5, 0.01);  // the range of a cell: no crash under the sanitizers
+        }
+    // a coordinate that is not a number reads as 0: the same as the lookup at 0
+    pray_rgb a = tex_lookup(&tx, NAN, INFINITY), b = tex_lookup(&tx, 0, 0);
+    CHECK((a.r == b.r && a.g == b.g && a.b == b.b));
+    mem_free(c, tx.mm);
+    pray_free(c);
+}

@@ -156,7 +156,8 @@ TEST_CASE("limit maxpixels: samples of an image, antialias counted") {
 
 TEST_CASE("limit depth: rays between two mirrors stop at the depth, and 64 is the most") {
     // the camera stands between two parallel mirrors, looking at one of them: every primary ray
-    // is reflected depth - 1 times
+    // is reflected depth - 1 times (the whole ray tree: the scene is black, so the cut-off would
+    // leave out every reflection)
     std::string prog = "option \"width\", 1\noption \"height\", 1\nparallel <0.1, 0, 0>, <0, 0, -0.1>, [0, 0, 0], [0, 1, 0]\n"
                        "M = mirror({1})\nA = plane(M, [0, 1, 0], <0, 1, 0>) & plane(M, [0, -1, 0], <0, -1, 0>)\n"
                        "rendertiff -A\n";
@@ -165,6 +166,7 @@ TEST_CASE("limit depth: rays between two mirrors stop at the depth, and 64 is th
         pray_ctx *c = pray_new();
         pray_set_frame(c, [](void *, const pray_image *, const char *) { return PRAY_OK; }, NULL);
         REQUIRE(pray_option(c, "depth", d) == PRAY_OK);
+        REQUIRE(pray_option(c, "cutoff", 0) == PRAY_OK);
         REQUIRE(pray_run_string(c, "m.ray", prog.data(), prog.size()) == PRAY_OK);
         pray_stats st;
         pray_stats_get(c, &st);
@@ -173,6 +175,24 @@ TEST_CASE("limit depth: rays between two mirrors stop at the depth, and 64 is th
         pray_free(c);
     }
     CHECK(testkit::run("option \"depth\", 65\n").error == "test.ray:1:1: error: option 'depth': 65 is out of range");
+}
+
+TEST_CASE("limit maxrays: a sample takes at most maxrays rays; at the value the image is whole") {
+    // the eye inside a mirror ball, depth 8: every sample takes exactly 8 rays (1 primary, 7
+    // reflected), with a lit surface so that every reflection adds to the image
+    std::string prog = "option \"width\", 4\noption \"height\", 4\noption \"depth\", 8\n"
+                       "Ball = -sphere(mirror({0.5}) + phong({0.3}, {0}, 1), [0, 0, 0], 10)\n"
+                       "rendertiff Ball, pointlight({1}, [0, 0, 0])\n";
+    testkit::Result at = testkit::run(prog, {"maxrays=8", "cutoff=0"});
+    REQUIRE(at.error == "");
+    REQUIRE(at.frames.size() == 1);
+    testkit::Result whole = testkit::run(prog, {"cutoff=0"});
+    REQUIRE(whole.frames.size() == 1);
+    CHECK(at.frames[0].pixels == whole.frames[0].pixels);
+    testkit::Result past = testkit::run(prog, {"maxrays=7", "cutoff=0"});
+    CHECK(past.status == PRAY_ERR_LIMIT);
+    CHECK(past.error == "test.ray:5:1: error: a sample of the image needs more than 7 rays (option maxrays)");
+    CHECK(past.frames.empty());
 }
 
 TEST_CASE("limit gridmem: the grid's tables stay within the budget") {
@@ -243,8 +263,8 @@ TEST_CASE("untrusted mode: every limit gets its ceiling; higher values and 'no l
         double ceiling;
     } ceilings[] = {{"depth", 16},         {"gridmem", 64},           {"maxline", 4096},
                     {"maxmem", 1024},      {"maxnest", 64},           {"maxpixels", 16777216},
-                    {"maxprims", 1048576}, {"maxsteps", 1000000},     {"maxstring", 4096},
-                    {"texmem", 64}};
+                    {"maxprims", 1048576}, {"maxrays", 256},          {"maxsteps", 1000000},
+                    {"maxstring", 4096},   {"texmem", 64}};
     pray_ctx *c = pray_new();
     pray_option(c, "maxsteps", 0);
     pray_option(c, "depth", 3);

@@ -240,6 +240,58 @@ TEST_CASE("depth: level 1 is the eye ray, deeper rays contribute nothing") {
     check_exact(f, 0, 0, 0.375, 0.5, 0);
 }
 
+TEST_CASE("cutoff: the rays left out move no sample by half an output step; cutoff 0 traces the whole tree") {
+    // glass balls that reflect and pass light between two mirror walls, under bright lights: a
+    // deep ray tree whose far branches add little
+    std::string prog = "option \"width\", 40\noption \"height\", 30\noption \"depth\", 12\nbackground {0.3, 0.4, 0.9}, {1.5}\n"
+                       "G = transparent({0.7, 0.8, 0.9}, 1.5) + mirror({0.2}) + phong({0.05}, {0.9}, 40)\n"
+                       "W = mirror({0.8, 0.9, 0.7}) + phong({0.1, 0.05, 0}, {0.3}, 10)\n"
+                       "S = sphere(G, [-0.6, 0, 0], 0.5) | sphere(G, [0.6, 0.5, 0.2], 0.45) | (sphere(G, [0, 1.5, -0.3], 0.6) - sphere(G, [0, 1.2, -0.3], 0.3))\n"
+                       "S = S | -plane(W, [0, 3, 0], <0, 1, 0>) | plane(W, [0, -6, 0], <0, 1, 0>) | plane(phong({0.6}, {0.2}, 5), [0, 0, -1], <0, 0, 1>)\n"
+                       "rendertiff S, pointlight({2.5, 2, 2}, [1, -3, 3]) | dirlight({0.8}, <-1, 1, -2>)\n";
+    struct Run {
+        std::vector<float> px;
+        double secondary;
+    };
+    auto render = [&](int cutoff, int bits) {
+        Run r;
+        std::vector<testkit::Frame> frames;
+        pray_ctx *c = pray_new();
+        pray_set_frame(c, testkit::frame_sink, &frames);
+        pray_option(c, "cutoff", cutoff);
+        pray_option(c, "bits", bits);
+        REQUIRE(pray_run_string(c, "cut.ray", prog.data(), prog.size()) == PRAY_OK);
+        pray_stats st;
+        pray_stats_get(c, &st);
+        r.secondary = st.rays_reflected + st.rays_refracted;
+        pray_free(c);
+        REQUIRE(frames.size() == 1);
+        r.px = frames[0].pixels;
+        return r;
+    };
+    Run whole = render(0, 8);
+    CHECK(render(0, 16).px == whole.px);  // without the cut-off the bits change nothing
+    for (int bits : {8, 16}) {
+        CAPTURE(bits);
+        double step = 1.0 / ((1 << bits) - 1);
+        Run cut = render(1, bits);
+        REQUIRE(cut.secondary < whole.secondary);  // (rays were left out: the checks below mean something)
+        double worst = 0;
+        int moved = 0;
+        for (size_t i = 0; i < whole.px.size(); i++) {
+            double d = std::fabs((double)cut.px[i] - whole.px[i]);
+            worst = d > worst ? d : worst;
+            auto q = [&](float v) { return v <= 0 ? 0L : v >= 1 ? (long)((1 << bits) - 1) : (long)((double)v * ((1 << bits) - 1) + 0.5); };
+            long dq = q(cut.px[i]) - q(whole.px[i]);
+            CHECK(std::labs(dq) <= 1);
+            moved += dq != 0;
+        }
+        CHECK(worst < 0.5 * step * (1 + 1e-6));  // (float pixels: a relative hair of rounding)
+        MESSAGE("bits " << bits << ": secondary rays " << cut.secondary << " of " << whole.secondary << ", largest change "
+                        << worst / step << " step, " << moved << " of " << whole.px.size() << " channels moved by one step");
+    }
+}
+
 TEST_CASE("transparent with index 1: the object behind, times T at each surface") {
     std::string Behind = "sphere(color({0.25, 0.5, 1}), [0, 5, 0], 1)";
     Frame f = frame_of(std::string(ONE) + "background {0.9}\nrendertiff sphere(transparent({0.5, 0.25, 1}, 1), [0, 0, 0], 1) | " +

@@ -1307,6 +1307,92 @@ TEST_CASE("textures: move shifts the texture coordinates") {
     pray_release(c, t);
 }
 
+TEST_CASE("textures: coordinates out of the range of numbers are refused where they are made, and never index memory") {
+    Ctx c;
+    Img tex = distinct4();
+    pray_texture *t = texture_of(c, tex, 8);
+    pray_model *m = flat_textured(c, t);
+    // shifts that are each fine but add up beyond the range of numbers
+    pray_model *m1 = pray_move(c, m, 1e308, 0);
+    REQUIRE(m1 != nullptr);
+    CHECK(pray_move(c, m1, 1e308, 0) == nullptr);
+    CHECK(std::string(pray_error(c)) == "error: move: the shifts of nested moves add up to more than the range of numbers");
+    pray_model *sum = pray_model_add(c, m1, m1);  // a sum keeps the larger shift of its parts
+    REQUIRE(sum != nullptr);
+    CHECK(pray_move(c, sum, 0, -1e308) == nullptr);
+    // a map whose vector's squared length would underflow
+    CHECK(pray_planemap(c, m, V3(0, 0, 0), V3(0, 0, 1), V3(1e-170, 0, 0), V3(0, 1, 0)) == nullptr);
+    CHECK(std::string(pray_error(c)).find("planemap: the vectors' lengths must lie between") != std::string::npos);
+    // a shift of 1e308 is still a texture: s is 1e308 wherever the plane is met, a whole number
+    // as 2^60 + x is, so each row shows one colour, that of a shift by 2^60
+    Cam cam = top_view(16, 2);
+    pray_model *m2 = pray_move(c, m, std::ldexp(1.0, 60), 0);
+    pray_object *o = pray_planemap(c, m1, V3(0, 0, 0), V3(0, 0, 1), V3(1, 0, 0), V3(0, 1, 0));
+    pray_object *o2 = pray_planemap(c, m2, V3(0, 0, 0), V3(0, 0, 1), V3(1, 0, 0), V3(0, 1, 0));
+    Img img = render(c, cam, o), img2 = render(c, cam, o2);
+    CHECK(img.px == img2.px);
+    for (int j = 0; j < 16; j++)
+        for (int i = 1; i < 16; i++)
+            for (int ch = 0; ch < 3; ch++) CHECK(img.at(i, j, ch) == img.at(0, j, ch));
+    pray_release(c, o);
+    pray_release(c, o2);
+    pray_release(c, m2);
+    pray_release(c, sum);
+    pray_release(c, m1);
+    pray_release(c, m);
+    pray_release(c, t);
+}
+
+TEST_CASE("models: shared parts cost what they are, or are refused; shading is bounded by the parts") {
+    Ctx c;
+    Img tex = distinct4();
+    pray_texture *t = texture_of(c, tex, 8);
+    // a model without texture stays one set of coefficients however it is combined: `M = M + M`
+    // forty times, with a move that moves nothing
+    pray_model *flat = pray_color(c, RGB(0.5, 0.5, 0.5));
+    pray_model *m = pray_move(c, flat, 0, 0);
+    for (int i = 0; i < 40; i++) {
+        pray_model *d = pray_model_add(c, m, m);
+        REQUIRE(d != nullptr);
+        pray_release(c, m);
+        m = d;
+    }
+    pray_object *o = pray_planemap(c, m, V3(0, 0, 0), V3(0, 0, 1), V3(1, 0, 0), V3(0, 1, 0));
+    Img img = render(c, top_view(4, 2), o);
+    CHECK(img.at(1, 1, 0) == (float)std::ldexp(0.5, 40));
+    pray_release(c, o);
+    pray_release(c, m);
+    pray_release(c, flat);
+    // a textured model doubled: 3 parts, then 7, 15, ... 4095 after ten doublings: it shades as
+    // the model scaled by 1024; one more part is allowed, two are refused
+    pray_model *T = flat_textured(c, t);
+    m = T;
+    for (int i = 0; i < 10; i++) {
+        pray_model *d = pray_model_add(c, m, m);
+        REQUIRE(d != nullptr);
+        if (m != T) pray_release(c, m);
+        m = d;
+    }
+    pray_model *s = pray_model_scale(c, T, RGB(1024, 1024, 1024));
+    pray_object *a = pray_planemap(c, m, V3(0, 0, 0), V3(0, 0, 1), V3(1, 0, 0), V3(0, 1, 0));
+    pray_object *b = pray_planemap(c, s, V3(0, 0, 0), V3(0, 0, 1), V3(1, 0, 0), V3(0, 1, 0));
+    Img ia = render(c, top_view(16, 2), a), ib = render(c, top_view(16, 2), b);
+    CHECK(ia.px == ib.px);
+    CHECK(ia.at(0, 0, 0) == 1024 * tex.at(0, 0, 0));
+    pray_model *b1 = pray_tiffbump(c, m, 0, t);
+    REQUIRE(b1 != nullptr);
+    CHECK(pray_tiffbump(c, b1, 0, t) == nullptr);
+    CHECK(pray_last_status(c) == PRAY_ERR_LIMIT);
+    CHECK(std::string(pray_error(c)) == "error: model made of more than 4096 parts (each use of a shared part counts)");
+    pray_release(c, b1);
+    pray_release(c, a);
+    pray_release(c, b);
+    pray_release(c, m);
+    pray_release(c, s);
+    pray_release(c, T);
+    pray_release(c, t);
+}
+
 TEST_CASE("textures: a transformed planemap carries its texture along") {
     Ctx c;
     pray_texture *t = texture_of(c, ramp());
