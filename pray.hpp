@@ -382,7 +382,8 @@ pray_status pray_render_file(const char *program, const char *const *options, in
    Statements: NAME = expr, delete, print, if/then/else/endif, while/endwhile, quit, background,
    perspective, parallel, option, rendertiff. Operators from the highest priority: unary + -
    (on objects: complement), . (scale, translate, rotate), ^, * / %, + -, comparisons
-   = == # < > <= >=, &, | \ (objects: union and difference; numbers: bitwise).
+   = == # < > <= >=, &, | \ (objects: union and difference; numbers: bitwise). A result that
+   is not a finite number (overflow) is an error at its operator or function.
 
    8. Limits
    Every limit of a run is an option with a default (the command line sets it with -D):

@@ -528,6 +528,57 @@ TEST_CASE("objects: a chain built in a loop is one node and fast") {
     CHECK(r.frames.size() == 1);
 }
 
+TEST_CASE("long chains of every operator run with a flat stack") {
+    // A chain is built and evaluated in a loop: before, 12000 terms overflowed the stack.
+    auto chain = [](const std::string &head, const std::string &term, int n) {
+        std::string p = "M = color({1})\nS = sphere(M, [0, 0, 0], 1)\nX = " + head;
+        p.reserve(p.size() + term.size() * (size_t)n + 16);
+        for (int i = 0; i < n; i++) p += term;
+        return p + "\nprint X\n";
+    };
+    const std::vector<std::string> wide = {"maxline=1000000000"};
+    auto prints = [&](const std::string &prog, const std::string &expected) {
+        testkit::Result r = testkit::run(prog, wide);
+        INFO(prog.substr(0, 120));
+        CHECK(problem(r) == "");
+        CHECK(r.printed == expected);
+    };
+    // a million terms: time and memory grow with the length only
+    auto t0 = std::chrono::steady_clock::now();
+    prints(chain("1", "+1", 1000000), "1e+06\n");
+    CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < 20.0);
+    const int n = 100000;
+    prints(chain("1", "-1", n), "-99999\n");
+    for (const char *t : {"*1", "/1", "%2", "=1", "==1", "#0", "<2", ">0", "<=1", ">=1", "&1", "|0", "\\0"})
+        prints(chain("1", t, n), "1\n");
+    prints(chain("<1, 2, 3>", ".<0, 0, 0>", n), "<1, 2, 3>\n");
+    prints(chain("<1, 2, 3>", " . 1", n), "<1, 2, 3>\n");
+    prints(chain("[1, 2, 3]", "+<0, 0, 0>", n), "[1, 2, 3]\n");
+    prints(chain("{0.5}", "*{1}", n), "{0.5, 0.5, 0.5}\n");
+    prints(chain("\"a\"", "+\"\"", n), "a\n");
+    for (const char *t : {"|S", "+S", "\\S", "-S", "%S"}) prints(chain("S", t, n), "object (100001 primitives)\n");
+    for (const char *t : {"&S", "*S"}) prints(chain("S", t, n), "object (100001 primitives)\n");
+    // mixed levels nest one chain in another, not one level per operator
+    prints(chain("0", "+2*3-6", n), "0\n");
+    // continued over lines of 1000 terms
+    std::string cont = "X = 0";
+    for (int line = 0; line < 100; line++) {
+        cont += " \\\n";
+        for (int i = 0; i < 1000; i++) cont += "+1";
+    }
+    prints(cont + "\nprint X\n", "100000\n");
+    // an error at the end of a long chain names its operator
+    std::string bad = "X = 1";
+    for (int i = 0; i < n; i++) bad += "+1";
+    Failure f = run_fail(bad + "+nothing+1\n", wide);
+    CHECK(f.where() + " " + f.msg == where_is(1, 6 + 2 * n) + " cannot apply '+' to number and object");
+    // '^' groups from the right and unary minus nests: both count as levels of maxnest
+    std::string pow = "X = 1", neg = "X = ";
+    for (int i = 0; i < 300; i++) pow += "^1", neg += "-";
+    CHECK_ERROR(pow + "\n", 1, 518, "expression nested deeper than 256 levels (option maxnest)");
+    CHECK_ERROR(neg + "1\n", 1, 261, "expression nested deeper than 256 levels (option maxnest)");
+}
+
 TEST_CASE("lights: '|' and '+' count sources; none has none") {
     const std::string s = "L = dirlight({1}, <1,1,1>)\nP = pointlight({1}, [0,0,1])\n";
     CHECK_PRINTS(s + "print L, P, none\n", "light (1 source) light (1 source) light (0 sources)\n");
@@ -587,6 +638,48 @@ TEST_CASE("runtime errors: arithmetic") {
     CHECK(f.printed == "1\n");
     CHECK(f.line == 2);
     CHECK(f.col == 9);
+}
+
+TEST_CASE("runtime errors: a result that is not finite, at the operator or call that made it") {
+    CHECK_ERROR("x = 1 + 1e308 * 10 + 1\n", 1, 15, "1e+308 * 10 is not a finite number");
+    CHECK_ERROR("x = 1e308 + 1e308\n", 1, 11, "1e+308 + 1e+308 is not a finite number");
+    CHECK_ERROR("x = -1e308 - 1e308\n", 1, 12, "-1e+308 - 1e+308 is not a finite number");
+    CHECK_ERROR("x = 1e300 / 1e-10\n", 1, 11, "1e+300 / 1e-10 is not a finite number");
+    CHECK_ERROR("x = 10 ^ 400\n", 1, 8, "10 ^ 400 is not a finite number");
+    CHECK_ERROR("x = 2 ^ 2 ^ 2 ^ 2 ^ 2\n", 1, 7, "2 ^ 65536 is not a finite number");
+    CHECK_ERROR("x = exp(1000)\n", 1, 5, "exp(1000) is not a finite number");
+    CHECK_ERROR("x = tan(1.5) * 1e308\n", 1, 14, "14.1014 * 1e+308 is not a finite number");
+    CHECK_ERROR("x = abs(<1.7e308, 1.7e308, 0>)\n", 1, 5, "abs(<1.7e+308, 1.7e+308, 0>) is not a finite number");
+    CHECK_ERROR("x = <1e308, 0, 0> + <1e308, 0, 0>\n", 1, 19, "<1e+308, 0, 0> + <1e+308, 0, 0> is not a finite vector");
+    CHECK_ERROR("x = <1e308, 0, 0> - <-1e308, 0, 0>\n", 1, 19, "<1e+308, 0, 0> - <-1e+308, 0, 0> is not a finite vector");
+    CHECK_ERROR("x = <1e200, 0, 0> * <1e200, 0, 0>\n", 1, 19, "<1e+200, 0, 0> * <1e+200, 0, 0> is not a finite number");
+    CHECK_ERROR("x = <1e200, 0, 0> % <0, 1e200, 0>\n", 1, 19, "<1e+200, 0, 0> % <0, 1e+200, 0> is not a finite vector");
+    CHECK_ERROR("x = <0, 1e300, 0> * 1e10\n", 1, 19, "<0, 1e+300, 0> * 1e+10 is not a finite vector");
+    CHECK_ERROR("x = 1e10 * <0, 1e300, 0>\n", 1, 10, "1e+10 * <0, 1e+300, 0> is not a finite vector");
+    CHECK_ERROR("x = <1, 1e308, 1> / 0.5\n", 1, 19, "<1, 1e+308, 1> / 0.5 is not a finite vector");
+    CHECK_ERROR("x = [0, 1e308, 0] + <0, 1e308, 0>\n", 1, 19, "[0, 1e+308, 0] + <0, 1e+308, 0> is not a finite point");
+    CHECK_ERROR("x = [1e300, 0, 0] . 1e300\n", 1, 19, "[1e+300, 0, 0] . 1e+300 is not a finite point");
+    CHECK_ERROR("x = <1e300, 0, 0> . 1e300\n", 1, 19, "<1e+300, 0, 0> . 1e+300 is not a finite vector");
+    CHECK_ERROR("x = {1e308} + {1e308}\n", 1, 13, "{1e+308, 1e+308, 1e+308} + {1e+308, 1e+308, 1e+308} is not a finite intensity");
+    CHECK_ERROR("x = {1e308} * 10\n", 1, 13, "{1e+308, 1e+308, 1e+308} * 10 is not a finite intensity");
+    CHECK_ERROR("x = {-1e308} - {1e308}\n", 1, 14, "{-1e+308, -1e+308, -1e+308} - {1e+308, 1e+308, 1e+308} is not a finite intensity");
+    // so NaN never comes to be: inf - inf stops at the inf
+    CHECK_ERROR("Inf = 1e308 * 10\nif Inf - Inf\n  print 1\nendif\n", 1, 13, "1e+308 * 10 is not a finite number");
+    // models, lights and objects made from finite values by an operator
+    CHECK_ERROR("M = color({10}) * 1e308\n", 1, 17, "model scale: intensity is not finite");
+    CHECK_ERROR("M = 1e308 * color({10})\n", 1, 11, "model scale: intensity is not finite");
+    CHECK_ERROR("M = color({1e308}) + color({1e308})\n", 1, 20, "model sum: intensity is not finite");
+    CHECK_ERROR("L = pointlight({1}, [1e300, 0, 0]) . 1e300\n", 1, 36,
+                "the transformation takes a light out of the range of numbers");
+    CHECK_ERROR("L = dirlight({1}, <1, 0, 0>) . 1e-300 . 1e-300\n", 1, 39,
+                "the transformation takes a light out of the range of numbers");
+    CHECK_ERROR("M = color({1})\nS = sphere(M, [1e300, 0, 0], 1) . 1e300\n", 2, 33,
+                "the transformation takes a primitive out of the range of numbers");
+    // results up to the largest number stay as they are
+    CHECK_PRINTS("print 1e308 + 7e307, -1e308 * 1.7, 1e-300 * 1e-300, 1e308 % 3 < 3, 2 ^ 1023 * 1.99\n",
+                 "1.7e+308 -1.7e+308 0 1 1.7887e+308\n");
+    CHECK_PRINTS("print <1e308, 0, 0> + <7e307, 0, 0>, abs(<1e308, 1e308, 0>), -<1.7e308, 0, 0>\n",
+                 "<1.7e+308, 0, 0> 1.41421e+308 <-1.7e+308, 0, 0>\n");
 }
 
 TEST_CASE("runtime errors: undefined variables suggest a defined name") {
