@@ -1196,8 +1196,8 @@ pray_status opt_unknown(pray_ctx *c, const char *name) {
     Suggest s;
     s.init(name);
     for (int i = 0; i < OPT_COUNT; i++) s.offer(OPTS[i].name);
-    if (s.best) return fail(c, PRAY_ERR_ARG, "unknown option '%s'; did you mean '%s'?", name, s.best);
-    return fail(c, PRAY_ERR_ARG, "unknown option '%s'", name);
+    if (s.best) return fail(c, PRAY_ERR_ARG, "unknown option '%s'; did you mean '%s'?", *Shown(name), s.best);
+    return fail(c, PRAY_ERR_ARG, "unknown option '%s'", *Shown(name));
 }
 
 } // namespace
@@ -6263,7 +6263,7 @@ pray_status pray_option_fix(pray_ctx *c, const char *name, const char *text) {
         char *end = NULL;
         double v = text ? strtod(text, &end) : 0;
         if (!text || end == text || *end)
-            return fail(c, PRAY_ERR_ARG, "option '%s': '%s' is not a number", name, text ? text : "");
+            return fail(c, PRAY_ERR_ARG, "option '%s': '%s' is not a number", name, text ? *Shown(text) : "");
         st = pray_option(c, name, v);
     }
     if (st == PRAY_OK) c->fixed |= 1u << i;
@@ -6549,6 +6549,12 @@ pray_object *pray_text(pray_ctx *c, pray_model *m, const char *text, pray_vec P,
         if (code < 32 || code > 126) code = '?';
         if (code == ' ' && !font) continue;
         pray_vec origin = vadd(P, vmul(X, k * spacing));
+        if (!vfinite(origin)) {  // finite arguments, but too far: say which one, not "plane"
+            fail(c, PRAY_ERR_ARG, "text: X times the spacing %g takes character %d out of the range of numbers", spacing,
+                 k + 1);
+            release_handle(c, all);
+            return NULL;
+        }
         memset(used, 0, sizeof used);
         for (int r = 0; all && r < ch; r++)
             for (int col = 0; all && col < cw; col++) {
@@ -6567,10 +6573,18 @@ pray_object *pray_text(pray_ctx *c, pray_model *m, const char *text, pray_vec P,
                 double x0 = (double)col / cw, x1 = (double)(c1 + 1) / cw;
                 double y0 = (double)(ref - 1 - r1) / ref, y1 = (double)(ref - r) / ref;
                 pray_vec a = vadd(origin, vadd(vmul(X, x0), vmul(Y, y0)));
-                pray_vec b = vadd(origin, vadd(vmul(X, x1), vmul(Y, y1)));
+                pray_vec b = vadd(origin, vadd(vmul(X, x1), vmul(Y, y1))), top = vadd(a, vmul(n, h));
+                if (!vfinite(a) || !vfinite(b) || !vfinite(top)) {
+                    char what[64];
+                    if (vfinite(a) && vfinite(b)) snprintf(what, sizeof what, "the thickness %g takes", h);
+                    else snprintf(what, sizeof what, "X and Y take");
+                    fail(c, PRAY_ERR_ARG, "text: %s character %d out of the range of numbers", what, k + 1);
+                    release_handle(c, all);
+                    return NULL;
+                }
                 pray_object *box = glyph_face(c, m, a, left);
                 pray_object *parts[5] = {glyph_face(c, m, b, nx), glyph_face(c, m, a, down), glyph_face(c, m, b, ny),
-                                         glyph_face(c, m, a, back), glyph_face(c, m, vadd(a, vmul(n, h)), front)};
+                                         glyph_face(c, m, a, back), glyph_face(c, m, top, front)};
                 for (int i = 0; i < 5; i++) {
                     pray_object *x = pray_csg(c, PRAY_INTERSECTION, box, parts[i]);
                     release_handle(c, box);
@@ -7789,6 +7803,18 @@ Stmt *parse_statement(Parser &P) {
         s = new_stmt(P, words[i].kind, t);
         if (!s) return NULL;
         P.pos++;
+        // 'delete' takes names: a function's or a constant's name is not read as a value
+        for (int k = P.pos, depth = 0; s->kind == ST_DELETE && P.t[k].kind != T_NL; k++) {
+            const Tok &a = P.t[k];
+            if (a.kind == T_OP && strchr("([{", a.op)) depth++;
+            if (a.kind == T_OP && strchr(")]}", a.op)) depth--;
+            bool first = k == P.pos || (depth == 0 && is_op(P.t[k - 1], ','));
+            if (first && a.kind == T_NAME && is_reserved(a.s)) {
+                syn(P, a, "'%s' is %s, not a variable: only variables can be deleted", a.s,
+                    builtin_find(a.s) ? "a function" : "a reserved word");
+                return NULL;
+            }
+        }
         if (!stmt_args(P, s, t, words[i].lo, words[i].hi)) return NULL;
         if (s->kind == ST_DELETE)
             for (int k = 0; k < s->nargs; k++)
@@ -8999,14 +9025,13 @@ pray_status pray_render_file(const char *program, const char *const *options, in
     pray_status st = PRAY_OK;
     for (int i = 0; i < noptions && st == PRAY_OK; i++) {
         const char *eq = options[i] ? strchr(options[i], '=') : NULL;
-        if (!eq || eq == options[i] || eq - options[i] > 63) {
-            st = fail(c, PRAY_ERR_ARG, "option '%s' is not of the form name=value", options[i] ? options[i] : "");
+        if (!eq || eq == options[i]) {
+            st = fail(c, PRAY_ERR_ARG, "option '%s' is not of the form name=value", options[i] ? *Shown(options[i]) : "");
             break;
         }
-        char name[64];
-        memcpy(name, options[i], (size_t)(eq - options[i]));
-        name[eq - options[i]] = 0;
-        st = pray_option_fix(c, name, eq + 1);
+        char *name = mem_strdup(c, options[i], (size_t)(eq - options[i]));
+        st = name ? pray_option_fix(c, name, eq + 1) : c->status;
+        mem_free(c, name);
     }
     if (st == PRAY_OK) st = pray_run_file(c, program);
     if (message && message_size) snprintf(message, message_size, "%s", c->msg);
@@ -9162,14 +9187,20 @@ int main(int argc, char **argv) {
                 if (st == PRAY_OK) st = pray_option_fix(c, "height", h);
             } else {
                 const char *eq = strchr(next, '=');
-                if (!eq || eq == next || eq - next > 63) {
+                if (!eq || eq == next) {
                     rc = usage_error("-D takes name=value, not '%s'", next);
                     break;
                 }
-                char name[64];
+                char *name = (char *)malloc((size_t)(eq - next) + 1);
+                if (!name) {
+                    fprintf(stderr, "pray: error: out of memory\n");
+                    rc = 1;
+                    break;
+                }
                 memcpy(name, next, (size_t)(eq - next));
                 name[eq - next] = 0;
                 st = pray_option_fix(c, name, eq + 1);
+                free(name);
             }
         } else if (a[0] == '-' && a[1] != 0) {
             rc = usage_error("unknown option '%s'", a);

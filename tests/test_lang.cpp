@@ -682,6 +682,32 @@ TEST_CASE("runtime errors: a result that is not finite, at the operator or call 
                  "<1.7e+308, 0, 0> 1.41421e+308 <-1.7e+308, 0, 0>\n");
 }
 
+TEST_CASE("runtime errors: derived values name the function and its argument") {
+    const std::string m = "M = color({1})\n";
+    CHECK_ERROR(m + "T = text(M, \"abc\", [0, 0, 0], <1, 0, 0>, <0, 0, 1>, 0.1, \"\", 1e308)\n", 2, 5,
+                "text: X times the spacing 1e+308 takes character 3 out of the range of numbers");
+    CHECK_ERROR(m + "T = text(M, \"a b\", [0, 0, 0], <1e308, 0, 0>, <0, 0, 1>, 0.1, \"\", 1)\n", 2, 5,
+                "text: X times the spacing 1 takes character 3 out of the range of numbers");
+    CHECK_ERROR(m + "T = text(M, \"ab\", [0, 0, 0], <1e308, 0, 0>, <0, 0, 1e308>, 0.1, \"\", 1)\n", 2, 5,
+                "text: X and Y take character 2 out of the range of numbers");
+    CHECK_ERROR(m + "T = text(M, \"ab\", [0, -1e308, 0], <1, 0, 0>, <0, 0, 1>, 1e308, \"\", 1)\n", 2, 5,
+                "text: the thickness 1e+308 takes character 1 out of the range of numbers");
+    // far, but in range
+    CHECK_PRINTS(m + "T = text(M, \"ab\", [0, 0, 0], <1, 0, 0>, <0, 0, 1>, 0.1, \"\", 1e308)\nprint T\n",
+                 "object (54 primitives)\n");
+    // delete takes names, and a function or a constant is not one
+    CHECK_ERROR("delete sphere\n", 1, 8, "'sphere' is a function, not a variable: only variables can be deleted");
+    CHECK_ERROR("x = 1\ndelete x, pi\n", 2, 11, "'pi' is a reserved word, not a variable: only variables can be deleted");
+    CHECK_ERROR("x = 1\ndelete x, cos(1)\n", 2, 11, "'cos' is a function, not a variable: only variables can be deleted");
+    CHECK_ERROR("x = 1\ndelete x + sin\n", 2, 12, "'sin' is a function: write it with its arguments in parentheses");
+    // an option name of any length is looked up, not cut
+    char msg[300];
+    std::string name(300, 'a'), opt = name + "=1";
+    const char *opts[] = {opt.c_str()};
+    CHECK(pray_render_file("examples/csg.ray", opts, 1, msg, sizeof msg) == PRAY_ERR_ARG);
+    CHECK(std::string(msg) == "error: unknown option '" + name.substr(0, 60) + "...'");
+}
+
 TEST_CASE("runtime errors: undefined variables suggest a defined name") {
     CHECK_ERROR("Centre = [0,0,0]\nR = 1\nx = Center\n", 3, 5, "undefined variable 'Center'; did you mean 'Centre'?");
     CHECK_ERROR("Centre = [0,0,0]\nprint 1, Center\n", 2, 10, "undefined variable 'Center'; did you mean 'Centre'?");
