@@ -498,6 +498,7 @@ struct Text {
     Array<char> a;
     void init() { a.init(); }
     bool add(pray_ctx *c, const char *s, size_t n) {
+        if (n >= (size_t)(INT_MAX - a.n)) return fail_nomem(c), false;  // over 2 GiB
         if (!a.reserve(c, a.n + (int)n + 1)) return false;
         memcpy(a.p + a.n, s, n);
         a.n += (int)n;
@@ -8976,21 +8977,42 @@ pray_status pray_run_string(pray_ctx *c, const char *name, const char *text, siz
 #endif
 }
 
+#if PRAY_HAS_STDIO
+namespace {
+// Read a program into t, on the context's allocator: its memory cap holds as for everything else.
+// Reading stops at a line longer than option maxline + 1 characters (counted as the lexer counts
+// them, a byte order mark included): the lexer then reports that line as it would in the whole
+// file, and an input that never ends (/dev/zero, a pipe) ends there.
+bool read_program(pray_ctx *c, FILE *f, Text *t) {
+    double lim = c->cur.opt.v[OPT_MAXLINE] + 1, col = 0;
+    char buf[8192];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0) {
+        if (!t->add(c, buf, n)) return false;
+        for (size_t i = 0; i < n; i++) {
+            if (buf[i] == '\n') col = 0;
+            else if ((buf[i] & 0xC0) != 0x80 && ++col > lim) return true;
+        }
+    }
+    return true;
+}
+} // namespace
+#endif
+
+// A path of "-" reads standard input, named stdin.ray in messages.
 pray_status pray_run_file(pray_ctx *c, const char *path) {
     if (!c) return PRAY_ERR_ARG;
     if (!path) return fail(c, PRAY_ERR_ARG, "no program file");
 #if PRAY_HAS_STDIO
+    bool in = strcmp(path, "-") == 0;
     errno = 0;
-    FILE *f = fopen(path, "rb");
+    FILE *f = in ? stdin : fopen(path, "rb");
     if (!f) return fail(c, PRAY_ERR_IO, "cannot open '%s': %s", path, strerror(errno ? errno : ENOENT));
     Text t;
     t.init();
-    char buf[8192];
-    size_t n;
-    bool ok = true;
-    while (ok && (n = fread(buf, 1, sizeof buf, f)) > 0) ok = t.add(c, buf, n);
+    bool ok = read_program(c, f, &t);
     bool bad = ferror(f) != 0;
-    fclose(f);
+    if (!in) fclose(f);
     pray_status st;
     if (!ok) st = c->status;
     else if (bad) st = fail(c, PRAY_ERR_IO, "cannot read '%s'", path);
@@ -9003,7 +9025,7 @@ pray_status pray_run_file(pray_ctx *c, const char *path) {
         if (dl >= sizeof c->run_dir) dl = 0;
         memcpy(c->run_dir, path, dl);
         c->run_dir[dl] = 0;
-        st = pray_run_string(c, path, t.str(), (size_t)t.a.n);
+        st = pray_run_string(c, in ? "stdin.ray" : path, t.str(), (size_t)t.a.n);
         c->run_dir[0] = 0;
     }
     t.a.release(c);
@@ -9112,32 +9134,6 @@ void print_stats(pray_ctx *c) {
             s.time_parse, s.time_prepare, s.time_render, s.threads, s.threads == 1 ? "" : "s");
 }
 
-int run_stdin(pray_ctx *c) {
-    size_t cap = 65536, n = 0;
-    char *buf = (char *)malloc(cap);
-    size_t got;
-    while (buf && (got = fread(buf + n, 1, cap - n, stdin)) > 0) {
-        n += got;
-        if (n == cap) {
-            char *nb = (char *)realloc(buf, cap * 2);
-            if (!nb) {
-                free(buf);
-                buf = NULL;
-                break;
-            }
-            buf = nb;
-            cap *= 2;
-        }
-    }
-    if (!buf) {
-        fprintf(stderr, "pray: error: out of memory\n");
-        return 1;
-    }
-    pray_status st = pray_run_string(c, "stdin.ray", buf, n);
-    free(buf);
-    return st;
-}
-
 } // namespace
 
 int main(int argc, char **argv) {
@@ -9221,9 +9217,7 @@ int main(int argc, char **argv) {
         return rc;
     }
     if (!quiet && stderr_is_terminal()) pray_set_progress(c, progress_bar, NULL);
-    pray_status st;
-    if (strcmp(program, "-") == 0) st = (pray_status)run_stdin(c);
-    else st = pray_run_file(c, program);
+    pray_status st = pray_run_file(c, program);
     if (st != PRAY_OK) {
         const char *m = pray_error(c);
         if (strncmp(m, "error: ", 7) == 0) fprintf(stderr, "pray: %s\n", m);
