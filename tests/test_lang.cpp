@@ -7,6 +7,7 @@
 #include "testkit.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -680,6 +681,46 @@ TEST_CASE("runtime errors: a result that is not finite, at the operator or call 
                  "1.7e+308 -1.7e+308 0 1 1.7887e+308\n");
     CHECK_PRINTS("print <1e308, 0, 0> + <7e307, 0, 0>, abs(<1e308, 1e308, 0>), -<1.7e308, 0, 0>\n",
                  "<1.7e+308, 0, 0> 1.41421e+308 <-1.7e+308, 0, 0>\n");
+}
+
+TEST_CASE("the API still refuses the infinities and NaNs that programs can no longer make") {
+    // bad inputs 091, 221-243, 253 and 261 reached these checks through 1e308*10 before overflow
+    // became an error at the operator
+    const double inf = HUGE_VAL, nan = HUGE_VAL - HUGE_VAL;
+    const pray_vec o = {0, 0, 0}, z = {0, 0, 1}, far = {inf, 0, 0}, odd = {0, nan, 0};
+    pray_ctx *c = pray_new();
+    pray_model *m = pray_color(c, pray_rgb{1, 1, 1});
+    auto refused = [&](const void *made, const std::string &message) {
+        CHECK(made == nullptr);
+        CHECK(std::string(pray_error(c)) == "error: " + message);
+    };
+    refused(pray_sphere(c, m, o, inf), "sphere: radius must be a positive number, not inf");
+    refused(pray_sphere(c, m, o, nan), "sphere: radius must be a positive number, not nan");
+    refused(pray_sphere(c, m, far, 1), "sphere: coordinates are not finite");
+    refused(pray_cylinder(c, m, o, z, inf), "cylinder: radius must be a positive number, not inf");
+    refused(pray_cylinder(c, m, o, pray_vec{0, 0, inf}, 1), "cylinder axis: coordinates are not finite");
+    refused(pray_plane(c, m, odd, z), "plane: coordinates are not finite");
+    refused(pray_dirlight(c, pray_rgb{inf, 1, 1}, z), "dirlight: intensity is not finite");
+    refused(pray_pointlight(c, pray_rgb{1, 1, 1}, far), "pointlight: coordinates are not finite");
+    refused(pray_phong(c, pray_rgb{1, 1, 1}, pray_rgb{1, 1, 1}, pray_rgb{0, 0, 0}, inf),
+            "phong: exponent must be a number >= 0, not inf");
+    refused(pray_phong(c, pray_rgb{inf, 1, 1}, pray_rgb{1, 1, 1}, pray_rgb{0, 0, 0}, 1), "phong: intensity is not finite");
+    refused(pray_mirror(c, pray_rgb{inf, 1, 1}), "mirror: intensity is not finite");
+    refused(pray_color(c, pray_rgb{nan, 1, 1}), "color: intensity is not finite");
+    pray_object *s = pray_sphere(c, m, o, 1);
+    REQUIRE(s);
+    refused(pray_scale(c, s, inf), "scale factor must be a finite number other than 0, not inf");
+    refused(pray_translate(c, s, far), "translation: coordinates are not finite");
+    refused(pray_rotate(c, s, far), "rotation: coordinates are not finite");
+    CHECK(pray_background(c, pray_rgb{inf, 1, 1}, pray_rgb{1, 1, 1}) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: background: intensity is not finite");
+    CHECK(pray_perspective(c, far, pray_vec{0, 0, -1}, pray_vec{0, -4, 0}, o) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: perspective: coordinates are not finite");
+    CHECK(pray_option(c, "width", nan) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: option 'width': nan is out of range");
+    pray_release(c, s);
+    pray_release(c, m);
+    pray_free(c);
 }
 
 TEST_CASE("runtime errors: derived values name the function and its argument") {
