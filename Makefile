@@ -13,6 +13,7 @@
 #   make sanitize   the tests and the bad inputs under AddressSanitizer and UBSan
 #   make fuzz       build the libFuzzer harness and fuzz for FUZZ_SECONDS (needs clang)
 #   make fuzz-tiff  the same for the TIFF reader (textures and font atlases)
+#   make fuzz-long  the program harness on long inputs, from generated chains of 20000 operators
 #   make clean
 
 CXX      ?= c++
@@ -32,7 +33,7 @@ TESTS = tests/pray_tests$(EXE)
 TESTS_FLOAT = tests/pray_tests_float$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
-.PHONY: all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff textures gallery ports pov charts
+.PHONY: all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff fuzz-long textures gallery ports pov charts
 
 all: $(PRAY)
 
@@ -111,6 +112,14 @@ fuzz: build/fuzz/fuzz_program
 	build/fuzz/fuzz_program -max_total_time=$(FUZZ_SECONDS) -max_len=4096 -timeout=10 \
 	  -dict=tests/fuzz/pray.dict -artifact_prefix=build/fuzz/artifacts/ \
 	  build/fuzz/corpus tests/fuzz/corpus tests/fuzz/crashes
+# Long inputs (up to 256 KiB): the seeds are generated into build/fuzz/seeds_long by
+# tests/fuzz/long_seeds.sh, new inputs go to build/fuzz/corpus_long.
+fuzz-long: build/fuzz/fuzz_program
+	@mkdir -p build/fuzz/corpus_long build/fuzz/artifacts
+	tests/fuzz/long_seeds.sh build/fuzz/seeds_long
+	build/fuzz/fuzz_program -max_total_time=$(FUZZ_SECONDS) -max_len=262144 -timeout=10 \
+	  -dict=tests/fuzz/pray.dict -artifact_prefix=build/fuzz/artifacts/long- \
+	  build/fuzz/corpus_long build/fuzz/seeds_long tests/fuzz/crashes
 build/fuzz/fuzz_tiff: tests/fuzz/fuzz_tiff.cpp pray.cpp pray.hpp
 	@mkdir -p build/fuzz
 	$(FUZZ_CXX) $(FUZZFLAGS) -I. tests/fuzz/fuzz_tiff.cpp pray.cpp -o $@

@@ -498,6 +498,7 @@ struct Text {
     Array<char> a;
     void init() { a.init(); }
     bool add(pray_ctx *c, const char *s, size_t n) {
+        if (n >= (size_t)(INT_MAX - a.n)) return fail_nomem(c), false;  // over 2 GiB
         if (!a.reserve(c, a.n + (int)n + 1)) return false;
         memcpy(a.p + a.n, s, n);
         a.n += (int)n;
@@ -1012,6 +1013,11 @@ pray_light *light_transform(pray_ctx *c, const pray_light *a, const Xform &f) {
     for (int i = 0; i < a->n; i++) {
         l->src[i] = a->src[i];
         l->src[i].v = a->src[i].point ? xf_point(f, a->src[i].v) : xf_dir(f, a->src[i].v);
+        if (!vfinite(l->src[i].v) || (!l->src[i].point && vmaxabs(l->src[i].v) == 0)) {
+            release_handle(c, l);
+            fail(c, PRAY_ERR_ARG, "the transformation takes a light out of the range of numbers");
+            return NULL;
+        }
     }
     return l;
 }
@@ -1267,8 +1273,8 @@ pray_status opt_unknown(pray_ctx *c, const char *name) {
     Suggest s;
     s.init(name);
     for (int i = 0; i < OPT_COUNT; i++) s.offer(OPTS[i].name);
-    if (s.best) return fail(c, PRAY_ERR_ARG, "unknown option '%s'; did you mean '%s'?", name, s.best);
-    return fail(c, PRAY_ERR_ARG, "unknown option '%s'", name);
+    if (s.best) return fail(c, PRAY_ERR_ARG, "unknown option '%s'; did you mean '%s'?", *Shown(name), s.best);
+    return fail(c, PRAY_ERR_ARG, "unknown option '%s'", *Shown(name));
 }
 
 } // namespace
@@ -6395,7 +6401,7 @@ pray_status pray_option_fix(pray_ctx *c, const char *name, const char *text) {
         char *end = NULL;
         double v = text ? strtod(text, &end) : 0;
         if (!text || end == text || *end)
-            return fail(c, PRAY_ERR_ARG, "option '%s': '%s' is not a number", name, text ? text : "");
+            return fail(c, PRAY_ERR_ARG, "option '%s': '%s' is not a number", name, text ? *Shown(text) : "");
         st = pray_option(c, name, v);
     }
     if (st == PRAY_OK) c->fixed |= 1u << i;
@@ -6476,13 +6482,26 @@ pray_model *pray_color(pray_ctx *c, pray_rgb col) {
     return m;
 }
 
+namespace {
+// A flat model made by a sum or a scaling: its intensities must have stayed finite.
+pray_model *finite_model(pray_ctx *c, pray_model *m, const char *what) {
+    if (m && m->kind == M_FLAT &&
+        (bad_rgb(c, m->diffuse, what) || bad_rgb(c, m->specular, what) || bad_rgb(c, m->ambient, what) ||
+         bad_rgb(c, m->emit, what) || bad_rgb(c, m->reflect, what) || bad_rgb(c, m->transmit, what))) {
+        release_handle(c, m);
+        return NULL;
+    }
+    return m;
+}
+} // namespace
+
 pray_model *pray_model_add(pray_ctx *c, pray_model *a, pray_model *b) {
-    return a && b ? model_sum(c, a, b) : NULL;
+    return a && b ? finite_model(c, model_sum(c, a, b), "model sum") : NULL;
 }
 
 pray_model *pray_model_scale(pray_ctx *c, pray_model *m, pray_rgb f) {
     if (!m || bad_rgb(c, f, "model scale")) return NULL;
-    return model_times(c, m, f);
+    return finite_model(c, model_times(c, m, f), "model scale");
 }
 
 pray_object *pray_sphere(pray_ctx *c, pray_model *m, pray_vec centre, double r) {
@@ -6673,6 +6692,12 @@ pray_object *pray_text(pray_ctx *c, pray_model *m, const char *text, pray_vec P,
         if (code < 32 || code > 126) code = '?';
         if (code == ' ' && !font) continue;
         pray_vec origin = vadd(P, vmul(X, k * spacing));
+        if (!vfinite(origin)) {  // finite arguments, but too far: say which one, not "plane"
+            fail(c, PRAY_ERR_ARG, "text: X times the spacing %g takes character %d out of the range of numbers", spacing,
+                 k + 1);
+            release_handle(c, all);
+            return NULL;
+        }
         memset(used, 0, sizeof used);
         for (int r = 0; all && r < ch; r++)
             for (int col = 0; all && col < cw; col++) {
@@ -6691,10 +6716,18 @@ pray_object *pray_text(pray_ctx *c, pray_model *m, const char *text, pray_vec P,
                 double x0 = (double)col / cw, x1 = (double)(c1 + 1) / cw;
                 double y0 = (double)(ref - 1 - r1) / ref, y1 = (double)(ref - r) / ref;
                 pray_vec a = vadd(origin, vadd(vmul(X, x0), vmul(Y, y0)));
-                pray_vec b = vadd(origin, vadd(vmul(X, x1), vmul(Y, y1)));
+                pray_vec b = vadd(origin, vadd(vmul(X, x1), vmul(Y, y1))), top = vadd(a, vmul(n, h));
+                if (!vfinite(a) || !vfinite(b) || !vfinite(top)) {
+                    char what[64];
+                    if (vfinite(a) && vfinite(b)) snprintf(what, sizeof what, "the thickness %g takes", h);
+                    else snprintf(what, sizeof what, "X and Y take");
+                    fail(c, PRAY_ERR_ARG, "text: %s character %d out of the range of numbers", what, k + 1);
+                    release_handle(c, all);
+                    return NULL;
+                }
                 pray_object *box = glyph_face(c, m, a, left);
                 pray_object *parts[5] = {glyph_face(c, m, b, nx), glyph_face(c, m, a, down), glyph_face(c, m, b, ny),
-                                         glyph_face(c, m, a, back), glyph_face(c, m, vadd(a, vmul(n, h)), front)};
+                                         glyph_face(c, m, a, back), glyph_face(c, m, top, front)};
                 for (int i = 0; i < 5; i++) {
                     pray_object *x = pray_csg(c, PRAY_INTERSECTION, box, parts[i]);
                     release_handle(c, box);
@@ -7371,7 +7404,7 @@ pray_status lex(Lexer &L) {
 // =============================================================================================
 namespace {
 
-enum { EX_NUM, EX_STR, EX_VAR, EX_CONST, EX_CALL, EX_UNARY, EX_BINARY, EX_POINT, EX_VECTOR, EX_INTENS };
+enum { EX_NUM, EX_STR, EX_VAR, EX_CONST, EX_CALL, EX_UNARY, EX_BINARY, EX_CHAIN, EX_POINT, EX_VECTOR, EX_INTENS };
 enum { C_TRUE, C_FALSE, C_NOTHING, C_NONE, C_PI };
 
 struct Expr {
@@ -7736,18 +7769,52 @@ Expr *parse_unary(Parser &P) {
     return r;
 }
 
-// transform -> unary { '.' unary }
-Expr *parse_transform(Parser &P) {
-    Expr *a = parse_unary(P);
-    while (a && is_op(cur(P), '.')) {
-        Tok &op = cur(P);
-        P.pos++;
-        a = binary(P, op, a, parse_unary(P));
+// A run of operators of one level that group from the left, `A op B op C ...`, is one EX_CHAIN
+// node: args[0] is A, args[i] (i > 0) the i-th operator, an EX_BINARY node with its right operand
+// in b. A chain of any length is built here and evaluated in a loop, never by recursion per
+// operator, so the stack stays flat however long it is.
+Expr *parse_chain(Parser &P, Expr *(*operand)(Parser &), bool (*match)(const Tok &)) {
+    Expr *a = operand(P);
+    if (!a || !match(cur(P))) return a;
+    Expr *e = new_expr(P, EX_CHAIN, cur(P));
+    Array<Expr *> list;
+    list.init();
+    bool ok = e && list.push(P.c, a);
+    while (ok && match(cur(P))) {
+        Expr *op = new_expr(P, EX_BINARY, cur(P));
+        ok = op != NULL;
+        if (ok) {
+            op->op = cur(P).op;
+            P.pos++;
+            op->b = operand(P);
+            ok = op->b && list.push(P.c, op);
+        }
     }
-    return a;
+    if (ok) {
+        e->args = freeze_list(P, list);
+        e->nargs = list.n;
+        e->line = list[list.n - 1]->line;  // the chain as a whole is placed at its last operator
+        e->col = list[list.n - 1]->col;
+        ok = e->args != NULL;
+    }
+    list.release(P.c);
+    return ok ? e : NULL;
 }
 
-// power -> transform [ '^' power ]   (right-associative)
+bool is_dot(const Tok &t) { return is_op(t, '.'); }
+bool is_mulop(const Tok &t) { return is_op(t, '*') || is_op(t, '/') || is_op(t, '%'); }
+bool is_addop(const Tok &t) { return is_op(t, '+') || is_op(t, '-'); }
+bool is_cmp(const Tok &t) {
+    return t.kind == T_OP && (t.op == '=' || t.op == OP_EQ2 || t.op == '#' || t.op == '<' ||
+                              t.op == '>' || t.op == OP_LE || t.op == OP_GE);
+}
+bool is_and(const Tok &t) { return is_op(t, '&'); }
+bool is_orop(const Tok &t) { return is_op(t, '|') || is_op(t, '\\'); }
+
+// transform -> unary { '.' unary }
+Expr *parse_transform(Parser &P) { return parse_chain(P, parse_unary, is_dot); }
+
+// power -> transform [ '^' power ]   (right-associative; each '^' is a level of maxnest)
 Expr *parse_power(Parser &P) {
     Expr *a = parse_transform(P);
     if (a && is_op(cur(P), '^')) {
@@ -7761,64 +7828,19 @@ Expr *parse_power(Parser &P) {
 }
 
 // multiplicative -> power { ('*' | '/' | '%') power }
-Expr *parse_mul(Parser &P) {
-    Expr *a = parse_power(P);
-    while (a && (is_op(cur(P), '*') || is_op(cur(P), '/') || is_op(cur(P), '%'))) {
-        Tok &op = cur(P);
-        P.pos++;
-        a = binary(P, op, a, parse_power(P));
-    }
-    return a;
-}
+Expr *parse_mul(Parser &P) { return parse_chain(P, parse_power, is_mulop); }
 
 // additive -> multiplicative { ('+' | '-') multiplicative }
-Expr *parse_additive(Parser &P) {
-    Expr *a = parse_mul(P);
-    while (a && (is_op(cur(P), '+') || is_op(cur(P), '-'))) {
-        Tok &op = cur(P);
-        P.pos++;
-        a = binary(P, op, a, parse_mul(P));
-    }
-    return a;
-}
-
-bool is_cmp(const Tok &t) {
-    return t.kind == T_OP && (t.op == '=' || t.op == OP_EQ2 || t.op == '#' || t.op == '<' ||
-                              t.op == '>' || t.op == OP_LE || t.op == OP_GE);
-}
+Expr *parse_additive(Parser &P) { return parse_chain(P, parse_mul, is_addop); }
 
 // comparison -> additive { cmp additive }
-Expr *parse_cmp(Parser &P) {
-    Expr *a = parse_additive(P);
-    while (a && is_cmp(cur(P))) {
-        Tok &op = cur(P);
-        P.pos++;
-        a = binary(P, op, a, parse_additive(P));
-    }
-    return a;
-}
+Expr *parse_cmp(Parser &P) { return parse_chain(P, parse_additive, is_cmp); }
 
 // and -> comparison { '&' comparison }
-Expr *parse_and(Parser &P) {
-    Expr *a = parse_cmp(P);
-    while (a && is_op(cur(P), '&')) {
-        Tok &op = cur(P);
-        P.pos++;
-        a = binary(P, op, a, parse_cmp(P));
-    }
-    return a;
-}
+Expr *parse_and(Parser &P) { return parse_chain(P, parse_cmp, is_and); }
 
 // expr -> and { ('|' | '\' | '¥') and }
-Expr *parse_expr(Parser &P) {
-    Expr *a = parse_and(P);
-    while (a && (is_op(cur(P), '|') || is_op(cur(P), '\\'))) {
-        Tok &op = cur(P);
-        P.pos++;
-        a = binary(P, op, a, parse_and(P));
-    }
-    return a;
-}
+Expr *parse_expr(Parser &P) { return parse_chain(P, parse_and, is_orop); }
 
 pray_status end_of_line(Parser &P) {
     if (cur(P).kind == T_NL) {
@@ -7924,6 +7946,18 @@ Stmt *parse_statement(Parser &P) {
         s = new_stmt(P, words[i].kind, t);
         if (!s) return NULL;
         P.pos++;
+        // 'delete' takes names: a function's or a constant's name is not read as a value
+        for (int k = P.pos, depth = 0; s->kind == ST_DELETE && P.t[k].kind != T_NL; k++) {
+            const Tok &a = P.t[k];
+            if (a.kind == T_OP && strchr("([{", a.op)) depth++;
+            if (a.kind == T_OP && strchr(")]}", a.op)) depth--;
+            bool first = k == P.pos || (depth == 0 && is_op(P.t[k - 1], ','));
+            if (first && a.kind == T_NAME && is_reserved(a.s)) {
+                syn(P, a, "'%s' is %s, not a variable: only variables can be deleted", a.s,
+                    builtin_find(a.s) ? "a function" : "a reserved word");
+                return NULL;
+            }
+        }
         if (!stmt_args(P, s, t, words[i].lo, words[i].hi)) return NULL;
         if (s->kind == ST_DELETE)
             for (int k = 0; k < s->nargs; k++)
@@ -8156,11 +8190,10 @@ void fmt_num(char *buf, size_t n, double x) {
     snprintf(buf, n, "%g", x);
 }
 
-// Text of a value as `print` writes it.
-bool value_text(pray_ctx *c, const Value &v, Text *out) {
-    char buf[128];
+// Text of a value other than a string as `print` writes it.
+void value_short(const Value &v, char *buf, size_t n) {
     switch (v.t) {
-    case V_NUM: fmt_num(buf, sizeof buf, v.v[0]); break;
+    case V_NUM: fmt_num(buf, n, v.v[0]); break;
     case V_POINT:
     case V_VECTOR:
     case V_INTENS: {
@@ -8170,23 +8203,30 @@ bool value_text(pray_ctx *c, const Value &v, Text *out) {
         fmt_num(d, sizeof d, v.v[2]);
         const char *o = v.t == V_POINT ? "[" : v.t == V_VECTOR ? "<" : "{";
         const char *e = v.t == V_POINT ? "]" : v.t == V_VECTOR ? ">" : "}";
-        snprintf(buf, sizeof buf, "%s%s, %s, %s%s", o, a, b, d, e);
+        snprintf(buf, n, "%s%s, %s, %s%s", o, a, b, d, e);
         break;
     }
-    case V_STRING: return out->add(c, ((Str *)v.ref)->s, (size_t)((Str *)v.ref)->n);
     case V_OBJECT: {
-        long n = ((pray_object *)v.ref)->nprims;
-        snprintf(buf, sizeof buf, "object (%ld primitive%s)", n, n == 1 ? "" : "s");
+        long k = ((pray_object *)v.ref)->nprims;
+        snprintf(buf, n, "object (%ld primitive%s)", k, k == 1 ? "" : "s");
         break;
     }
     case V_LIGHT: {
-        int n = ((pray_light *)v.ref)->n;
-        snprintf(buf, sizeof buf, "light (%d source%s)", n, n == 1 ? "" : "s");
+        int k = ((pray_light *)v.ref)->n;
+        snprintf(buf, n, "light (%d source%s)", k, k == 1 ? "" : "s");
         break;
     }
-    case V_MODEL: snprintf(buf, sizeof buf, "model"); break;
-    default: snprintf(buf, sizeof buf, "nothing"); break;
+    case V_MODEL: snprintf(buf, n, "model"); break;
+    case V_STRING: snprintf(buf, n, "a string"); break;
+    default: snprintf(buf, n, "nothing"); break;
     }
+}
+
+// Text of a value as `print` writes it.
+bool value_text(pray_ctx *c, const Value &v, Text *out) {
+    if (v.t == V_STRING) return out->add(c, ((Str *)v.ref)->s, (size_t)((Str *)v.ref)->n);
+    char buf[128];
+    value_short(v, buf, sizeof buf);
     return out->adds(c, buf);
 }
 
@@ -8216,10 +8256,7 @@ pray_status made(Interp &I, const Expr *call, int type, void *h, Value *out) {
 
 pray_status math1(Interp &I, const Expr *call, Value *a, Value *out, double (*f)(double)) {
     if (want(I, call, a, 0, V_NUM)) return I.c->status;
-    double r = f(a[0].v[0]);
-    if (!finite_num(r) && finite_num(a[0].v[0]))
-        return rerr(I, call, PRAY_ERR_RUNTIME, "%s(%g) is not a finite number", call->s, a[0].v[0]);
-    *out = vnum(r);
+    *out = vnum(f(a[0].v[0]));
     return PRAY_OK;
 }
 
@@ -8527,10 +8564,7 @@ pray_status binop(Interp &I, const Expr *e, const Value &a, const Value &b, Valu
     case '.': return transform(I, e, a, b, out);
     case '^':
         if (!nn) break;
-        *out = vnum(pow(x, y));
-        if (!finite_num(out->v[0]) && finite_num(x) && finite_num(y))
-            return rerr(I, e, PRAY_ERR_RUNTIME, "%g ^ %g is not a finite number", x, y);
-        return PRAY_OK;
+        return *out = vnum(pow(x, y)), PRAY_OK;
     case '*':
         if (nn) return *out = vnum(x * y), PRAY_OK;
         if (ta == V_VECTOR && tb == V_NUM) return *out = of_vec(V_VECTOR, vmul(vec_of(a), y)), PRAY_OK;
@@ -8619,6 +8653,45 @@ pray_status binop(Interp &I, const Expr *e, const Value &a, const Value &b, Valu
     return type_err(I, e, op_name(op), a, b);
 }
 
+// A number, point, vector or intensity with a component that is not finite.
+bool not_finite(const Value &v) {
+    int n = v.t == V_NUM ? 1 : v.t == V_POINT || v.t == V_VECTOR || v.t == V_INTENS ? 3 : 0;
+    for (int i = 0; i < n; i++)
+        if (!finite_num(v.v[i])) return true;
+    return false;
+}
+
+// The rule of all arithmetic: a result that is not finite (an overflow, or a NaN such as
+// (-8) ^ 0.5) is an error at the operator or the call that made it, "A op B is not a finite
+// number" or "f(A) is not a finite number", with the operands (numbers, points, vectors,
+// intensities) as print writes them. So values are finite everywhere else.
+pray_status not_finite_err(Interp &I, const Expr *e, const Value *a, int n, const Value &r) {
+    bool call = e->kind == EX_CALL;
+    char what[600], v[128];
+    size_t k = call ? (size_t)snprintf(what, sizeof what, "%s(", e->s) : 0;
+    for (int i = 0; i < n && k < 400; i++) {
+        value_short(a[i], v, sizeof v);
+        if (i > 0 && call) k += (size_t)snprintf(what + k, sizeof what - k, ", ");
+        else if (i > 0) k += (size_t)snprintf(what + k, sizeof what - k, " %s ", op_name(e->op));
+        k += (size_t)snprintf(what + k, sizeof what - k, "%s", v);
+    }
+    if (call && k < 400) snprintf(what + k, sizeof what - k, ")");
+    return rerr(I, e, PRAY_ERR_RUNTIME, "%s is not a finite %s", what, TYPE_NAMES[r.t]);
+}
+
+// Apply the binary operator e to a and b (both released) into out.
+pray_status operate(Interp &I, const Expr *e, Value &a, Value &b, Value *out) {
+    pray_status st = binop(I, e, a, b, out);
+    if (st == PRAY_OK && not_finite(*out)) {
+        Value ab[2] = {a, b};
+        st = not_finite_err(I, e, ab, 2, *out);
+        vrelease(I, *out);
+    }
+    vrelease(I, a);
+    vrelease(I, b);
+    return st;
+}
+
 pray_status eval_num(Interp &I, const Expr *e, double *x) {
     Value v;
     if (eval(I, e, &v)) return I.c->status;
@@ -8688,6 +8761,10 @@ pray_status eval(Interp &I, const Expr *e, Value *out) {
         int done = 0;
         for (; done < n && st == PRAY_OK; done++) st = eval(I, e->args[done], &args[done]);
         if (st == PRAY_OK) st = BUILTINS[e->n].fn(I, e, args, out);
+        if (st == PRAY_OK && not_finite(*out)) {
+            st = not_finite_err(I, e, args, n, *out);
+            vrelease(I, *out);
+        }
         for (int i = 0; i < done; i++) vrelease(I, args[i]);
         return st;
     }
@@ -8710,17 +8787,27 @@ pray_status eval(Interp &I, const Expr *e, Value *out) {
             for (int i = 0; i < 3; i++) out->v[i] = -a.v[i];
         return PRAY_OK;
     }
-    default: {  // binary
+    case EX_CHAIN: {  // A op B op C ...: from the left, in a loop
+        if (eval(I, e->args[0], out)) return I.c->status;
+        for (int i = 1; i < e->nargs; i++) {
+            Value a = *out, b;
+            memset(out, 0, sizeof *out);
+            if (eval(I, e->args[i]->b, &b)) {
+                vrelease(I, a);
+                return I.c->status;
+            }
+            if (operate(I, e->args[i], a, b, out)) return I.c->status;
+        }
+        return PRAY_OK;
+    }
+    default: {  // binary: '^'
         Value a, b;
         if (eval(I, e->a, &a)) return I.c->status;
         if (eval(I, e->b, &b)) {
             vrelease(I, a);
             return I.c->status;
         }
-        pray_status st = binop(I, e, a, b, out);
-        vrelease(I, a);
-        vrelease(I, b);
-        return st;
+        return operate(I, e, a, b, out);
     }
     }
 }
@@ -9032,21 +9119,42 @@ pray_status pray_run_string(pray_ctx *c, const char *name, const char *text, siz
 #endif
 }
 
+#if PRAY_HAS_STDIO
+namespace {
+// Read a program into t, on the context's allocator: its memory cap holds as for everything else.
+// Reading stops at a line longer than option maxline + 1 characters (counted as the lexer counts
+// them, a byte order mark included): the lexer then reports that line as it would in the whole
+// file, and an input that never ends (/dev/zero, a pipe) ends there.
+bool read_program(pray_ctx *c, FILE *f, Text *t) {
+    double lim = c->cur.opt.v[OPT_MAXLINE] + 1, col = 0;
+    char buf[8192];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0) {
+        if (!t->add(c, buf, n)) return false;
+        for (size_t i = 0; i < n; i++) {
+            if (buf[i] == '\n') col = 0;
+            else if ((buf[i] & 0xC0) != 0x80 && ++col > lim) return true;
+        }
+    }
+    return true;
+}
+} // namespace
+#endif
+
+// A path of "-" reads standard input, named stdin.ray in messages.
 pray_status pray_run_file(pray_ctx *c, const char *path) {
     if (!c) return PRAY_ERR_ARG;
     if (!path) return fail(c, PRAY_ERR_ARG, "no program file");
 #if PRAY_HAS_STDIO
+    bool in = strcmp(path, "-") == 0;
     errno = 0;
-    FILE *f = fopen(path, "rb");
+    FILE *f = in ? stdin : fopen(path, "rb");
     if (!f) return fail(c, PRAY_ERR_IO, "cannot open '%s': %s", path, strerror(errno ? errno : ENOENT));
     Text t;
     t.init();
-    char buf[8192];
-    size_t n;
-    bool ok = true;
-    while (ok && (n = fread(buf, 1, sizeof buf, f)) > 0) ok = t.add(c, buf, n);
+    bool ok = read_program(c, f, &t);
     bool bad = ferror(f) != 0;
-    fclose(f);
+    if (!in) fclose(f);
     pray_status st;
     if (!ok) st = c->status;
     else if (bad) st = fail(c, PRAY_ERR_IO, "cannot read '%s'", path);
@@ -9059,7 +9167,7 @@ pray_status pray_run_file(pray_ctx *c, const char *path) {
         if (dl >= sizeof c->run_dir) dl = 0;
         memcpy(c->run_dir, path, dl);
         c->run_dir[dl] = 0;
-        st = pray_run_string(c, path, t.str(), (size_t)t.a.n);
+        st = pray_run_string(c, in ? "stdin.ray" : path, t.str(), (size_t)t.a.n);
         c->run_dir[0] = 0;
     }
     t.a.release(c);
@@ -9081,14 +9189,13 @@ pray_status pray_render_file(const char *program, const char *const *options, in
     pray_status st = PRAY_OK;
     for (int i = 0; i < noptions && st == PRAY_OK; i++) {
         const char *eq = options[i] ? strchr(options[i], '=') : NULL;
-        if (!eq || eq == options[i] || eq - options[i] > 63) {
-            st = fail(c, PRAY_ERR_ARG, "option '%s' is not of the form name=value", options[i] ? options[i] : "");
+        if (!eq || eq == options[i]) {
+            st = fail(c, PRAY_ERR_ARG, "option '%s' is not of the form name=value", options[i] ? *Shown(options[i]) : "");
             break;
         }
-        char name[64];
-        memcpy(name, options[i], (size_t)(eq - options[i]));
-        name[eq - options[i]] = 0;
-        st = pray_option_fix(c, name, eq + 1);
+        char *name = mem_strdup(c, options[i], (size_t)(eq - options[i]));
+        st = name ? pray_option_fix(c, name, eq + 1) : c->status;
+        mem_free(c, name);
     }
     if (st == PRAY_OK) st = pray_run_file(c, program);
     if (message && message_size) snprintf(message, message_size, "%s", c->msg);
@@ -9169,32 +9276,6 @@ void print_stats(pray_ctx *c) {
             s.time_parse, s.time_prepare, s.time_render, s.threads, s.threads == 1 ? "" : "s");
 }
 
-int run_stdin(pray_ctx *c) {
-    size_t cap = 65536, n = 0;
-    char *buf = (char *)malloc(cap);
-    size_t got;
-    while (buf && (got = fread(buf + n, 1, cap - n, stdin)) > 0) {
-        n += got;
-        if (n == cap) {
-            char *nb = (char *)realloc(buf, cap * 2);
-            if (!nb) {
-                free(buf);
-                buf = NULL;
-                break;
-            }
-            buf = nb;
-            cap *= 2;
-        }
-    }
-    if (!buf) {
-        fprintf(stderr, "pray: error: out of memory\n");
-        return 1;
-    }
-    pray_status st = pray_run_string(c, "stdin.ray", buf, n);
-    free(buf);
-    return st;
-}
-
 } // namespace
 
 int main(int argc, char **argv) {
@@ -9244,14 +9325,20 @@ int main(int argc, char **argv) {
                 if (st == PRAY_OK) st = pray_option_fix(c, "height", h);
             } else {
                 const char *eq = strchr(next, '=');
-                if (!eq || eq == next || eq - next > 63) {
+                if (!eq || eq == next) {
                     rc = usage_error("-D takes name=value, not '%s'", next);
                     break;
                 }
-                char name[64];
+                char *name = (char *)malloc((size_t)(eq - next) + 1);
+                if (!name) {
+                    fprintf(stderr, "pray: error: out of memory\n");
+                    rc = 1;
+                    break;
+                }
                 memcpy(name, next, (size_t)(eq - next));
                 name[eq - next] = 0;
                 st = pray_option_fix(c, name, eq + 1);
+                free(name);
             }
         } else if (a[0] == '-' && a[1] != 0) {
             rc = usage_error("unknown option '%s'", a);
@@ -9272,9 +9359,7 @@ int main(int argc, char **argv) {
         return rc;
     }
     if (!quiet && stderr_is_terminal()) pray_set_progress(c, progress_bar, NULL);
-    pray_status st;
-    if (strcmp(program, "-") == 0) st = (pray_status)run_stdin(c);
-    else st = pray_run_file(c, program);
+    pray_status st = pray_run_file(c, program);
     if (st != PRAY_OK) {
         const char *m = pray_error(c);
         if (strncmp(m, "error: ", 7) == 0) fprintf(stderr, "pray: %s\n", m);

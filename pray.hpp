@@ -161,7 +161,9 @@ double pray_option_get(const pray_ctx *ctx, const char *name);
 /* Run a program held in memory. `name` is used in messages and for the default output name
    (name with its extension replaced by .tif). `text` need not be NUL-terminated. */
 pray_status pray_run_string(pray_ctx *ctx, const char *name, const char *text, size_t len);
-/* Run a program file. */
+/* Run a program file; "-" reads standard input (named "stdin.ray" in messages). Reading stops at
+   the first line longer than option maxline and holds to the memory cap, so an endless input
+   ends in an error. */
 pray_status pray_run_file(pray_ctx *ctx, const char *path);
 /* The number of frames the last run rendered. */
 int pray_frames(const pray_ctx *ctx);
@@ -384,7 +386,8 @@ pray_status pray_render_file(const char *program, const char *const *options, in
    Statements: NAME = expr, delete, print, if/then/else/endif, while/endwhile, quit, background,
    perspective, parallel, option, rendertiff. Operators from the highest priority: unary + -
    (on objects: complement), . (scale, translate, rotate), ^, * / %, + -, comparisons
-   = == # < > <= >=, &, | \ (objects: union and difference; numbers: bitwise).
+   = == # < > <= >=, &, | \ (objects: union and difference; numbers: bitwise). A result that
+   is not a finite number (overflow) is an error at its operator or function.
 
    8. Limits
    Every limit of a run is an option with a default (the command line sets it with -D):

@@ -7,6 +7,7 @@
 #include "testkit.hpp"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -528,6 +529,57 @@ TEST_CASE("objects: a chain built in a loop is one node and fast") {
     CHECK(r.frames.size() == 1);
 }
 
+TEST_CASE("long chains of every operator run with a flat stack") {
+    // A chain is built and evaluated in a loop: before, 12000 terms overflowed the stack.
+    auto chain = [](const std::string &head, const std::string &term, int n) {
+        std::string p = "M = color({1})\nS = sphere(M, [0, 0, 0], 1)\nX = " + head;
+        p.reserve(p.size() + term.size() * (size_t)n + 16);
+        for (int i = 0; i < n; i++) p += term;
+        return p + "\nprint X\n";
+    };
+    const std::vector<std::string> wide = {"maxline=1000000000"};
+    auto prints = [&](const std::string &prog, const std::string &expected) {
+        testkit::Result r = testkit::run(prog, wide);
+        INFO(prog.substr(0, 120));
+        CHECK(problem(r) == "");
+        CHECK(r.printed == expected);
+    };
+    // a million terms: time and memory grow with the length only
+    auto t0 = std::chrono::steady_clock::now();
+    prints(chain("1", "+1", 1000000), "1e+06\n");
+    CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < 20.0);
+    const int n = 100000;
+    prints(chain("1", "-1", n), "-99999\n");
+    for (const char *t : {"*1", "/1", "%2", "=1", "==1", "#0", "<2", ">0", "<=1", ">=1", "&1", "|0", "\\0"})
+        prints(chain("1", t, n), "1\n");
+    prints(chain("<1, 2, 3>", ".<0, 0, 0>", n), "<1, 2, 3>\n");
+    prints(chain("<1, 2, 3>", " . 1", n), "<1, 2, 3>\n");
+    prints(chain("[1, 2, 3]", "+<0, 0, 0>", n), "[1, 2, 3]\n");
+    prints(chain("{0.5}", "*{1}", n), "{0.5, 0.5, 0.5}\n");
+    prints(chain("\"a\"", "+\"\"", n), "a\n");
+    for (const char *t : {"|S", "+S", "\\S", "-S", "%S"}) prints(chain("S", t, n), "object (100001 primitives)\n");
+    for (const char *t : {"&S", "*S"}) prints(chain("S", t, n), "object (100001 primitives)\n");
+    // mixed levels nest one chain in another, not one level per operator
+    prints(chain("0", "+2*3-6", n), "0\n");
+    // continued over lines of 1000 terms
+    std::string cont = "X = 0";
+    for (int line = 0; line < 100; line++) {
+        cont += " \\\n";
+        for (int i = 0; i < 1000; i++) cont += "+1";
+    }
+    prints(cont + "\nprint X\n", "100000\n");
+    // an error at the end of a long chain names its operator
+    std::string bad = "X = 1";
+    for (int i = 0; i < n; i++) bad += "+1";
+    Failure f = run_fail(bad + "+nothing+1\n", wide);
+    CHECK(f.where() + " " + f.msg == where_is(1, 6 + 2 * n) + " cannot apply '+' to number and object");
+    // '^' groups from the right and unary minus nests: both count as levels of maxnest
+    std::string pow = "X = 1", neg = "X = ";
+    for (int i = 0; i < 300; i++) pow += "^1", neg += "-";
+    CHECK_ERROR(pow + "\n", 1, 518, "expression nested deeper than 256 levels (option maxnest)");
+    CHECK_ERROR(neg + "1\n", 1, 261, "expression nested deeper than 256 levels (option maxnest)");
+}
+
 TEST_CASE("lights: '|' and '+' count sources; none has none") {
     const std::string s = "L = dirlight({1}, <1,1,1>)\nP = pointlight({1}, [0,0,1])\n";
     CHECK_PRINTS(s + "print L, P, none\n", "light (1 source) light (1 source) light (0 sources)\n");
@@ -587,6 +639,114 @@ TEST_CASE("runtime errors: arithmetic") {
     CHECK(f.printed == "1\n");
     CHECK(f.line == 2);
     CHECK(f.col == 9);
+}
+
+TEST_CASE("runtime errors: a result that is not finite, at the operator or call that made it") {
+    CHECK_ERROR("x = 1 + 1e308 * 10 + 1\n", 1, 15, "1e+308 * 10 is not a finite number");
+    CHECK_ERROR("x = 1e308 + 1e308\n", 1, 11, "1e+308 + 1e+308 is not a finite number");
+    CHECK_ERROR("x = -1e308 - 1e308\n", 1, 12, "-1e+308 - 1e+308 is not a finite number");
+    CHECK_ERROR("x = 1e300 / 1e-10\n", 1, 11, "1e+300 / 1e-10 is not a finite number");
+    CHECK_ERROR("x = 10 ^ 400\n", 1, 8, "10 ^ 400 is not a finite number");
+    CHECK_ERROR("x = 2 ^ 2 ^ 2 ^ 2 ^ 2\n", 1, 7, "2 ^ 65536 is not a finite number");
+    CHECK_ERROR("x = exp(1000)\n", 1, 5, "exp(1000) is not a finite number");
+    CHECK_ERROR("x = tan(1.5) * 1e308\n", 1, 14, "14.1014 * 1e+308 is not a finite number");
+    CHECK_ERROR("x = abs(<1.7e308, 1.7e308, 0>)\n", 1, 5, "abs(<1.7e+308, 1.7e+308, 0>) is not a finite number");
+    CHECK_ERROR("x = <1e308, 0, 0> + <1e308, 0, 0>\n", 1, 19, "<1e+308, 0, 0> + <1e+308, 0, 0> is not a finite vector");
+    CHECK_ERROR("x = <1e308, 0, 0> - <-1e308, 0, 0>\n", 1, 19, "<1e+308, 0, 0> - <-1e+308, 0, 0> is not a finite vector");
+    CHECK_ERROR("x = <1e200, 0, 0> * <1e200, 0, 0>\n", 1, 19, "<1e+200, 0, 0> * <1e+200, 0, 0> is not a finite number");
+    CHECK_ERROR("x = <1e200, 0, 0> % <0, 1e200, 0>\n", 1, 19, "<1e+200, 0, 0> % <0, 1e+200, 0> is not a finite vector");
+    CHECK_ERROR("x = <0, 1e300, 0> * 1e10\n", 1, 19, "<0, 1e+300, 0> * 1e+10 is not a finite vector");
+    CHECK_ERROR("x = 1e10 * <0, 1e300, 0>\n", 1, 10, "1e+10 * <0, 1e+300, 0> is not a finite vector");
+    CHECK_ERROR("x = <1, 1e308, 1> / 0.5\n", 1, 19, "<1, 1e+308, 1> / 0.5 is not a finite vector");
+    CHECK_ERROR("x = [0, 1e308, 0] + <0, 1e308, 0>\n", 1, 19, "[0, 1e+308, 0] + <0, 1e+308, 0> is not a finite point");
+    CHECK_ERROR("x = [1e300, 0, 0] . 1e300\n", 1, 19, "[1e+300, 0, 0] . 1e+300 is not a finite point");
+    CHECK_ERROR("x = <1e300, 0, 0> . 1e300\n", 1, 19, "<1e+300, 0, 0> . 1e+300 is not a finite vector");
+    CHECK_ERROR("x = {1e308} + {1e308}\n", 1, 13, "{1e+308, 1e+308, 1e+308} + {1e+308, 1e+308, 1e+308} is not a finite intensity");
+    CHECK_ERROR("x = {1e308} * 10\n", 1, 13, "{1e+308, 1e+308, 1e+308} * 10 is not a finite intensity");
+    CHECK_ERROR("x = {-1e308} - {1e308}\n", 1, 14, "{-1e+308, -1e+308, -1e+308} - {1e+308, 1e+308, 1e+308} is not a finite intensity");
+    // so NaN never comes to be: inf - inf stops at the inf
+    CHECK_ERROR("Inf = 1e308 * 10\nif Inf - Inf\n  print 1\nendif\n", 1, 13, "1e+308 * 10 is not a finite number");
+    // models, lights and objects made from finite values by an operator
+    CHECK_ERROR("M = color({10}) * 1e308\n", 1, 17, "model scale: intensity is not finite");
+    CHECK_ERROR("M = 1e308 * color({10})\n", 1, 11, "model scale: intensity is not finite");
+    CHECK_ERROR("M = color({1e308}) + color({1e308})\n", 1, 20, "model sum: intensity is not finite");
+    CHECK_ERROR("L = pointlight({1}, [1e300, 0, 0]) . 1e300\n", 1, 36,
+                "the transformation takes a light out of the range of numbers");
+    CHECK_ERROR("L = dirlight({1}, <1, 0, 0>) . 1e-300 . 1e-300\n", 1, 39,
+                "the transformation takes a light out of the range of numbers");
+    CHECK_ERROR("M = color({1})\nS = sphere(M, [1e300, 0, 0], 1) . 1e300\n", 2, 33,
+                "the transformation takes a primitive out of the range of numbers");
+    // results up to the largest number stay as they are
+    CHECK_PRINTS("print 1e308 + 7e307, -1e308 * 1.7, 1e-300 * 1e-300, 1e308 % 3 < 3, 2 ^ 1023 * 1.99\n",
+                 "1.7e+308 -1.7e+308 0 1 1.7887e+308\n");
+    CHECK_PRINTS("print <1e308, 0, 0> + <7e307, 0, 0>, abs(<1e308, 1e308, 0>), -<1.7e308, 0, 0>\n",
+                 "<1.7e+308, 0, 0> 1.41421e+308 <-1.7e+308, 0, 0>\n");
+}
+
+TEST_CASE("the API still refuses the infinities and NaNs that programs can no longer make") {
+    // bad inputs 091, 221-243, 253 and 261 reached these checks through 1e308*10 before overflow
+    // became an error at the operator
+    const double inf = HUGE_VAL, nan = HUGE_VAL - HUGE_VAL;
+    const pray_vec o = {0, 0, 0}, z = {0, 0, 1}, far = {inf, 0, 0}, odd = {0, nan, 0};
+    pray_ctx *c = pray_new();
+    pray_model *m = pray_color(c, pray_rgb{1, 1, 1});
+    auto refused = [&](const void *made, const std::string &message) {
+        CHECK(made == nullptr);
+        CHECK(std::string(pray_error(c)) == "error: " + message);
+    };
+    refused(pray_sphere(c, m, o, inf), "sphere: radius must be a positive number, not inf");
+    refused(pray_sphere(c, m, o, nan), "sphere: radius must be a positive number, not nan");
+    refused(pray_sphere(c, m, far, 1), "sphere: coordinates are not finite");
+    refused(pray_cylinder(c, m, o, z, inf), "cylinder: radius must be a positive number, not inf");
+    refused(pray_cylinder(c, m, o, pray_vec{0, 0, inf}, 1), "cylinder axis: coordinates are not finite");
+    refused(pray_plane(c, m, odd, z), "plane: coordinates are not finite");
+    refused(pray_dirlight(c, pray_rgb{inf, 1, 1}, z), "dirlight: intensity is not finite");
+    refused(pray_pointlight(c, pray_rgb{1, 1, 1}, far), "pointlight: coordinates are not finite");
+    refused(pray_phong(c, pray_rgb{1, 1, 1}, pray_rgb{1, 1, 1}, pray_rgb{0, 0, 0}, inf),
+            "phong: exponent must be a number >= 0, not inf");
+    refused(pray_phong(c, pray_rgb{inf, 1, 1}, pray_rgb{1, 1, 1}, pray_rgb{0, 0, 0}, 1), "phong: intensity is not finite");
+    refused(pray_mirror(c, pray_rgb{inf, 1, 1}), "mirror: intensity is not finite");
+    refused(pray_color(c, pray_rgb{nan, 1, 1}), "color: intensity is not finite");
+    pray_object *s = pray_sphere(c, m, o, 1);
+    REQUIRE(s);
+    refused(pray_scale(c, s, inf), "scale factor must be a finite number other than 0, not inf");
+    refused(pray_translate(c, s, far), "translation: coordinates are not finite");
+    refused(pray_rotate(c, s, far), "rotation: coordinates are not finite");
+    CHECK(pray_background(c, pray_rgb{inf, 1, 1}, pray_rgb{1, 1, 1}) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: background: intensity is not finite");
+    CHECK(pray_perspective(c, far, pray_vec{0, 0, -1}, pray_vec{0, -4, 0}, o) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: perspective: coordinates are not finite");
+    CHECK(pray_option(c, "width", nan) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: option 'width': nan is out of range");
+    pray_release(c, s);
+    pray_release(c, m);
+    pray_free(c);
+}
+
+TEST_CASE("runtime errors: derived values name the function and its argument") {
+    const std::string m = "M = color({1})\n";
+    CHECK_ERROR(m + "T = text(M, \"abc\", [0, 0, 0], <1, 0, 0>, <0, 0, 1>, 0.1, \"\", 1e308)\n", 2, 5,
+                "text: X times the spacing 1e+308 takes character 3 out of the range of numbers");
+    CHECK_ERROR(m + "T = text(M, \"a b\", [0, 0, 0], <1e308, 0, 0>, <0, 0, 1>, 0.1, \"\", 1)\n", 2, 5,
+                "text: X times the spacing 1 takes character 3 out of the range of numbers");
+    CHECK_ERROR(m + "T = text(M, \"ab\", [0, 0, 0], <1e308, 0, 0>, <0, 0, 1e308>, 0.1, \"\", 1)\n", 2, 5,
+                "text: X and Y take character 2 out of the range of numbers");
+    CHECK_ERROR(m + "T = text(M, \"ab\", [0, -1e308, 0], <1, 0, 0>, <0, 0, 1>, 1e308, \"\", 1)\n", 2, 5,
+                "text: the thickness 1e+308 takes character 1 out of the range of numbers");
+    // far, but in range
+    CHECK_PRINTS(m + "T = text(M, \"ab\", [0, 0, 0], <1, 0, 0>, <0, 0, 1>, 0.1, \"\", 1e308)\nprint T\n",
+                 "object (54 primitives)\n");
+    // delete takes names, and a function or a constant is not one
+    CHECK_ERROR("delete sphere\n", 1, 8, "'sphere' is a function, not a variable: only variables can be deleted");
+    CHECK_ERROR("x = 1\ndelete x, pi\n", 2, 11, "'pi' is a reserved word, not a variable: only variables can be deleted");
+    CHECK_ERROR("x = 1\ndelete x, cos(1)\n", 2, 11, "'cos' is a function, not a variable: only variables can be deleted");
+    CHECK_ERROR("x = 1\ndelete x + sin\n", 2, 12, "'sin' is a function: write it with its arguments in parentheses");
+    // an option name of any length is looked up, not cut
+    char msg[300];
+    std::string name(300, 'a'), opt = name + "=1";
+    const char *opts[] = {opt.c_str()};
+    CHECK(pray_render_file("examples/csg.ray", opts, 1, msg, sizeof msg) == PRAY_ERR_ARG);
+    CHECK(std::string(msg) == "error: unknown option '" + name.substr(0, 60) + "...'");
 }
 
 TEST_CASE("runtime errors: undefined variables suggest a defined name") {

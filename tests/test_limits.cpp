@@ -14,6 +14,7 @@
 #include <vector>
 
 #if defined(__unix__) || defined(__APPLE__)
+#include <sys/wait.h>
 #include <unistd.h>
 #define HAVE_SYMLINK 1
 #endif
@@ -109,6 +110,41 @@ TEST_CASE("limit maxline: a line of exactly maxline characters, and one more") {
     std::string longest = "X = 1" + repeat(" ", 65531) + "\nprint X\n";
     CHECK(testkit::run(longest).printed == "1\n");
     CHECK(testkit::run(" " + longest).error == "test.ray:1:65537: error: line longer than 65536 characters (option maxline)");
+}
+
+TEST_CASE("limit maxline and maxmem while a program is read: a file or a stream that never ends") {
+#if defined(__unix__) || defined(__APPLE__)
+    // reading stops just past the first line over maxline, reported as for a finite file
+    pray_ctx *c = pray_new();
+    pray_set_memory_limit(c, (size_t)4 << 20);
+    CHECK(pray_run_file(c, "/dev/zero") == PRAY_ERR_LIMIT);
+    CHECK(std::string(pray_error(c)) == "/dev/zero:1:65537: error: line longer than 65536 characters (option maxline)");
+    // without a line limit, the memory cap ends it
+    pray_option(c, "maxline", 1e9);
+    CHECK(pray_run_file(c, "/dev/zero") == PRAY_ERR_NOMEM);
+    CHECK(std::string(pray_error(c)) == "error: out of memory: over the context's cap of 4194304 bytes");
+    pray_free(c);
+    // standard input ("-") is read the same way, by the command line too: one message, no
+    // empty line after it
+    auto pray_cmd = [](const std::string &args) {
+        std::string out;
+        FILE *p = popen(("t=; command -v timeout >/dev/null && t='timeout 60'; $t ./pray " + args + " 2>&1").c_str(), "r");
+        REQUIRE(p);
+        char buf[4096];
+        size_t n;
+        while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+        int rc = pclose(p);
+        return std::to_string(WIFEXITED(rc) ? WEXITSTATUS(rc) : -1) + " " + out;
+    };
+    CHECK(pray_cmd("- </dev/zero") == "1 stdin.ray:1:65537: error: line longer than 65536 characters (option maxline)\n");
+    CHECK(pray_cmd("--untrusted - </dev/zero") == "1 stdin.ray:1:4097: error: line longer than 4096 characters (option maxline)\n");
+    CHECK(pray_cmd("-D maxline=1000000000 -D maxmem=16 - </dev/zero") ==
+          "1 pray: error: out of memory: over the cap of 16 MiB (option maxmem)\n");
+    CHECK(pray_cmd("-D maxline=1000000000 -D maxmem=16 /dev/zero") ==
+          "1 pray: error: out of memory: over the cap of 16 MiB (option maxmem)\n");
+    CHECK(pray_cmd("- <examples/redsph.ray -s 4x4 -o limits_stdin.ppm") == "0 ");
+    std::remove("limits_stdin.ppm");
+#endif
 }
 
 TEST_CASE("limit maxstring: literals and strings built by +") {
