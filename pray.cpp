@@ -1105,11 +1105,13 @@ pray_model *model_node(pray_ctx *c, int kind, pray_model *a, pray_model *b, doub
     return m;
 }
 
-// A flat model made by a sum or a scale whose coefficients left the range of numbers: freed,
-// and the error. Returns m when it is good.
-pray_model *flat_checked(pray_ctx *c, pray_model *m, const char *what) {
-    if (!m || (cfinite(m->diffuse) && cfinite(m->specular) && cfinite(m->ambient) && cfinite(m->emit) &&
-               cfinite(m->reflect) && cfinite(m->transmit)))
+// A model made by a sum or a scale whose coefficients (a textured model's: their bounds,
+// model_most) left the range of numbers: freed, and the error. Returns m when it is good.
+pray_model *model_checked(pray_ctx *c, pray_model *m, const char *what) {
+    if (!m) return NULL;
+    if (m->kind == M_FLAT ? cfinite(m->diffuse) && cfinite(m->specular) && cfinite(m->ambient) && cfinite(m->emit) &&
+                                cfinite(m->reflect) && cfinite(m->transmit)
+                          : finite_num(m->most[0]) && finite_num(m->most[1]) && finite_num(m->most[2]) && finite_num(m->clear))
         return m;
     release_handle(c, m);
     fail(c, PRAY_ERR_ARG, "%s: the coefficients are not finite", what);
@@ -1117,7 +1119,7 @@ pray_model *flat_checked(pray_ctx *c, pray_model *m, const char *what) {
 }
 
 pray_model *model_sum(pray_ctx *c, pray_model *a, pray_model *b) {
-    if (a->kind != M_FLAT || b->kind != M_FLAT) return model_node(c, M_SUM, a, b);
+    if (a->kind != M_FLAT || b->kind != M_FLAT) return model_checked(c, model_node(c, M_SUM, a, b), "model sum");
     pray_model *m = model_new(c);
     if (!m) return NULL;
     m->diffuse = cadd(a->diffuse, b->diffuse);
@@ -1130,7 +1132,7 @@ pray_model *model_sum(pray_ctx *c, pray_model *a, pray_model *b) {
     m->exponent = a->has_exponent ? a->exponent : b->exponent;
     m->has_index = a->has_index || b->has_index;
     m->index = a->has_index ? a->index : b->index;
-    return flat_checked(c, m, "model sum");
+    return model_checked(c, m, "model sum");
 }
 
 pray_model *model_times(pray_ctx *c, pray_model *a, pray_rgb f) {
@@ -1140,7 +1142,7 @@ pray_model *model_times(pray_ctx *c, pray_model *a, pray_rgb f) {
         m->factor = f;
         m->clear *= rgb_maxabs(f);
         for (int i = 0; i < 3; i++) m->most[i] *= rgb_maxabs(f);
-        return m;
+        return model_checked(c, m, "model scale");
     }
     pray_model *m = model_new(c);
     if (!m) return NULL;
@@ -1152,7 +1154,7 @@ pray_model *model_times(pray_ctx *c, pray_model *a, pray_rgb f) {
     m->emit = cmul(a->emit, f);
     m->reflect = cmul(a->reflect, f);
     m->transmit = cmul(a->transmit, f);
-    return flat_checked(c, m, "model scale");
+    return model_checked(c, m, "model scale");
 }
 
 // =============================================================================================
@@ -6482,26 +6484,13 @@ pray_model *pray_color(pray_ctx *c, pray_rgb col) {
     return m;
 }
 
-namespace {
-// A flat model made by a sum or a scaling: its intensities must have stayed finite.
-pray_model *finite_model(pray_ctx *c, pray_model *m, const char *what) {
-    if (m && m->kind == M_FLAT &&
-        (bad_rgb(c, m->diffuse, what) || bad_rgb(c, m->specular, what) || bad_rgb(c, m->ambient, what) ||
-         bad_rgb(c, m->emit, what) || bad_rgb(c, m->reflect, what) || bad_rgb(c, m->transmit, what))) {
-        release_handle(c, m);
-        return NULL;
-    }
-    return m;
-}
-} // namespace
-
 pray_model *pray_model_add(pray_ctx *c, pray_model *a, pray_model *b) {
-    return a && b ? finite_model(c, model_sum(c, a, b), "model sum") : NULL;
+    return a && b ? model_sum(c, a, b) : NULL;
 }
 
 pray_model *pray_model_scale(pray_ctx *c, pray_model *m, pray_rgb f) {
     if (!m || bad_rgb(c, f, "model scale")) return NULL;
-    return finite_model(c, model_times(c, m, f), "model scale");
+    return model_times(c, m, f);
 }
 
 pray_object *pray_sphere(pray_ctx *c, pray_model *m, pray_vec centre, double r) {

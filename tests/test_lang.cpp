@@ -667,9 +667,9 @@ TEST_CASE("runtime errors: a result that is not finite, at the operator or call 
     // so NaN never comes to be: inf - inf stops at the inf
     CHECK_ERROR("Inf = 1e308 * 10\nif Inf - Inf\n  print 1\nendif\n", 1, 13, "1e+308 * 10 is not a finite number");
     // models, lights and objects made from finite values by an operator
-    CHECK_ERROR("M = color({10}) * 1e308\n", 1, 17, "model scale: intensity is not finite");
-    CHECK_ERROR("M = 1e308 * color({10})\n", 1, 11, "model scale: intensity is not finite");
-    CHECK_ERROR("M = color({1e308}) + color({1e308})\n", 1, 20, "model sum: intensity is not finite");
+    CHECK_ERROR("M = color({10}) * 1e308\n", 1, 17, "model scale: the coefficients are not finite");
+    CHECK_ERROR("M = 1e308 * color({10})\n", 1, 11, "model scale: the coefficients are not finite");
+    CHECK_ERROR("M = color({1e308}) + color({1e308})\n", 1, 20, "model sum: the coefficients are not finite");
     CHECK_ERROR("L = pointlight({1}, [1e300, 0, 0]) . 1e300\n", 1, 36,
                 "the transformation takes a light out of the range of numbers");
     CHECK_ERROR("L = dirlight({1}, <1, 0, 0>) . 1e-300 . 1e-300\n", 1, 39,
@@ -727,10 +727,11 @@ TEST_CASE("runtime errors: derived values name the function and its argument") {
     const std::string m = "M = color({1})\n";
     CHECK_ERROR(m + "T = text(M, \"abc\", [0, 0, 0], <1, 0, 0>, <0, 0, 1>, 0.1, \"\", 1e308)\n", 2, 5,
                 "text: X times the spacing 1e+308 takes character 3 out of the range of numbers");
-    CHECK_ERROR(m + "T = text(M, \"a b\", [0, 0, 0], <1e308, 0, 0>, <0, 0, 1>, 0.1, \"\", 1)\n", 2, 5,
-                "text: X times the spacing 1 takes character 3 out of the range of numbers");
+    CHECK_ERROR(m + "T = text(M, \"a b\", [0, 0, 0], <1e150, 0, 0>, <0, 0, 1>, 0.1, \"\", 1e158)\n", 2, 5,
+                "text: X times the spacing 1e+158 takes character 3 out of the range of numbers");
+    // the axes themselves have lengths between 1e-150 and 1e150, as a texture map's vectors
     CHECK_ERROR(m + "T = text(M, \"ab\", [0, 0, 0], <1e308, 0, 0>, <0, 0, 1e308>, 0.1, \"\", 1)\n", 2, 5,
-                "text: X and Y take character 2 out of the range of numbers");
+                "text: the vectors' lengths must lie between 1e-150 and 1e+150");
     CHECK_ERROR(m + "T = text(M, \"ab\", [0, -1e308, 0], <1, 0, 0>, <0, 0, 1>, 1e308, \"\", 1)\n", 2, 5,
                 "text: the thickness 1e+308 takes character 1 out of the range of numbers");
     // far, but in range

@@ -1379,6 +1379,17 @@ TEST_CASE("models: shared parts cost what they are, or are refused; shading is b
     Img ia = render(c, top_view(16, 2), a), ib = render(c, top_view(16, 2), b);
     CHECK(ia.px == ib.px);
     CHECK(ia.at(0, 0, 0) == 1024 * tex.at(0, 0, 0));
+    // scalings of a textured model multiply when it is shaded: their product must be a number
+    pray_model *big = pray_model_scale(c, T, RGB(1e200, 1e200, 1e200));
+    REQUIRE(big != nullptr);
+    CHECK(pray_model_scale(c, big, RGB(1e200, 1, 1)) == nullptr);
+    CHECK(std::string(pray_error(c)) == "error: model scale: the coefficients are not finite");
+    pray_model *huge = pray_model_scale(c, big, RGB(1e108, 1, 1));
+    REQUIRE(huge != nullptr);
+    CHECK(pray_model_add(c, huge, huge) == nullptr);
+    CHECK(std::string(pray_error(c)) == "error: model sum: the coefficients are not finite");
+    pray_release(c, huge);
+    pray_release(c, big);
     pray_model *b1 = pray_tiffbump(c, m, 0, t);
     REQUIRE(b1 != nullptr);
     CHECK(pray_tiffbump(c, b1, 0, t) == nullptr);
