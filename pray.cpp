@@ -26,14 +26,11 @@
 // =============================================================================================
 #if defined(__unix__) || defined(__APPLE__)
 #ifndef _POSIX_C_SOURCE
-#define _POSIX_C_SOURCE 200112L
+#define _POSIX_C_SOURCE 200809L  // openat, O_NOFOLLOW, O_DIRECTORY
 #endif
 #ifndef _XOPEN_SOURCE
-#define _XOPEN_SOURCE 600  // realpath
+#define _XOPEN_SOURCE 700
 #endif
-#define PRAY_HAS_REALPATH 1
-#else
-#define PRAY_HAS_REALPATH 0
 #endif
 
 #include "pray.hpp"
@@ -46,6 +43,7 @@
 #pragma GCC optimize("fp-contract=off")
 #endif
 
+#include <ctype.h>
 #include <errno.h>
 #include <float.h>
 #include <limits.h>
@@ -115,9 +113,13 @@
 #endif
 
 #if defined(_WIN32)
+#include <fcntl.h>
 #include <io.h>
+#include <sys/stat.h>
 #include <windows.h>
 #elif defined(__unix__) || defined(__APPLE__) || defined(__DJGPP__)
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #define PRAY_HAS_UNISTD 1
 #endif
@@ -172,6 +174,125 @@ bool file_replace(const char *from, const char *to) {
     remove(to);
 #endif
     return rename(from, to) == 0;
+}
+#endif
+
+// Files by descriptor, so that a file is opened once and what was opened is checked (fstat):
+// POSIX (open, openat, fstat, fdopen), DJGPP and Windows (open and fstat without links or
+// openat). PRAY_FILES_AT: a name can be walked from a directory without following links.
+// Elsewhere (PRAY_FILES_FD 0) only fopen: no check of the kind of file, no exclusive creation.
+#if PRAY_HAS_STDIO && defined(_WIN32)
+#define PRAY_FILES_FD 1
+#define PRAY_FILES_AT 0
+struct FileId {
+    int valid;  // Windows gives no inode: files are compared by name
+};
+int fd_open(const char *path, int write) {
+    return write ? _open(path, _O_WRONLY | _O_CREAT | _O_EXCL | _O_BINARY, _S_IREAD | _S_IWRITE)
+                 : _open(path, _O_RDONLY | _O_BINARY);
+}
+void fd_close(int fd) { _close(fd); }
+FILE *fd_stdio(int fd, const char *mode) { return _fdopen(fd, mode); }
+// Is the open file a regular one? (Windows gives no inode: no identity.)
+bool fd_regular(int fd, FileId *id) {
+    struct _stat st;
+    if (id) id->valid = 0;
+    return _fstat(fd, &st) == 0 && (st.st_mode & _S_IFMT) == _S_IFREG;
+}
+bool name_id(const char *, FileId *id) { return (id->valid = 0) != 0; }
+unsigned long process_id() { return (unsigned long)GetCurrentProcessId(); }
+#elif PRAY_HAS_STDIO && defined(PRAY_HAS_UNISTD)
+#define PRAY_FILES_FD 1
+#ifndef O_BINARY
+#define O_BINARY 0
+#endif
+#ifndef O_NOFOLLOW
+#define O_NOFOLLOW 0
+#endif
+#ifndef O_NONBLOCK
+#define O_NONBLOCK 0
+#endif
+#ifndef O_CLOEXEC
+#define O_CLOEXEC 0
+#endif
+#if defined(AT_FDCWD) && defined(O_DIRECTORY) && O_NOFOLLOW != 0 && !defined(__DJGPP__)
+#define PRAY_FILES_AT 1
+#else
+#define PRAY_FILES_AT 0
+#endif
+// DJGPP makes inode numbers up: files are compared by name there.
+#if defined(__DJGPP__)
+#define PRAY_FILE_IDS 0
+#else
+#define PRAY_FILE_IDS 1
+#endif
+struct FileId {
+    int valid;  // 1 when dev and ino identify the file
+    dev_t dev;
+    ino_t ino;
+};
+// Reading never blocks in open (a FIFO would wait for a writer); creating is exclusive and never
+// through a link, with mode 0666 less the umask, as fopen would.
+int fd_open(const char *path, int write) {
+    return write ? open(path, O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC | O_BINARY, 0666)
+                 : open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_BINARY);
+}
+void fd_close(int fd) { close(fd); }
+FILE *fd_stdio(int fd, const char *mode) { return fdopen(fd, mode); }
+bool fd_regular(int fd, FileId *id) {
+    struct stat st;
+    if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) return false;
+    if (id) {
+        id->valid = PRAY_FILE_IDS;
+        id->dev = st.st_dev;
+        id->ino = st.st_ino;
+    }
+    return true;
+}
+#if PRAY_FILES_AT
+// One step of a walk: `name` in directory `dir`, not followed if it is a link; a directory
+// unless `last`.
+int fd_open_at(int dir, const char *name, bool last) {
+    return openat(dir, name, O_RDONLY | O_NOFOLLOW | O_CLOEXEC | (last ? O_NONBLOCK : O_DIRECTORY));
+}
+// Is `name` in directory `dir` a symbolic link? (Only to explain a walk that failed.)
+bool is_link_at(int dir, const char *name) {
+    struct stat st;
+    return fstatat(dir, name, &st, AT_SYMLINK_NOFOLLOW) == 0 && S_ISLNK(st.st_mode);
+}
+#endif
+// The identity of a file by name (following links), for comparing two names.
+bool name_id(const char *path, FileId *id) {
+    struct stat st;
+    id->valid = 0;
+    if (stat(path, &st) != 0) return false;
+    id->valid = PRAY_FILE_IDS;
+    id->dev = st.st_dev;
+    id->ino = st.st_ino;
+    return true;
+}
+// Which process this is, for unique temporary names.
+unsigned long process_id() { return (unsigned long)getpid(); }
+#else
+#define PRAY_FILES_FD 0
+#define PRAY_FILES_AT 0
+struct FileId {
+    int valid;
+};
+#if PRAY_HAS_STDIO
+bool name_id(const char *, FileId *id) { return (id->valid = 0) != 0; }
+unsigned long process_id() { return 0; }
+#endif
+#endif
+#if PRAY_HAS_STDIO
+bool same_id(const FileId &a, const FileId &b) {
+#if PRAY_FILES_FD && !defined(_WIN32)
+    return a.valid && b.valid && a.dev == b.dev && a.ino == b.ino;
+#else
+    (void)a;
+    (void)b;
+    return false;
+#endif
 }
 #endif
 
@@ -311,8 +432,9 @@ struct Block {
 // Options by index; the table in section 6 has their names, defaults and ranges.
 enum {
     OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_CUTOFF, OPT_DEPTH, OPT_EYEBUFFER, OPT_FREEZE,
-    OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_LIGHTBUFFER, OPT_MAXLINE, OPT_MAXMEM, OPT_MAXNEST, OPT_MAXPIXELS, OPT_MAXPRIMS,
-    OPT_MAXRAYS, OPT_MAXSTEPS, OPT_MAXSTRING, OPT_MERGE, OPT_OUTPUT, OPT_SHADOWCACHE, OPT_SHADOWS, OPT_TEXMEM, OPT_THREADS,
+    OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_LIGHTBUFFER, OPT_MAXFRAMES, OPT_MAXLINE, OPT_MAXMEM, OPT_MAXNEST,
+    OPT_MAXOUTPUT, OPT_MAXPIXELS, OPT_MAXPRIMS, OPT_MAXRAYS, OPT_MAXSTEPS, OPT_MAXSTRING, OPT_MERGE, OPT_OUTPUT,
+    OPT_SHADOWCACHE, OPT_SHADOWS, OPT_TEXMEM, OPT_THREADS,
     OPT_WIDTH, OPT_COUNT
 };
 
@@ -352,7 +474,13 @@ struct pray_ctx {
     pray_stats stats;
     int frames;
     pray_texture *textures;  // files decoded in this run
-    char run_dir[512];       // directory of the running program, for texture files
+    const char *run_dir;     // directory of the running program: the start of its name
+    size_t run_dir_len;      // (0: the current directory), for texture files
+    FileId prog_id;          // the program file being run, which no image may replace
+    const char *prog_name;   // its name (compared where files have no identity)
+    char *volatile temp_name;  // the temporary file being written now (pray_temp_file)
+    unsigned temp_serial;    // makes temporary names unique
+    double written;          // bytes of image files written by this run (option maxoutput)
 };
 
 namespace {
@@ -1182,9 +1310,11 @@ const OptDef OPTS[OPT_COUNT] = {
     {"gridmem", 64, 1, 65536, 1, 64},
     {"height", 256, 1, MAX_IMAGE_SIDE, 1, 0},
     {"lightbuffer", 1, 0, 1, 1, 0},
+    {"maxframes", 0, 0, 1e9, 1, 1000},
     {"maxline", 65536, 1, 1e9, 1, 4096},
     {"maxmem", 0, 0, 1e9, 1, 1024},
     {"maxnest", 256, 1, MAX_NESTING, 1, 64},
+    {"maxoutput", 0, 0, 1e9, 1, 1024},
     {"maxpixels", 1073741824.0, 1, 1e15, 1, 16777216.0},
     {"maxprims", MAX_PRIMITIVES, 1, MAX_PRIMITIVES, 1, 1048576},
     {"maxrays", 65536, 1, 1e9, 1, 256},
@@ -1212,6 +1342,23 @@ struct Shown {
         size_t n = strlen(name);
         if (n <= 60) snprintf(buf, sizeof buf, "%s", name);
         else snprintf(buf, sizeof buf, "%.60s...", name);
+    }
+    const char *operator*() const { return buf; }
+};
+
+// A file's name as messages show it: a long one keeps its end, after "...", so that a message
+// has room for its place and reason.
+struct ShownPath {
+    char buf[200];
+    explicit ShownPath(const char *path) {
+        size_t n = strlen(path), keep = sizeof buf - 4;
+        if (n < sizeof buf) {
+            memcpy(buf, path, n + 1);
+            return;
+        }
+        const char *t = path + n - keep;
+        while ((*t & 0xC0) == 0x80) t++;  // not in the middle of a UTF-8 character
+        snprintf(buf, sizeof buf, "...%s", t);
     }
     const char *operator*() const { return buf; }
 };
@@ -4905,77 +5052,147 @@ const char *untrusted_path_problem(const char *path) {
     return NULL;
 }
 
-#if PRAY_HAS_INTERP  // for the files programs name
-bool file_exists(const char *path) {
-#if PRAY_HAS_STDIO
-    FILE *f = fopen(path, "rb");
-    if (f) fclose(f);
-    return f != NULL;
-#else
-    (void)path;
-    return false;
-#endif
-}
+// How a file named by a program or a host is looked for (open_read).
+enum { FIND_AS_NAMED, FIND_BESIDE, FIND_CONFINED };
 
-// On POSIX systems: does `file` (which exists) resolve to a place inside directory `dir`
-// ("" = the current one)? Catches symbolic links that lead out.
-bool inside_dir(const char *dir, const char *file) {
-#if PRAY_HAS_REALPATH
-    char d[PATH_MAX], f[PATH_MAX];
-    if (!realpath(dir[0] ? dir : ".", d) || !realpath(file, f)) return false;
-    size_t n = strlen(d);
-    return strncmp(d, f, n) == 0 && (f[n] == '/' || (n == 1 && d[0] == '/'));
-#else
-    (void)dir;
-    (void)file;
-    return true;
-#endif
+#if PRAY_HAS_STDIO
+#if PRAY_FILES_AT
+// Open `name` (NUL-terminated, modified) from directory `dir` ("" = the current one) one
+// component at a time, never following a link: a name that was swapped for a link between a
+// check and an open cannot lead elsewhere, since the open is the check. -1 on failure (errno);
+// `*link` is set when a component is a symbolic link, `*at` to that component unless it is the
+// last.
+int open_confined(const char *dir, char *name, bool *link, const char **at) {
+    int d = open(dir[0] ? dir : ".", O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    for (char *q = name; d >= 0;) {
+        char *e = q;
+        while (*e && *e != '/') e++;
+        bool last = *e == 0;
+        *e = 0;
+        if (!*q && !last) {  // "a//b"
+            q = e + 1;
+            continue;
+        }
+        const char *step = *q ? q : ".";
+        int next = fd_open_at(d, step, last);
+        int err = errno;
+        if (next < 0 && (err == ELOOP || is_link_at(d, step))) {  // ELOOP: a link when opened
+            *link = true;
+            *at = last ? NULL : step;
+        }
+        fd_close(d);
+        errno = err;
+        if (next < 0 || last) return next;
+        d = next;
+        q = e + 1;
+    }
+    return -1;
 }
 #endif
 
-// Read a whole file through the context's allocator; NULL on failure (message set).
-unsigned char *read_file(pray_ctx *c, const char *path, size_t *n, double max_bytes) {
-#if PRAY_HAS_STDIO
-    errno = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        fail(c, PRAY_ERR_IO, "cannot open '%s': %s", path, strerror(errno ? errno : ENOENT));
+// The one way pray opens a file to read: programs, textures and fonts. The file is opened once
+// (without waiting on a FIFO) and must be a regular file; `id` gets its identity where the system
+// has one. `dir` (dlen bytes, ending in a separator) is the program's directory: FIND_BESIDE
+// looks for a relative name as written, then beside the program; FIND_CONFINED beside the program
+// only, without following links where the system allows (PRAY_FILES_AT; elsewhere links are
+// followed). `*path` gets the name opened (context memory, also on failure: free with mem_free).
+// NULL on failure, message set.
+FILE *open_read(pray_ctx *c, const char *dir, size_t dlen, const char *name, int how, char **path, FileId *id) {
+    size_t n = strlen(name);
+    char *p = (char *)mem_alloc(c, 2 * (dlen + n + 2));  // the path, and room for a walk
+    *path = p;
+    if (!p) return NULL;
+    memcpy(p, dir, dlen);
+    memcpy(p + dlen, name, n + 1);
+    bool relative = name[0] && name[0] != '/' && name[0] != '\\' && name[1] != ':';
+    const char *first = how == FIND_BESIDE && relative && dlen ? p + dlen : p;  // as written first
+    if (how == FIND_AS_NAMED) first = p + dlen;
+    bool link = false;
+    const char *at = NULL;
+    int err = 0;
+#if PRAY_FILES_FD
+    int fd = -1;
+    if (how == FIND_CONFINED) {
+#if PRAY_FILES_AT
+        char *walk = p + dlen + n + 1;
+        memcpy(walk, dir, dlen);
+        walk[dlen] = 0;
+        memcpy(walk + dlen + 1, name, n + 1);
+        errno = 0;
+        fd = open_confined(walk, walk + dlen + 1, &link, &at);
+#else
+        errno = 0;
+        fd = fd_open(p, 0);
+#endif
+    } else {
+        errno = 0;
+        fd = fd_open(first, 0);
+        if (fd < 0 && errno == ENOENT && first != p) {
+            fd = fd_open(p, 0);
+            if (fd >= 0 || errno != ENOENT) first = p;  // else: named as written
+        }
+    }
+    err = errno ? errno : ENOENT;
+    if (fd >= 0 && !fd_regular(fd, id)) {
+        fd_close(fd);
+        fail(c, PRAY_ERR_IO, "cannot read '%s': not a regular file", *ShownPath(first));
         return NULL;
     }
+    FILE *f = fd >= 0 ? fd_stdio(fd, "rb") : NULL;
+    if (fd >= 0 && !f) {
+        err = errno ? errno : EIO;
+        fd_close(fd);
+    }
+#else
+    if (id) id->valid = 0;
+    errno = 0;
+    FILE *f = fopen(first, "rb");
+    if (!f && how == FIND_BESIDE && first != p && errno == ENOENT) {
+        f = fopen(p, "rb");
+        if (f || errno != ENOENT) first = p;
+    }
+    err = errno ? errno : ENOENT;
+#endif
+    if (link)
+        fail(c, PRAY_ERR_IO, "untrusted program: '%s' %s%s%s; files are read from the program's directory only, "
+             "and links are not followed", *Shown(name), at ? "passes through the symbolic link '" : "is a symbolic link",
+             at ? *Shown(at) : "", at ? "'" : "");
+    else if (!f) fail(c, PRAY_ERR_IO, "cannot open '%s': %s", *ShownPath(first), strerror(err));
+    if (first != p) memmove(p, first, strlen(first) + 1);
+    return f;
+}
+
+// Read an open file whole through the context's allocator (NUL-terminated; free with mem_free)
+// and close it; at most max_bytes (option texmem) when that is not negative. NULL on failure.
+unsigned char *read_all(pray_ctx *c, FILE *f, const char *path, size_t *n, double max_bytes) {
     Text t;
     t.init();
     char buf[8192];
     size_t got;
     bool ok = true;
     while (ok && (got = fread(buf, 1, sizeof buf, f)) > 0) {
-        if ((double)t.a.n + got > max_bytes) {
-            fail(c, PRAY_ERR_LIMIT, "'%s' is over the texture memory limit (option texmem)", path);
+        if (max_bytes >= 0 && (double)t.a.n + got > max_bytes) {
+            fail(c, PRAY_ERR_LIMIT, "'%s' is over the texture memory limit (option texmem)", *ShownPath(path));
             ok = false;
         } else
             ok = t.add(c, buf, got);
     }
-    if (ok && ferror(f)) ok = fail(c, PRAY_ERR_IO, "cannot read '%s'", path) == PRAY_OK;
+    if (ok && ferror(f)) ok = fail(c, PRAY_ERR_IO, "cannot read '%s'", *ShownPath(path)) == PRAY_OK;
     fclose(f);
+    if (ok && !t.a.p) ok = t.add(c, "", 0);  // an empty file: still a (NUL-terminated) buffer
     if (!ok) {
         t.a.release(c);
         return NULL;
     }
-    if (!t.a.p && !t.add(c, "", 0)) return NULL;  // an empty file: still a (NUL-terminated) buffer
     *n = (size_t)t.a.n;
-    return (unsigned char *)t.a.p;  // NUL-terminated Text storage; freed with mem_free
-#else
-    (void)path;
-    (void)n;
-    (void)max_bytes;
-    fail(c, PRAY_ERR_IO, "this build has no file access");
-    return NULL;
-#endif
+    return (unsigned char *)t.a.p;
 }
+#endif
 
 pray_texture *texture_make(pray_ctx *c, const char *name, const unsigned char *data, size_t n) {
-    TexImage img;
+    TexImage img = {0, 0, NULL};
     double cap = c->cur.opt.v[OPT_TEXMEM] * 1048576.0;
-    if (tiff_decode(c, name, data, n, cap, &img)) return NULL;
+    if (tiff_decode(c, *ShownPath(name), data, n, cap, &img)) return NULL;
     pray_texture *t = (pray_texture *)handle_new(c, sizeof(pray_texture), H_TEXTURE);
     char *nm = t ? mem_strdup(c, name, strlen(name)) : NULL;
     if (!t || !nm) {
@@ -4990,23 +5207,38 @@ pray_texture *texture_make(pray_ctx *c, const char *name, const unsigned char *d
     return t;
 }
 
-// A texture file, decoded once per context run however often it is used.
-pray_texture *texture_file(pray_ctx *c, const char *path) {
-    for (pray_texture *t = c->textures; t; t = t->next)
-        if (strcmp(t->name, path) == 0) {
+// A texture file (found as `how` says, open_read), decoded once per context run however often
+// it is used.
+pray_texture *texture_file(pray_ctx *c, const char *dir, size_t dlen, const char *name, int how) {
+#if PRAY_HAS_STDIO
+    char *path = NULL;
+    FILE *f = open_read(c, dir, dlen, name, how, &path, NULL);
+    pray_texture *t = f ? c->textures : NULL;
+    while (t && strcmp(t->name, path) != 0) t = t->next;
+    if (t) {
+        fclose(f);
+        retain(t);
+    } else if (f) {
+        size_t n = 0;
+        unsigned char *data = read_all(c, f, path, &n, c->cur.opt.v[OPT_TEXMEM] * 1048576.0);
+        t = data ? texture_make(c, path, data, n) : NULL;
+        mem_free(c, data);
+        if (t) {
+            t->next = c->textures;  // the cache holds one reference
+            c->textures = t;
             retain(t);
-            return t;
         }
-    size_t n = 0;
-    unsigned char *data = read_file(c, path, &n, c->cur.opt.v[OPT_TEXMEM] * 1048576.0);
-    if (!data) return NULL;
-    pray_texture *t = texture_make(c, path, data, n);
-    mem_free(c, data);
-    if (!t) return NULL;
-    t->next = c->textures;  // the cache holds one reference
-    c->textures = t;
-    retain(t);
+    }
+    mem_free(c, path);
     return t;
+#else
+    (void)dir;
+    (void)dlen;
+    (void)name;
+    (void)how;
+    fail(c, PRAY_ERR_IO, "this build has no file access");
+    return NULL;
+#endif
 }
 
 void texture_cache_clear(pray_ctx *c) {
@@ -6244,13 +6476,86 @@ pray_status write_format(pray_ctx *c, const pray_image *img, int fmt, int bits, 
 #endif
 
 #if PRAY_HAS_STDIO
+// A file being written: stops at the first error, or where the bytes would pass `room`.
 struct FileSink {
     FILE *f;
-    int err;
+    int err;  // errno of the first failure; -1: over the room
+    double bytes, room;
 };
 void file_put(void *ud, const void *p, size_t n) {
     FileSink *s = (FileSink *)ud;
+    if (!s->err && s->bytes + n > s->room) s->err = -1;
     if (!s->err && n && fwrite(p, 1, n, s->f) != n) s->err = errno ? errno : EIO;
+    s->bytes += n;
+}
+
+// Is `path` the program being run? By identity where files have one, else by name.
+bool is_program(pray_ctx *c, const char *path) {
+    if (!c->prog_name) return false;
+    FileId id;
+    if (c->prog_id.valid) return name_id(path, &id) && same_id(id, c->prog_id);
+    const char *a = path, *b = c->prog_name;
+    while (a[0] == '.' && (a[1] == '/' || a[1] == '\\')) a += 2;
+    while (b[0] == '.' && (b[1] == '/' || b[1] == '\\')) b += 2;
+#if defined(_WIN32) || defined(__DJGPP__)
+    for (; *a && *b; a++, b++) {
+        int x = *a == '\\' ? '/' : tolower((unsigned char)*a), y = *b == '\\' ? '/' : tolower((unsigned char)*b);
+        if (x != y) return false;
+    }
+    return *a == *b;
+#else
+    return strcmp(a, b) == 0;
+#endif
+}
+
+// Create a temporary file beside `path`, exclusively, never through a link, under a name no
+// other writer uses: ".NAME.XXXXXX" + PRAY_TEMP_SUFFIX (NAME: the file's name, cut to 32 bytes,
+// so that a name of 255 bytes still has one), or with PRAY_8_3_NAMES "NAXXXXXX" + the suffix
+// ("CS4F0Q2Z.$$$"). `*tmp` gets the name (context memory). NULL on failure (errno set).
+FILE *create_temp(pray_ctx *c, const char *path, char **tmp) {
+    size_t n = strlen(path), d = n;
+    while (d > 0 && path[d - 1] != '/' && path[d - 1] != '\\' && path[d - 1] != ':') d--;
+    size_t keep = n - d;
+#ifdef PRAY_8_3_NAMES
+    keep = (size_t)(file_ext(path) - 1 - (path + d));
+    if (keep > 2) keep = 2;
+    const char *lead = "", *dot = "";
+#else
+    if (keep > 32) keep = 32;
+    while (keep > 0 && (path[d + keep] & 0xC0) == 0x80) keep--;  // whole UTF-8 characters
+    const char *lead = ".", *dot = ".";
+#endif
+    *tmp = (char *)mem_alloc(c, d + keep + 16 + sizeof PRAY_TEMP_SUFFIX);
+    if (!*tmp) return NULL;
+    FILE *f = NULL;
+    errno = EEXIST;
+    for (int tries = 0; !f && errno == EEXIST && tries < 100; tries++) {
+        unsigned long h = process_id() * 2654435761u ^ (unsigned long)(size_t)c ^ (unsigned long)clock() * 40503u;
+        h = h * 31 + c->temp_serial++ * 2246822519u;
+        char id[7];
+        for (int i = 0; i < 6; i++, h /= 36) id[i] = "0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZ"[h % 36];
+        id[6] = 0;
+        snprintf(*tmp, d + keep + 16 + sizeof PRAY_TEMP_SUFFIX, "%.*s%s%.*s%s%s%s", (int)d, path, lead, (int)keep,
+                 path + d, dot, id, PRAY_TEMP_SUFFIX);
+        errno = 0;
+#if PRAY_FILES_FD
+        int fd = fd_open(*tmp, 1);
+        if (fd >= 0 && !(f = fd_stdio(fd, "wb"))) {
+            int e = errno;
+            fd_close(fd);
+            remove(*tmp);
+            errno = e ? e : EIO;
+        }
+#else
+        FILE *there = fopen(*tmp, "rb");  // no exclusive creation here: look first
+        if (there) {
+            fclose(there);
+            errno = EEXIST;
+        } else
+            f = fopen(*tmp, "wb");
+#endif
+    }
+    return f;
 }
 #endif
 
@@ -6321,6 +6626,7 @@ void pray_free(pray_ctx *c) {
 }
 
 const char *pray_error(const pray_ctx *c) { return c ? c->msg : "error: no context"; }
+const char *pray_temp_file(const pray_ctx *c) { return c ? c->temp_name : NULL; }
 pray_status pray_last_status(const pray_ctx *c) { return c ? c->status : PRAY_ERR_ARG; }
 void pray_clear_error(pray_ctx *c) {
     c->status = PRAY_OK;
@@ -6566,7 +6872,7 @@ pray_texture *pray_texture_file(pray_ctx *c, const char *path) {
         if (c) fail(c, PRAY_ERR_ARG, "no texture file name");
         return NULL;
     }
-    return texture_file(c, path);
+    return texture_file(c, "", 0, path, FIND_AS_NAMED);
 }
 
 pray_texture *pray_texture_tiff(pray_ctx *c, const void *data, size_t n, const char *name) {
@@ -6982,28 +7288,36 @@ pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *pat
                     PRAY_HAS_PNG ? " or .png" : "");
     if (fmt == FMT_PNG && bits != 8) return fail(c, PRAY_ERR_ARG, "PNG output has 8 bits only");
 #if PRAY_HAS_STDIO
-    size_t n = strlen(path);
-#ifdef PRAY_8_3_NAMES
-    n = (size_t)(file_ext(path) - 1 - path);  // the suffix replaces the extension: CSG.$$$
-#endif
-    char *tmp = (char *)mem_alloc(c, n + sizeof PRAY_TEMP_SUFFIX);
-    if (!tmp) return c->status;
-    memcpy(tmp, path, n);
-    memcpy(tmp + n, PRAY_TEMP_SUFFIX, sizeof PRAY_TEMP_SUFFIX);
+    if (is_program(c, path))
+        return fail(c, PRAY_ERR_IO, "cannot write '%s': it is the program being run (choose another output name)",
+                    *ShownPath(path));
+    // written under a temporary name, then renamed: the file is whole or not there
+    char *tmp = NULL;
     FileSink fs;
     errno = 0;
-    fs.f = fopen(tmp, "wb");
+    fs.f = create_temp(c, path, &tmp);
+    if (!fs.f && !tmp) return c->status;
     fs.err = fs.f ? 0 : (errno ? errno : EIO);
+    fs.bytes = 0;
+    double mib = c->cur.opt.v[OPT_MAXOUTPUT];
+    fs.room = mib > 0 ? mib * 1048576.0 - c->written : HUGE_VAL;
     pray_status st = PRAY_OK;
     if (fs.f) {
+        c->temp_name = tmp;  // for pray_temp_file: a signal handler may remove it
         Sink s = {file_put, &fs};
         st = write_format(c, img, fmt, bits, s);
         if (fflush(fs.f) != 0 && !fs.err) fs.err = errno ? errno : EIO;
         if (fclose(fs.f) != 0 && !fs.err) fs.err = errno ? errno : EIO;
         if (st == PRAY_OK && !fs.err && !file_replace(tmp, path)) fs.err = errno ? errno : EIO;
+        if (st != PRAY_OK || fs.err) remove(tmp);
+        c->temp_name = NULL;
     }
-    if (st == PRAY_OK && fs.err) st = fail(c, PRAY_ERR_IO, "cannot write '%s': %s", path, strerror(fs.err));
-    if (st != PRAY_OK && fs.f) remove(tmp);
+    if (st == PRAY_OK && fs.err == -1)
+        st = fail(c, PRAY_ERR_LIMIT, "'%s' would take the images written over %.0f MiB (option maxoutput)",
+                  *ShownPath(path), mib);
+    else if (st == PRAY_OK && fs.err)
+        st = fail(c, PRAY_ERR_IO, "cannot write '%s': %s", *ShownPath(path), strerror(fs.err));
+    if (st == PRAY_OK) c->written += fs.bytes;
     mem_free(c, tmp);
     return st;
 #else
@@ -7083,7 +7397,7 @@ pray_status perr(pray_ctx *c, const char *name, int line, int col, pray_status s
     vsnprintf(tmp, sizeof tmp, fmt, ap);
     va_end(ap);
     c->status = s;
-    snprintf(c->msg, sizeof c->msg, "%s:%d:%d: error: %s", name, line, col, tmp);
+    snprintf(c->msg, sizeof c->msg, "%s:%d:%d: error: %s", *ShownPath(name), line, col, tmp);
     return s;
 }
 
@@ -8359,29 +8673,17 @@ pray_status bi_spheremap(Interp &I, const Expr *call, Value *a, Value *out) {
 }
 
 // A texture named by the program: as written, else beside the program. An untrusted program's
-// files are read beside it only. Errors name the call.
+// files are read beside it only (open_read). Errors name the call.
 pray_texture *program_texture(Interp &I, const Expr *call, const Value &name) {
     pray_ctx *c = I.c;
     const char *path = ((const Str *)name.ref)->s;
-    char beside[1100];
-    snprintf(beside, sizeof beside, "%s%s", c->run_dir, path);
-    const char *use = path;
-    if (c->untrusted) {
-        const char *why = untrusted_path_problem(path);
-        if (!why && file_exists(beside) && !inside_dir(c->run_dir, beside))
-            why = "a link that leads out of the program's directory";
-        if (why) {
-            rerr(I, call, PRAY_ERR_RUNTIME, "untrusted program: '%s' is %s; files are read from the program's "
-                 "directory only", *Shown(path), why);
-            return NULL;
-        }
-        use = beside;
-    } else {
-        // as written, else beside the program; when neither opens, the message names it as written
-        bool relative = path[0] && path[0] != '/' && path[0] != '\\' && path[1] != ':';
-        if (relative && c->run_dir[0] && !file_exists(path) && file_exists(beside)) use = beside;
+    const char *why = c->untrusted ? untrusted_path_problem(path) : NULL;
+    if (why) {
+        rerr(I, call, PRAY_ERR_RUNTIME, "untrusted program: '%s' is %s; files are read from the program's "
+             "directory only", *Shown(path), why);
+        return NULL;
     }
-    pray_texture *t = pray_texture_file(c, use);
+    pray_texture *t = texture_file(c, c->run_dir ? c->run_dir : "", c->run_dir_len, path, c->untrusted ? FIND_CONFINED : FIND_BESIDE);
     if (!t && api_err(I, call->line, call->col) == PRAY_ERR_IO) c->status = PRAY_ERR_RUNTIME;
     return t;
 }
@@ -8847,13 +9149,23 @@ pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
         if (!l) return api_err(I, s->line, s->col);
         all = l;
     }
-    char base[1024], name[1100];
-    if (c->cur.opt.output[0]) snprintf(base, sizeof base, "%s", c->cur.opt.output);
-    else {
-        const char *ext = file_ext(I.name);
-        int keep = ext ? (int)(ext - 1 - I.name) : (int)strlen(I.name);
-        snprintf(base, sizeof base, "%.*s.tif", keep, I.name);
+    double most = c->cur.opt.v[OPT_MAXFRAMES];
+    if (most > 0 && I.frames >= most) {
+        release_handle(c, all);
+        fail(c, PRAY_ERR_LIMIT, "more than %.0f frames (option maxframes)", most);
+        return api_err(I, s->line, s->col);
     }
+    // the output option, else the program's name with .tif; the frame's name adds _NNNN
+    const char *ext = file_ext(I.name);
+    size_t keep = c->cur.opt.output[0] ? strlen(c->cur.opt.output) : ext ? (size_t)(ext - 1 - I.name) : strlen(I.name);
+    char *base = (char *)mem_alloc(c, keep + 5), *name = base ? (char *)mem_alloc(c, keep + 40) : NULL;
+    if (!name) {
+        mem_free(c, base);
+        release_handle(c, all);
+        return api_err(I, s->line, s->col);
+    }
+    if (c->cur.opt.output[0]) memcpy(base, c->cur.opt.output, keep + 1);
+    else snprintf(base, keep + 5, "%.*s.tif", (int)keep, I.name);
     // frames are numbered per output name: a program that names each image gets those names
     int slot = 0;
     while (slot < I.names.n && strcmp(I.names[slot].name, base) != 0) slot++;
@@ -8863,17 +9175,26 @@ pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
         nc.frames = 0;
         if (!nc.name || !I.names.push(c, nc)) {
             mem_free(c, nc.name);
+            mem_free(c, base);
+            mem_free(c, name);
+            release_handle(c, all);
             return api_err(I, s->line, s->col);
         }
     }
-    frame_name(name, sizeof name, base, I.names[slot].frames);
+    frame_name(name, keep + 40, base, I.names[slot].frames);
     pray_image img;
     pray_status st = pray_render(c, (pray_object *)a[0].ref, all, &img);
     release_handle(c, all);
-    if (st) return api_err(I, s->line, s->col);
+    if (st) {
+        mem_free(c, base);
+        mem_free(c, name);
+        return api_err(I, s->line, s->col);
+    }
     if (c->frame_fn) st = c->frame_fn(c->frame_ud, &img, name);
     else st = pray_write_image(c, &img, name, opt_int(c, OPT_BITS));
     pray_image_free(c, &img);
+    mem_free(c, base);
+    mem_free(c, name);
     if (st) {
         if (c->frame_fn && c->msg[0] == 0) fail(c, st, "frame callback failed");
         pray_status keep = c->status;
@@ -9085,6 +9406,7 @@ void reset_run(pray_ctx *c) {
     texture_cache_clear(c);  // files are read again by the next run
     memset(&c->stats, 0, sizeof c->stats);
     c->frames = 0;
+    c->written = 0;
     c->status = PRAY_OK;
     c->msg[0] = 0;
 }
@@ -9095,9 +9417,17 @@ pray_status pray_run_string(pray_ctx *c, const char *name, const char *text, siz
     reset_run(c);
     if (!text) return fail(c, PRAY_ERR_ARG, "no program text");
 #if PRAY_HAS_INTERP
+    const char *nm = name && *name ? name : "pray";
+    // texture files named by the program are also looked for beside it: in the directory of its name
+    c->run_dir = nm;
+    c->run_dir_len = 0;
+    for (size_t i = 0; nm[i]; i++)
+        if (nm[i] == '/' || nm[i] == '\\' || nm[i] == ':') c->run_dir_len = i + 1;
     c->running = 1;
-    pray_status st = run_program(c, name && *name ? name : "pray", text, len);
+    pray_status st = run_program(c, nm, text, len);
     c->running = 0;
+    c->run_dir = NULL;
+    c->run_dir_len = 0;
     c->cur = c->base;
     apply_memory_cap(c);
     return st;
@@ -9136,9 +9466,12 @@ pray_status pray_run_file(pray_ctx *c, const char *path) {
     if (!path) return fail(c, PRAY_ERR_ARG, "no program file");
 #if PRAY_HAS_STDIO
     bool in = strcmp(path, "-") == 0;
-    errno = 0;
-    FILE *f = in ? stdin : fopen(path, "rb");
-    if (!f) return fail(c, PRAY_ERR_IO, "cannot open '%s': %s", path, strerror(errno ? errno : ENOENT));
+    char *opened = NULL;
+    FileId id;
+    id.valid = 0;
+    FILE *f = in ? stdin : open_read(c, "", 0, path, FIND_AS_NAMED, &opened, &id);
+    mem_free(c, opened);
+    if (!f) return c->status;
     Text t;
     t.init();
     bool ok = read_program(c, f, &t);
@@ -9146,18 +9479,13 @@ pray_status pray_run_file(pray_ctx *c, const char *path) {
     if (!in) fclose(f);
     pray_status st;
     if (!ok) st = c->status;
-    else if (bad) st = fail(c, PRAY_ERR_IO, "cannot read '%s'", path);
+    else if (bad) st = fail(c, PRAY_ERR_IO, "cannot read '%s'", *ShownPath(path));
     else {
-        // texture files named by the program are also looked for beside it
-        const char *slash = NULL;
-        for (const char *q = path; *q; q++)
-            if (*q == '/' || *q == '\\' || *q == ':') slash = q;
-        size_t dl = slash ? (size_t)(slash - path + 1) : 0;
-        if (dl >= sizeof c->run_dir) dl = 0;
-        memcpy(c->run_dir, path, dl);
-        c->run_dir[dl] = 0;
+        c->prog_id = id;  // no image may replace the program (pray_write_image)
+        c->prog_name = in ? NULL : path;
         st = pray_run_string(c, in ? "stdin.ray" : path, t.str(), (size_t)t.a.n);
-        c->run_dir[0] = 0;
+        c->prog_id.valid = 0;
+        c->prog_name = NULL;
     }
     t.a.release(c);
     return st;
@@ -9199,6 +9527,7 @@ pray_status pray_render_file(const char *program, const char *const *options, in
 #if !PRAY_HAS_INTERP || !PRAY_HAS_STDIO
 #error "the command-line program needs the interpreter and stdio"
 #endif
+#include <signal.h>
 
 namespace {
 
@@ -9263,6 +9592,20 @@ void print_stats(pray_ctx *c) {
             s.areas, s.memory, s.rays_primary, s.rays_primary_full, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.lightbuf_voxels, s.lightbuf_cores, s.rays_lightbuf, s.rays_lightcore, s.eyebuf_voxels, s.rays_eyebuf, s.rays_shadowcache, s.voxel_steps,
             s.area_moves, s.set_inside, s.set_outside, s.checks, s.frozen_skips, s.intersection_tests,
             s.time_parse, s.time_prepare, s.time_render, s.threads, s.threads == 1 ? "" : "s");
+}
+
+// SIGINT and SIGTERM while an image is written: remove its temporary file, then die of the
+// signal as the default would. Only async-signal-safe calls.
+pray_ctx *volatile the_ctx;
+extern "C" void on_signal(int sig) {
+    const char *t = the_ctx ? pray_temp_file(the_ctx) : NULL;
+#if defined(PRAY_HAS_UNISTD)
+    if (t) unlink(t);
+#else
+    if (t) remove(t);
+#endif
+    signal(sig, SIG_DFL);
+    raise(sig);
 }
 
 } // namespace
@@ -9348,7 +9691,13 @@ int main(int argc, char **argv) {
         return rc;
     }
     if (!quiet && stderr_is_terminal()) pray_set_progress(c, progress_bar, NULL);
+    the_ctx = c;
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
     pray_status st = pray_run_file(c, program);
+    signal(SIGINT, SIG_DFL);
+    signal(SIGTERM, SIG_DFL);
+    the_ctx = NULL;
     if (st != PRAY_OK) {
         const char *m = pray_error(c);
         if (strncmp(m, "error: ", 7) == 0) fprintf(stderr, "pray: %s\n", m);

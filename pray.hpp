@@ -25,7 +25,7 @@
    @@ PRAY_NO_THREADS             no threads (DOS, bare targets)
    @@ PRAY_NO_DEFAULT_ALLOC       no malloc-based allocator: pray_new_with must be given one
    @@ PRAY_MAX_ALLOC bytes        default memory cap of a context (0 = none)
-   @@ PRAY_TEMP_SUFFIX ".tmp"     appended to a file name while it is being written
+   @@ PRAY_TEMP_SUFFIX ".tmp"     ends the temporary name a file is written under
    @@ PRAY_MAIN                   compile the command-line program (main) from pray.cpp
    ------------------------------------------------------------------------------------------- */
 #ifdef PRAY_USER_CONFIG
@@ -109,10 +109,12 @@ void pray_clear_error(pray_ctx *ctx);
 void pray_set_memory_limit(pray_ctx *ctx, size_t bytes);
 /* Untrusted mode, for programs from elsewhere; it cannot be turned off. Every limit option gets a
    ceiling (lowered to it now; a higher value, or 0 where 0 means "no limit", is refused later):
-   depth 16, gridmem 64, maxline 4096, maxmem 1024, maxnest 64, maxpixels 16777216, maxprims
-   1048576, maxsteps 1000000, maxstring 4096, texmem 64. Texture and font files named by a
-   program are read only from the program's directory (relative names without "..", no links
-   out of it); an `output` set by a program must be a plain file name. */
+   depth 16, gridmem 64, maxframes 1000, maxline 4096, maxmem 1024, maxnest 64, maxoutput 1024,
+   maxpixels 16777216, maxprims 1048576, maxsteps 1000000, maxstring 4096, texmem 64. Texture and
+   font files named by a program are read only from the program's directory (relative names
+   without "..", opened one directory at a time without following any symbolic link; on Windows
+   and DOS links inside the directory are followed); an `output` set by a program must be a plain
+   file name. */
 void pray_set_untrusted(pray_ctx *ctx);
 /* Where `print` writes (default: standard output; NULL fn discards). */
 void pray_set_print(pray_ctx *ctx, pray_write_fn fn, void *ud);
@@ -120,6 +122,9 @@ void pray_set_print(pray_ctx *ctx, pray_write_fn fn, void *ud);
 void pray_set_progress(pray_ctx *ctx, pray_progress_fn fn, void *ud);
 /* Frame callback for `rendertiff` (default none: frames are written to files). */
 void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
+/* The temporary file an image is being written to now (see pray_write_image), else NULL. For a
+   signal handler that removes it before the program dies: reading it is async-signal-safe. */
+const char *pray_temp_file(const pray_ctx *ctx);
 
 /* ---------------------------------------------------------------------------------------------
    Options: the same names as the PRAY `option` statement: width, height (pixels, default 256),
@@ -138,8 +143,9 @@ void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
    of a string, literal or built, 65536), maxprims (primitives one object stands for, 16777216),
    maxpixels (samples of one image: width x height x antialias^2, 1073741824), maxrays (rays one
    sample may take, primary, reflected and refracted, 65536), maxmem (MiB a context may hold,
-   0 = no cap). maxline and maxnest apply when a program is read, so only the
-   host or the command line can change them for that program.
+   0 = no cap), maxframes (frames of a run, 0 = no limit), maxoutput (MiB of image files a run
+   writes, 0 = no limit). maxline and maxnest apply when a program is read, so only the host or
+   the command line can change them for that program.
 
    What the host sets here (options, camera, background) is where every program run starts;
    what a program sets lasts until the end of its run.
@@ -158,12 +164,14 @@ double pray_option_get(const pray_ctx *ctx, const char *name);
 /* ---------------------------------------------------------------------------------------------
    Running PRAY programs.
    ------------------------------------------------------------------------------------------- */
-/* Run a program held in memory. `name` is used in messages and for the default output name
-   (name with its extension replaced by .tif). `text` need not be NUL-terminated. */
+/* Run a program held in memory. `name` is used in messages, for the default output name (name
+   with its extension replaced by .tif) and as the place beside which texture files are looked for
+   (its directory). `text` need not be NUL-terminated. */
 pray_status pray_run_string(pray_ctx *ctx, const char *name, const char *text, size_t len);
-/* Run a program file; "-" reads standard input (named "stdin.ray" in messages). Reading stops at
-   the first line longer than option maxline and holds to the memory cap, so an endless input
-   ends in an error. */
+/* Run a program file (a regular file; a FIFO, directory or device is refused); "-" reads
+   standard input (named "stdin.ray" in messages). Reading stops at the first line longer than
+   option maxline and holds to the memory cap, so an endless input ends in an error. Its images
+   never replace it: an output naming the program file itself fails with PRAY_ERR_IO. */
 pray_status pray_run_file(pray_ctx *ctx, const char *path);
 /* The number of frames the last run rendered. */
 int pray_frames(const pray_ctx *ctx);
@@ -182,9 +190,9 @@ pray_model *pray_color(pray_ctx *ctx, pray_rgb colour);
 pray_model *pray_model_add(pray_ctx *ctx, pray_model *a, pray_model *b);
 pray_model *pray_model_scale(pray_ctx *ctx, pray_model *m, pray_rgb factor);
 
-/* Textures: a TIFF file (decoded once per context run, however often it is asked for), or TIFF
-   data in memory. Baseline TIFF: bilevel, grey, palette, RGB(A); 1, 4, 8, 16 bits; strips or
-   tiles; no compression, PackBits or LZW (with the horizontal predictor). */
+/* Textures: a TIFF file (a regular file, decoded once per context run, however often it is
+   asked for), or TIFF data in memory. Baseline TIFF: bilevel, grey, palette, RGB(A); 1, 4, 8,
+   16 bits; strips or tiles; no compression, PackBits or LZW (with the horizontal predictor). */
 pray_texture *pray_texture_file(pray_ctx *ctx, const char *path);
 pray_texture *pray_texture_tiff(pray_ctx *ctx, const void *data, size_t size, const char *name);
 /* Width and height of a texture in pixels, and its colour at texel (x, y) (rows from the top). */
@@ -305,7 +313,12 @@ void pray_image_free(pray_ctx *ctx, pray_image *img);
 
 /* Write an image; the format comes from the extension: .tif/.tiff (bits 8 or 16), .ppm (bits 8
    or 16), .png (8 bits, when built with stb_image_write). The file is written under a temporary
-   name and renamed when complete; on failure nothing is left behind. */
+   name beside it and renamed when complete; on failure nothing is left behind. The temporary
+   file is new each time (".NAME.XXXXXX" + PRAY_TEMP_SUFFIX, NAME cut to 32 bytes; with
+   PRAY_8_3_NAMES "NAXXXXXX" + the suffix, NA its first two characters), created
+   exclusively and never through a link (POSIX, Windows, DJGPP; where only stdio is there, after
+   checking that no such file exists), with mode 0666 less the umask. Option maxoutput counts the
+   bytes written. */
 pray_status pray_write_image(pray_ctx *ctx, const pray_image *img, const char *path, int bits);
 /* The same formats into a byte sink. */
 pray_status pray_write_tiff(pray_ctx *ctx, const pray_image *img, int bits, pray_write_fn fn,
@@ -403,6 +416,8 @@ pray_status pray_render_file(const char *program, const char *const *options, in
        gridmem    MiB for the grid's tables                      64           64
        texmem     MiB for the textures of a run                  256          64
        maxmem     MiB the context may hold (0 = no cap)          0            1024
+       maxframes  frames a run renders (0 = no limit)            0            1000
+       maxoutput  MiB of image files a run writes (0 = none)     0            1024
    maxline and maxnest are read when a program is read. Fixed limits besides: images up to
    65536 pixels a side and 2^28 pixels, CSG trees up to 2000 levels, models up to 256 levels
    and, with textures, 4096 parts (each use of a shared part counted).

@@ -7,10 +7,13 @@
 #include "../pray.hpp"
 #include "testkit.hpp"
 
+#include <signal.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -607,4 +610,208 @@ TEST_CASE("command line: -D and -s win over the program's options") {
     rc = run_cmd("./pray -D height=3 " + sq(d / "w.ray"), &out);
     CHECK_MESSAGE(rc == 0, out);
     CHECK(starts(slurp(d / "prog.ppm"), "P6\n64 3\n255\n"));
+}
+
+// =============================================================================================
+// Writing and reading files safely (hostile names, links, FIFOs, races, signals)
+// =============================================================================================
+namespace {
+// The names in a directory that look like a temporary file of pray (".NAME.XXXXXX.tmp").
+std::string temporaries(const TempDir &d) {
+    std::string s;
+    for (const fs::directory_entry &e : fs::directory_iterator(d.path)) {
+        std::string n = e.path().filename().string();
+        if (n.size() > 4 && n.compare(n.size() - 4, 4, ".tmp") == 0) s += n + " ";
+    }
+    return s;
+}
+
+// A whole 8-bit PPM: its header's size and its length agree. Returns the width, or 0.
+int whole_ppm(const std::string &bytes) {
+    int w = 0, h = 0, n = 0;
+    if (sscanf(bytes.c_str(), "P6\n%d %d\n255\n%n", &w, &h, &n) != 2 || n == 0) return 0;
+    return bytes.size() == (size_t)n + 3u * w * h ? w : 0;
+}
+} // namespace
+
+TEST_CASE("the temporary file is new, unique and no link: a planted link is neither followed nor renamed") {
+    TempDir d;
+    spit(d / "victim.txt", "victim");
+    fs::create_symlink("victim.txt", d / "out.ppm.tmp");   // the temporary name pray once used
+    fs::create_symlink("victim.txt", d / "link.ppm");      // an output that is a link
+    REQUIRE(write_test_image(d / "out.ppm", 8) == PRAY_OK);
+    REQUIRE(write_test_image(d / "link.ppm", 8) == PRAY_OK);
+    CHECK(slurp(d / "victim.txt") == "victim");
+    CHECK(fs::is_symlink(d / "out.ppm.tmp"));
+    CHECK(!fs::is_symlink(d / "out.ppm"));
+    CHECK(!fs::is_symlink(d / "link.ppm"));  // the link is replaced, not what it points to
+    CHECK(whole_ppm(slurp(d / "link.ppm")) == W);
+    CHECK(d.listing() == "link.ppm out.ppm out.ppm.tmp victim.txt");
+    // the same through the command line in untrusted mode
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    spit(d / "p.ray", "rendertiff sphere(color({1}), [0, 0, 0], 1)\n");
+    fs::create_symlink("victim.txt", d / "u.ppm.tmp");
+    std::string out;
+    CHECK(run_cmd("cd " + sq(d.path) + " && " + fs::absolute("pray").string() + " --untrusted -s 8x8 -o u.ppm p.ray", &out) == 0);
+    CHECK(slurp(d / "victim.txt") == "victim");
+    CHECK(whole_ppm(slurp(d / "u.ppm")) == 8);
+}
+
+TEST_CASE("the file is made with the permissions fopen would give: 0666 less the umask") {
+    TempDir d;
+    for (mode_t mask : {(mode_t)022, (mode_t)077, (mode_t)002}) {
+        CAPTURE(mask);
+        mode_t old = umask(mask);
+        pray_status st = write_test_image(d / "m.ppm", 8);
+        umask(old);
+        REQUIRE(st == PRAY_OK);
+        struct stat sb;
+        REQUIRE(stat((d / "m.ppm").c_str(), &sb) == 0);
+        CHECK((sb.st_mode & 0777) == (0666 & ~mask));
+        fs::remove(d / "m.ppm");
+    }
+}
+
+TEST_CASE("a name of 255 bytes can be written: the temporary name is shorter") {
+    TempDir d;
+    std::string name = std::string(251, 'n') + ".ppm";
+    REQUIRE(write_test_image(d / name, 8) == PRAY_OK);
+    CHECK(whole_ppm(slurp(d / name)) == W);
+    pray_ctx *c = NULL;
+    CHECK(write_test_image(d / ("n" + name), 8, &c) == PRAY_ERR_IO);  // 256: the system's limit
+    CHECK(std::string(pray_error(c)).find("File name too long") != std::string::npos);
+    pray_free(c);
+    CHECK(d.listing() == name);
+}
+
+TEST_CASE("command line: renders to one output at once leave one whole image (8 at a time, 5 rounds)") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    TempDir d;
+    spit(d / "p.ray", "rendertiff sphere(color({1}), [0, 0, 0], 1)\n");
+    // eight widths: a file that mixes two renders has a header that does not fit its length
+    std::string script = "cd " + sq(d.path) + " && for w in 201 202 203 204 205 206 207 208; do (" +
+                         fs::absolute("pray").string() + " -s ${w}x150 -o out.ppm p.ray || echo FAILED $w) & done; wait";
+    for (int round = 0; round < 5; round++) {
+        CAPTURE(round);
+        std::string out;
+        run_cmd(script, &out);
+        CHECK(out == "");
+        int w = whole_ppm(slurp(d / "out.ppm"));
+        CHECK(w >= 201);
+        CHECK(w <= 208);
+        CHECK(d.listing() == "out.ppm p.ray");
+    }
+}
+
+TEST_CASE("command line: SIGINT or SIGTERM while writing removes the temporary file (60 runs)") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    TempDir d;
+    spit(d / "p.ray", "rendertiff nothing\n");
+    std::string prog = fs::absolute("pray").string(), out = d / "out.ppm", ray = d / "p.ray";
+    // the test's own handlers (doctest's) must not run in a child before it becomes ./pray:
+    // the signals wait, blocked, until the child has their default disposition
+    sigset_t both, before;
+    sigemptyset(&both);
+    sigaddset(&both, SIGINT);
+    sigaddset(&both, SIGTERM);
+    sigprocmask(SIG_BLOCK, &both, &before);
+    auto start = [&]() {
+        pid_t pid = fork();
+        if (pid == 0) {
+            signal(SIGINT, SIG_DFL);
+            signal(SIGTERM, SIG_DFL);
+            sigprocmask(SIG_UNBLOCK, &both, NULL);
+            execl(prog.c_str(), "pray", "--quiet", "-s", "1200x1200", "-D", "bits=16", "-o", out.c_str(), ray.c_str(),
+                  (char *)NULL);
+            _exit(127);
+        }
+        return pid;
+    };
+    // how long one run takes, to kill the others at any point of it
+    auto t0 = std::chrono::steady_clock::now();
+    pid_t pid = start();
+    int status = 0;
+    waitpid(pid, &status, 0);
+    CHECK(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 0);
+    long total = (long)std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0).count();
+    fs::remove(out);
+    srand(12345);
+    int killed = 0, finished = 0;
+    for (int i = 0; i < 60; i++) {
+        CAPTURE(i);
+        pid = start();
+        REQUIRE(pid > 0);
+        usleep((useconds_t)(rand() % (total + 1)));
+        kill(pid, i % 2 ? SIGINT : SIGTERM);
+        waitpid(pid, &status, 0);
+        if (WIFSIGNALED(status)) {
+            killed++;
+            CHECK((WTERMSIG(status) == SIGINT || WTERMSIG(status) == SIGTERM));  // died of the signal
+        } else
+            finished++;
+        CHECK(temporaries(d) == "");
+        if (exists(out)) {
+            CHECK(slurp(out).size() == 19u + 6u * 1200 * 1200);  // only ever a whole image
+            fs::remove(out);
+        }
+    }
+    sigprocmask(SIG_SETMASK, &before, NULL);
+    MESSAGE("killed ", killed, ", finished ", finished, " of 60 runs of ", total / 1000, " ms");
+    CHECK(killed > 10);
+}
+
+TEST_CASE("command line: pray refuses to write over its own program") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    TempDir d;
+    const std::string prog = "rendertiff sphere(color({1}), [0, 0, 0], 1)\n";
+    spit(d / "p.ppm", prog);
+    spit(d / "scene.tif", prog);
+    fs::create_symlink("p.ppm", d / "alias.ppm");
+    std::string out;
+    CHECK(run_cmd("./pray -s 8x8 -o " + sq(d / "p.ppm") + " " + sq(d / "p.ppm"), &out) == 3);
+    CHECK(out == d / "p.ppm" + ":1:1: error: cannot write '" + (d / "p.ppm") +
+                     "': it is the program being run (choose another output name)\n");
+    // another name for the same file
+    CHECK(run_cmd("./pray -s 8x8 -o " + sq(d / "alias.ppm") + " " + sq(d / "p.ppm"), &out) == 3);
+    CHECK(run_cmd("cd " + sq(d.path) + " && " + fs::absolute("pray").string() + " -s 8x8 -o ./p.ppm p.ppm", &out) == 3);
+    // the default name of scene.tif is scene.tif
+    CHECK(run_cmd("./pray -s 8x8 " + sq(d / "scene.tif"), &out) == 3);
+    CHECK(out.find("it is the program being run") != std::string::npos);
+    CHECK(slurp(d / "p.ppm") == prog);
+    CHECK(slurp(d / "scene.tif") == prog);
+    CHECK(d.listing() == "alias.ppm p.ppm scene.tif");
+    // another output is fine
+    CHECK(run_cmd("./pray -s 8x8 -o " + sq(d / "q.ppm") + " " + sq(d / "p.ppm"), &out) == 0);
+}
+
+TEST_CASE("command line: a FIFO, a directory or a device as program or texture is an error, never a hang") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    TempDir d;
+    REQUIRE(mkfifo((d / "fifo.tif").c_str(), 0600) == 0);
+    REQUIRE(mkfifo((d / "fifo.ray").c_str(), 0600) == 0);
+    const std::string pray = "timeout 20 " + fs::absolute("pray").string() + " -s 8x8 -o out.ppm ";
+    const char *textures[] = {"fifo.tif", ".", "/dev/zero", "/dev/null"};
+    for (const char *t : textures)
+        for (const char *mode : {"", "--untrusted "}) {
+            CAPTURE(t);
+            CAPTURE(mode);
+            spit(d / "p.ray", std::string("T = tiff(color({0}), color({1}), \"") + t + "\")\n");
+            std::string out;
+            int rc = run_cmd("cd " + sq(d.path) + " && " + pray + mode + "p.ray", &out);
+            if (*mode && t[0] == '/') {
+                CHECK(rc == 1);  // untrusted: an absolute name is refused before any open
+                CHECK(out.find("is not a relative name") != std::string::npos);
+                continue;
+            }
+            CHECK(rc == 1);
+            CHECK(out == std::string("p.ray:1:5: error: cannot read '") + t + "': not a regular file\n");
+        }
+    for (const char *p : {"fifo.ray", ".", "/dev/null"}) {
+        CAPTURE(p);
+        std::string out;
+        CHECK(run_cmd("cd " + sq(d.path) + " && " + pray + p, &out) == 3);
+        CHECK(out == std::string("pray: error: cannot read '") + p + "': not a regular file\n");
+    }
+    CHECK(d.listing() == "fifo.ray fifo.tif p.ray");
 }

@@ -4,6 +4,7 @@
 
 #include "testkit.hpp"
 
+#include <atomic>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -11,6 +12,7 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #if defined(__unix__) || defined(__APPLE__)
@@ -114,18 +116,14 @@ TEST_CASE("limit maxline: a line of exactly maxline characters, and one more") {
 
 TEST_CASE("limit maxline and maxmem while a program is read: a file or a stream that never ends") {
 #if defined(__unix__) || defined(__APPLE__)
-    // reading stops just past the first line over maxline, reported as for a finite file
+    // a program file is a regular file: a device that never ends is refused before it is read
     pray_ctx *c = pray_new();
-    pray_set_memory_limit(c, (size_t)4 << 20);
-    CHECK(pray_run_file(c, "/dev/zero") == PRAY_ERR_LIMIT);
-    CHECK(std::string(pray_error(c)) == "/dev/zero:1:65537: error: line longer than 65536 characters (option maxline)");
-    // without a line limit, the memory cap ends it
-    pray_option(c, "maxline", 1e9);
-    CHECK(pray_run_file(c, "/dev/zero") == PRAY_ERR_NOMEM);
-    CHECK(std::string(pray_error(c)) == "error: out of memory: over the context's cap of 4194304 bytes");
+    CHECK(pray_run_file(c, "/dev/zero") == PRAY_ERR_IO);
+    CHECK(std::string(pray_error(c)) == "error: cannot read '/dev/zero': not a regular file");
     pray_free(c);
-    // standard input ("-") is read the same way, by the command line too: one message, no
-    // empty line after it
+    // standard input ("-") may be a stream that never ends: reading stops just past the first
+    // line over maxline, reported as for a finite file, and without a line limit the memory cap
+    // ends it; one message, no empty line after it
     auto pray_cmd = [](const std::string &args) {
         std::string out;
         FILE *p = popen(("t=; command -v timeout >/dev/null && t='timeout 60'; $t ./pray " + args + " 2>&1").c_str(), "r");
@@ -140,8 +138,7 @@ TEST_CASE("limit maxline and maxmem while a program is read: a file or a stream 
     CHECK(pray_cmd("--untrusted - </dev/zero") == "1 stdin.ray:1:4097: error: line longer than 4096 characters (option maxline)\n");
     CHECK(pray_cmd("-D maxline=1000000000 -D maxmem=16 - </dev/zero") ==
           "1 pray: error: out of memory: over the cap of 16 MiB (option maxmem)\n");
-    CHECK(pray_cmd("-D maxline=1000000000 -D maxmem=16 /dev/zero") ==
-          "1 pray: error: out of memory: over the cap of 16 MiB (option maxmem)\n");
+    CHECK(pray_cmd("-D maxline=1000000000 -D maxmem=16 /dev/zero") == "3 pray: error: cannot read '/dev/zero': not a regular file\n");
     CHECK(pray_cmd("- <examples/redsph.ray -s 4x4 -o limits_stdin.ppm") == "0 ");
     std::remove("limits_stdin.ppm");
 #endif
@@ -188,6 +185,65 @@ TEST_CASE("limit maxpixels: samples of an image, antialias counted") {
     pray_image_free(c, &img);
     pray_release(c, s);
     pray_free(c);
+}
+
+TEST_CASE("limit maxframes: N frames with maxframes N, the one after refused before it is rendered") {
+    std::string prog = std::string(TINY) + "rendertiff nothing\nrendertiff nothing\nrendertiff nothing\nprint 1\n";
+    at_and_past("maxframes", 3, prog, "5:1: error: more than 2 frames (option maxframes)");
+    Result r = testkit::run(prog, {"maxframes=2"});
+    CHECK(r.status == PRAY_ERR_LIMIT);
+    CHECK(r.frames.size() == 2);
+    CHECK(testkit::run(prog, {"maxframes=0"}).printed == "1\n");  // 0: no limit
+    // an endless loop of frames stops at the limit
+    r = testkit::run(std::string(TINY) + "while 1\n  rendertiff nothing\nendwhile\n", {"maxframes=50"});
+    CHECK(r.error == "test.ray:4:3: error: more than 50 frames (option maxframes)");
+    CHECK(r.frames.size() == 50);
+}
+
+TEST_CASE("limit maxoutput: image files up to N MiB, not a byte more, and nothing half written") {
+    const std::string dir = "limits_output";
+    REQUIRE(std::system(("rm -rf " + dir + " && mkdir " + dir).c_str()) == 0);
+    // a 1285 x 272 8-bit PPM is 16 bytes of header and 1048560 of samples: exactly 1 MiB
+    std::string one = "option \"width\", 1285\noption \"height\", 272\noption \"output\", \"" + dir + "/a.ppm\"\n"
+                      "rendertiff nothing\n";
+    std::string more = one + "option \"width\", 1\noption \"height\", 1\noption \"output\", \"" + dir + "/b.ppm\"\n"
+                       "rendertiff nothing\n";
+    auto run = [&](const std::string &prog, const char *limit, std::string *err) {
+        pray_ctx *c = pray_new();
+        pray_option_fix(c, "maxoutput", limit);
+        pray_status st = pray_run_string(c, "out.ray", prog.data(), prog.size());
+        *err = pray_error(c);
+        pray_free(c);
+        return st;
+    };
+    auto listing = [&]() {
+        std::string out;
+        FILE *p = popen(("ls -A " + dir).c_str(), "r");
+        char buf[256];
+        while (p && fgets(buf, sizeof buf, p)) out += buf;
+        if (p) pclose(p);
+        return out;
+    };
+    std::string err;
+    CHECK(run(one, "1", &err) == PRAY_OK);
+    std::ifstream a((dir + "/a.ppm").c_str(), std::ios::binary | std::ios::ate);
+    CHECK((long)a.tellg() == 1048576L);
+    CHECK(run(more, "1", &err) == PRAY_ERR_LIMIT);  // one byte more is refused
+    CHECK(err == "out.ray:8:1: error: '" + dir + "/b.ppm' would take the images written over 1 MiB (option maxoutput)");
+    CHECK(listing() == "a.ppm\n");  // the second file is not there, nor its temporary file
+    CHECK(run(more, "2", &err) == PRAY_OK);
+    CHECK(listing() == "a.ppm\nb.ppm\n");
+    CHECK(run(more, "0", &err) == PRAY_OK);  // 0: no limit
+    // a file over the limit by itself is not left half written
+    REQUIRE(std::system(("rm -f " + dir + "/*").c_str()) == 0);
+    pray_ctx *k = pray_new();
+    CHECK(pray_option(k, "maxoutput", 0.5) == PRAY_ERR_ARG);  // whole MiB only
+    pray_free(k);
+    std::string big = "option \"width\", 1400\noption \"height\", 272\noption \"output\", \"" + dir + "/c.tif\"\n"
+                      "rendertiff nothing\n";
+    CHECK(run(big, "1", &err) == PRAY_ERR_LIMIT);
+    CHECK(listing() == "");
+    REQUIRE(std::system(("rm -rf " + dir).c_str()) == 0);
 }
 
 TEST_CASE("limit depth: rays between two mirrors stop at the depth, and 64 is the most") {
@@ -297,10 +353,11 @@ TEST_CASE("untrusted mode: every limit gets its ceiling; higher values and 'no l
     const struct {
         const char *name;
         double ceiling;
-    } ceilings[] = {{"depth", 16},         {"gridmem", 64},           {"maxline", 4096},
-                    {"maxmem", 1024},      {"maxnest", 64},           {"maxpixels", 16777216},
-                    {"maxprims", 1048576}, {"maxrays", 256},          {"maxsteps", 1000000},
-                    {"maxstring", 4096},   {"texmem", 64}};
+    } ceilings[] = {{"depth", 16},         {"gridmem", 64},           {"maxframes", 1000},
+                    {"maxline", 4096},     {"maxmem", 1024},          {"maxnest", 64},
+                    {"maxoutput", 1024},   {"maxpixels", 16777216},   {"maxprims", 1048576},
+                    {"maxrays", 256},      {"maxsteps", 1000000},     {"maxstring", 4096},
+                    {"texmem", 64}};
     pray_ctx *c = pray_new();
     pray_option(c, "maxsteps", 0);
     pray_option(c, "depth", 3);
@@ -337,6 +394,8 @@ TEST_CASE("untrusted mode: files only from the program's directory") {
     write_sphere_tiffs({dir + "/red.tif", dir + "/sub/red.tif", "limits_outside.tif"}, 4, pray_rgb{1, 0, 0}, 9);
 #ifdef HAVE_SYMLINK
     REQUIRE(symlink("../limits_outside.tif", (dir + "/link.tif").c_str()) == 0);
+    REQUIRE(symlink("red.tif", (dir + "/inlink.tif").c_str()) == 0);
+    REQUIRE(symlink("sub", (dir + "/sublink").c_str()) == 0);
 #endif
     auto run = [&](const std::string &file, bool untrusted, const std::string &output = "") {
         std::string prog = std::string(TINY) + "M = color({1})\nT = tiff(M, M, \"" + file + "\")\n";
@@ -359,9 +418,18 @@ TEST_CASE("untrusted mode: files only from the program's directory") {
     CHECK(run("C:/x.tif", true).find("is not a relative name") != std::string::npos);
     CHECK(run("", true).find("is an empty name") != std::string::npos);
 #ifdef HAVE_SYMLINK
-    CHECK(run("link.tif", true) == where + "link.tif' is a link that leads out of the program's directory; files are read from the program's directory only");
+    // no link is followed, wherever it leads: the name is walked from the program's directory
+    const std::string tail = "; files are read from the program's directory only, and links are not followed";
+    CHECK(run("link.tif", true) == where + "link.tif' is a symbolic link" + tail);
+    CHECK(run("inlink.tif", true) == where + "inlink.tif' is a symbolic link" + tail);
+    CHECK(run("sublink/red.tif", true) == where + "sublink/red.tif' passes through the symbolic link 'sublink'" + tail);
+    CHECK(run("sub//red.tif", true) == "");
     CHECK(run("link.tif", false) == "");  // trusted: read wherever the link leads
+    CHECK(run("sublink/red.tif", false) == "");
 #endif
+    // not a regular file
+    CHECK(run(".", true) == dir + "/p.ray:4:5: error: cannot read '" + dir + "/.': not a regular file");
+    CHECK(run("sub", false) == dir + "/p.ray:4:5: error: cannot read '" + dir + "/sub': not a regular file");
     CHECK(run("../limits_outside.tif", false) == "");
     // a file in the current directory is not looked for when untrusted
     CHECK(run("limits_outside.tif", true).find("cannot open") != std::string::npos);
@@ -373,6 +441,89 @@ TEST_CASE("untrusted mode: files only from the program's directory") {
     CHECK(run("red.tif", false, "sub/x.tif") == "");
     REQUIRE(std::system(clean.c_str()) == 0);
     std::remove("limits_outside.tif");
+}
+
+TEST_CASE("untrusted mode: a texture swapped for a link while it is opened never leads out (1000 runs)") {
+#ifdef HAVE_SYMLINK
+    // t.tif is, in turn, a link to a file outside (not a TIFF: reading it would say so) and a
+    // hard link to the TIFF beside the program; each swap is one rename, so the name always exists
+    const std::string dir = "limits_race";
+    REQUIRE(std::system(("rm -rf " + dir + " && mkdir " + dir).c_str()) == 0);
+    write_sphere_tiffs({dir + "/real.tif"}, 4, pray_rgb{1, 0, 0}, 9);
+    write_text("limits_race_outside.txt", "a secret outside the program's directory\n");
+    write_text(dir + "/p.ray", "M = color({1})\nT = tiff(M, M, \"t.tif\")\n");
+    REQUIRE(link((dir + "/real.tif").c_str(), (dir + "/t.tif").c_str()) == 0);
+    std::atomic<bool> stop(false);
+    std::thread swapper([&] {
+        const std::string l = dir + "/swap.l", r = dir + "/swap.r", t = dir + "/t.tif";
+        while (!stop) {
+            if (symlink("../limits_race_outside.txt", l.c_str()) == 0) rename(l.c_str(), t.c_str());
+            if (link((dir + "/real.tif").c_str(), r.c_str()) == 0) rename(r.c_str(), t.c_str());
+        }
+    });
+    int ok = 0, refused = 0, other = 0;
+    std::string odd;
+    for (int i = 0; i < 1000; i++) {
+        pray_ctx *c = pray_new();
+        pray_set_untrusted(c);
+        if (pray_run_file(c, (dir + "/p.ray").c_str()) == PRAY_OK) ok++;
+        else if (std::string(pray_error(c)).find("'t.tif' is a symbolic link") != std::string::npos) refused++;
+        else {
+            other++;
+            odd = pray_error(c);
+        }
+        pray_free(c);
+    }
+    stop = true;
+    swapper.join();
+    CAPTURE(odd);
+    CHECK(other == 0);  // before the walk without links: 13 to 204 of 1000 read the file outside
+    CHECK(ok > 0);
+    CHECK(refused > 0);
+    MESSAGE("read the TIFF ", ok, " times, refused the link ", refused, " times");
+    REQUIRE(std::system(("rm -rf " + dir).c_str()) == 0);
+    std::remove("limits_race_outside.txt");
+#endif
+}
+
+TEST_CASE("long names: a program under a path of 600 bytes, texture names of 1100, nothing is cut") {
+    const std::string dir = "limits_long";
+    REQUIRE(std::system(("rm -rf " + dir + " && mkdir -p " + dir + "/d").c_str()) == 0);
+    write_sphere_tiffs({dir + "/d/lp.tif", dir + "/d/red.tif"}, 4, pray_rgb{1, 0, 0}, 9);
+    write_text("lp.tif", "a file of the same name in the current directory\n");
+    write_text(dir + "/d/red", "the file a name cut at 1100 bytes would open\n");
+    auto run = [&](const std::string &prog_path, const std::string &tex, bool untrusted) {
+        write_text(dir + "/d/p.ray", "M = color({1})\nT = tiff(M, M, \"" + tex + "\")\n");
+        pray_ctx *c = pray_new();
+        if (untrusted) pray_set_untrusted(c);
+        pray_status st = pray_run_file(c, prog_path.c_str());
+        std::string e = st == PRAY_OK ? "" : pray_error(c);
+        pray_free(c);
+        return e;
+    };
+    // (1) the program's directory is longer than 512 bytes: its textures are still beside it
+    std::string far = dir + "/d/" + repeat("./", 300) + "p.ray";
+    CHECK(run(far, "lp.tif", true) == "");
+    // (2) a texture name that made "directory + name" 1100 bytes, cut to ".../red"
+    std::string near = dir + "/d/p.ray";
+    std::string name = "." + repeat("/", 1099 - (int)(dir + "/d/").size() - 4) + "red.tif";
+    CHECK(run(near, name, true) == "");
+    CHECK(run(near, name, false) == "");
+    // (3) a name the system cannot take fails with its reason, not with another file
+    std::string huge = repeat("x", 5000) + ".tif";
+    std::string e = run(near, huge, false);
+    CHECK(e.find("File name too long") != std::string::npos);
+    // (4) the message keeps the place and the reason: the path is shortened, from its start
+    std::string farther = dir + "/d/" + repeat("./", 520) + "p.ray";
+    e = run(farther, "nosuch.tif", false);
+    CHECK(e.find("...") == 0);
+    CHECK(e.size() < 300);
+    CHECK(e.find("/./p.ray:2:5: error: cannot open 'nosuch.tif': No such file or directory") != std::string::npos);
+    e = run(farther, "nosuch.tif", true);  // untrusted: the name beside the program, shortened
+    CHECK(e.find("/./p.ray:2:5: error: cannot open '...") != std::string::npos);
+    CHECK(e.find("/./nosuch.tif': No such file or directory") != std::string::npos);
+    REQUIRE(std::system(("rm -rf " + dir).c_str()) == 0);
+    std::remove("lp.tif");
 }
 
 // ---------------------------------------------------------------------------------------------

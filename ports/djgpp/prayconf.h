@@ -10,11 +10,11 @@
 /* No stb_image_write on DOS: pray writes TIFF and PPM, both in binary mode. */
 #define PRAY_NO_PNG
 
-/* 8.3 file names. While an image is written it has a temporary name: pray.cpp appends
-   PRAY_TEMP_SUFFIX to the file name (CSG.TIF -> CSG.TIF.$$$), which only a DOS with long file
-   names (LFN=y: Windows 9x/XP DOS boxes, DOSLFN) can hold; and frames after the first are named
-   NAME_0001.TIF, which is 8.3 only for names of 3 characters. PRAY_8_3_NAMES asks for
-   CSG.$$$ (the suffix replaces the extension) and FRA_0001.TIF (the name shortened). */
+/* 8.3 file names. While an image is written it has a unique temporary name, by default
+   .CSG.TIF.XXXXXX + PRAY_TEMP_SUFFIX, which only a DOS with long file names (LFN=y: Windows
+   9x/XP DOS boxes, DOSLFN) can hold; and frames after the first are named NAME_0001.TIF, which is
+   8.3 only for names of 3 characters. PRAY_8_3_NAMES asks for CSXXXXXX.$$$ (two characters of
+   the name, six unique ones, the suffix as extension) and FRA_0001.TIF (the name shortened). */
 #define PRAY_TEMP_SUFFIX ".$$$"
 #define PRAY_8_3_NAMES
 

@@ -6,21 +6,53 @@
 //   build/fuzz/fuzz_program tests/fuzz/crashes/FILE   replay one input
 //
 // Every run gets small caps, fixed so that the program's own `option` statements cannot raise
-// them: 8 x 8 pixels, ray depth 3, 20000 statements, one thread, 64 MiB of memory. `print` output is
-// discarded and frames go to a callback, which encodes them as TIFF and PPM into memory: nothing
-// is written to files.
+// them: 8 x 8 pixels, ray depth 3, 20000 statements, 16 frames, one thread, 64 MiB of memory.
+// `print` output is discarded and frames go to a callback, which encodes them as TIFF and PPM into
+// memory: nothing is written to files.
+//
+// Texture files: at start-up the harness writes a 4 x 4 TIFF `t.tif` and a 16 x 16 font atlas
+// `f.tif` into a temporary directory of its own (removed at exit), and runs every input as the
+// program `DIR/fuzz.ray`, so that `tiff(M, M, "t.tif")` and `text(..., "f.tif", 1)` read them
+// (beside the program); other names reach the file system through the same opener.
 //
 // Besides the sanitizers, the harness checks what the API promises about failures: a failing
 // run returns a known status and leaves a message; a message of a program error starts with
-// "fuzz.ray:LINE:COL: error: ". A broken promise aborts, so libFuzzer reports it as a crash.
+// "DIR/fuzz.ray:LINE:COL: error: ". A broken promise aborts, so libFuzzer reports it as a crash.
 #include "../../pray.hpp"
 
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
+
+#include <string>
 
 namespace {
+
+std::string dir;      // the harness's directory, holding t.tif and f.tif
+std::string program;  // DIR/fuzz.ray: the name every input runs under
+
+void remove_dir() {
+    unlink((dir + "/t.tif").c_str());
+    unlink((dir + "/f.tif").c_str());
+    rmdir(dir.c_str());
+}
+
+// A width x height TIFF of stripes, written by pray itself.
+void write_tiff(const std::string &path, int width, int height) {
+    pray_ctx *c = pray_new();
+    float *px = (float *)calloc((size_t)width * height * 3, sizeof(float));
+    if (!c || !px) abort();
+    for (int i = 0; i < width * height * 3; i++) px[i] = (float)((i / 3 % width + i / 3 / width) % 3) / 2;
+    pray_image img = {width, height, px};
+    if (pray_write_image(c, &img, path.c_str(), 8) != PRAY_OK) {
+        fprintf(stderr, "fuzz_program: cannot write %s: %s\n", path.c_str(), pray_error(c));
+        abort();
+    }
+    free(px);
+    pray_free(c);
+}
 
 void byte_sink(void *ud, const void *data, size_t n) {
     const unsigned char *p = static_cast<const unsigned char *>(data);
@@ -55,11 +87,11 @@ void broken(const char *what, pray_status st, const char *msg) {
     abort();
 }
 
-// "fuzz.ray:" digits ":" digits ": error: "
+// "DIR/fuzz.ray:" digits ":" digits ": error: "
 bool has_place(const char *m) {
-    const char *p = "fuzz.ray:";
-    if (strncmp(m, p, strlen(p)) != 0) return false;
-    m += strlen(p);
+    std::string p = program + ":";
+    if (strncmp(m, p.c_str(), p.size()) != 0) return false;
+    m += p.size();
     for (int part = 0; part < 2; part++) {
         if (*m < '0' || *m > '9') return false;
         while (*m >= '0' && *m <= '9') m++;
@@ -70,6 +102,17 @@ bool has_place(const char *m) {
 
 } // namespace
 
+extern "C" int LLVMFuzzerInitialize(int *, char ***) {
+    char tmpl[] = "/tmp/pray-fuzz.XXXXXX";
+    if (!mkdtemp(tmpl)) abort();
+    dir = tmpl;
+    program = dir + "/fuzz.ray";
+    atexit(remove_dir);
+    write_tiff(dir + "/t.tif", 4, 4);
+    write_tiff(dir + "/f.tif", 64, 64);  // 16 x 16 cells of 4 x 4 pixels
+    return 0;
+}
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     pray_ctx *c = pray_new();
     if (!c) return 0;
@@ -78,12 +121,12 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     long frames = 0;
     pray_set_frame(c, frame_sink, &frames);
     static const char *const caps[][2] = {
-        {"maxsteps", "20000"}, {"width", "8"}, {"height", "8"}, {"depth", "3"}, {"threads", "1"},
+        {"maxsteps", "20000"}, {"width", "8"}, {"height", "8"}, {"depth", "3"}, {"threads", "1"}, {"maxframes", "16"},
     };
     for (size_t i = 0; i < sizeof caps / sizeof caps[0]; i++)
         if (pray_option_fix(c, caps[i][0], caps[i][1]) != PRAY_OK) broken("a cap was refused", pray_last_status(c), pray_error(c));
 
-    pray_status st = pray_run_string(c, "fuzz.ray", (const char *)data, size);
+    pray_status st = pray_run_string(c, program.c_str(), (const char *)data, size);
     const char *msg = pray_error(c);
     if (!msg) broken("pray_error returned NULL", st, msg);
     if (st != PRAY_OK) {
@@ -92,7 +135,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         if (!strstr(msg, "error: ")) broken("a message without 'error: '", st, msg);
         // Syntax and runtime errors are errors of the program: they name the place.
         if ((st == PRAY_ERR_SYNTAX || st == PRAY_ERR_RUNTIME) && !has_place(msg))
-            broken("a program error without fuzz.ray:line:col", st, msg);
+            broken("a program error without DIR/fuzz.ray:line:col", st, msg);
     }
     if (pray_frames(c) < 0) broken("negative frame count", st, msg);
     pray_free(c);
