@@ -6538,6 +6538,9 @@ FILE *create_temp(pray_ctx *c, const char *path, char **tmp) {
         snprintf(*tmp, d + keep + 16 + sizeof PRAY_TEMP_SUFFIX, "%.*s%s%.*s%s%s%s", (int)d, path, lead, (int)keep,
                  path + d, dot, id, PRAY_TEMP_SUFFIX);
         errno = 0;
+        // named before it exists: a signal from here on finds the name (pray_temp_file); one
+        // that comes before the file does removes nothing
+        c->temp_name = *tmp;
 #if PRAY_FILES_FD
         int fd = fd_open(*tmp, 1);
         if (fd >= 0 && !(f = fd_stdio(fd, "wb"))) {
@@ -6554,6 +6557,7 @@ FILE *create_temp(pray_ctx *c, const char *path, char **tmp) {
         } else
             f = fopen(*tmp, "wb");
 #endif
+        if (!f) c->temp_name = NULL;
     }
     return f;
 }
@@ -7302,8 +7306,7 @@ pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *pat
     double mib = c->cur.opt.v[OPT_MAXOUTPUT];
     fs.room = mib > 0 ? mib * 1048576.0 - c->written : HUGE_VAL;
     pray_status st = PRAY_OK;
-    if (fs.f) {
-        c->temp_name = tmp;  // for pray_temp_file: a signal handler may remove it
+    if (fs.f) {  // (create_temp has named it for pray_temp_file: a signal handler may remove it)
         Sink s = {file_put, &fs};
         st = write_format(c, img, fmt, bits, s);
         if (fflush(fs.f) != 0 && !fs.err) fs.err = errno ? errno : EIO;
