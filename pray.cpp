@@ -117,6 +117,8 @@
 #include <io.h>
 #include <sys/stat.h>
 #include <windows.h>
+#undef near  // 16-bit pointer words that windows.h still defines (to nothing)
+#undef far
 #elif defined(__unix__) || defined(__APPLE__) || defined(__DJGPP__)
 #include <fcntl.h>
 #include <sys/stat.h>
