@@ -11,7 +11,7 @@
    [SECTION] 8  Ray/primitive intersection
    [SECTION] 9  CSG status-tree sweep (the brute-force reference, thesis 3.4)
    [SECTION] 9b Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
-   [SECTION] 9c TIFF reader and textures, the built-in font
+   [SECTION] 9c Reading files (programs, textures, fonts), TIFF reader and textures, the built-in font
    [SECTION] 10 Whitted shading, textured surfaces, the render driver (threads, undersampling)
    [SECTION] 11 Image writers: TIFF, PPM, PNG; writing files safely; public functions
    [SECTION] 12 PRAY lexer
@@ -4650,7 +4650,7 @@ void primary_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, Visit &
 }
 
 // =============================================================================================
-// [SECTION] 9c TIFF reader and textures: baseline TIFF in both byte orders for textures and fonts
+// [SECTION] 9c Reading files; TIFF reader and textures: baseline TIFF in both byte orders for textures and fonts
 // =============================================================================================
 // Bilevel, greyscale, palette, RGB and RGBA; 1, 4, 8 and 16 bits per sample; strips and tiles;
 // no compression, PackBits, LZW with or without the horizontal predictor. Every offset and size
