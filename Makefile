@@ -148,8 +148,8 @@ pov: $(PRAY)
 charts: $(PRAY) textures
 	bench/charts.sh
 
-# Every configuration macro on its own, float and double, C++98/11/17, warnings as errors.
-MATRIX_STDS = -std=c++98 -std=c++11 -std=c++17
+# Every configuration macro on its own, float and double, C++98/11/17/20, warnings as errors.
+MATRIX_STDS = -std=c++98 -std=c++11 -std=c++17 -std=c++20
 MATRIX_DEFS = "" -DPRAY_REAL=float -DPRAY_NO_INTERP -DPRAY_NO_STDIO -DPRAY_NO_PNG -DPRAY_NO_THREADS \
               -DPRAY_NO_DEFAULT_ALLOC "-DPRAY_MAX_ALLOC=1000000" "-DPRAY_MAIN" "-DPRAY_MAIN -DPRAY_REAL=float" \
               $(foreach h,$(wildcard ports/*/prayconf.h),'-DPRAY_MAIN -DPRAY_USER_CONFIG="$(h)"')

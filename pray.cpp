@@ -1975,7 +1975,7 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
             int j = i + 1;
             for (; j < n && o[j].kind == a.kind; j++) {
                 // normals and axes are unit vectors: absolute; positions relative to their scale
-                bool unit = a.kind != O_SPHERE && comp <= 3;
+                bool unit = a.kind != (double)O_SPHERE && comp <= 3;
                 double m = scale[a.prim] > scale[o[j].prim] ? scale[a.prim] : scale[o[j].prim];
                 if (o[j].v - a.v > (unit ? 8 * eps : 8 * eps * m)) break;
                 k[o[j].prim].v[comp] = a.v;
