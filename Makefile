@@ -4,7 +4,7 @@
 #   make textures   the examples' TIFF textures, rendered by examples/maketex.ray into examples/tex/
 #   make gallery    render every example into docs/gallery/ and write docs/gallery.md (tools/gallery.sh)
 #   make check      build and run all tests (installs the test packages if missing)
-#   make matrix     compile pray.cpp under every configuration macro and language level
+#   make matrix     compile pray.cpp under every configuration macro and language level, g++ and clang++
 #   make bench      the acceleration benchmarks (bench/run.sh), results in docs/benchmarks.md
 #   make pov        pray against POV-Ray 3.7 (bench/pov.sh; installs povray)
 #   make charts     speed against accuracy and the benchmarks, drawn (bench/charts.sh), docs/images/bench-*.png
@@ -33,12 +33,21 @@ TESTS = tests/pray_tests$(EXE)
 TESTS_FLOAT = tests/pray_tests_float$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
-.PHONY: all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff fuzz-long textures gallery ports pov charts
+.PHONY: FORCE all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff fuzz-long textures gallery ports pov charts
 
 all: $(PRAY)
 
-$(PRAY): pray.cpp pray.hpp
+$(PRAY): pray.cpp pray.hpp build/png
 	$(CXX) -std=c++98 $(CXXFLAGS) -DPRAY_MAIN pray.cpp -o $@ $(LDLIBS)
+
+# pray writes PNG when the compiler finds <stb/stb_image_write.h> (Debian libstb-dev). build/png
+# says whether it does, and changes (so everything is built again) when the header comes or goes,
+# e.g. when make check has installed it after make examples.
+build/png: FORCE
+	@mkdir -p build; \
+	if echo '#include <stb/stb_image_write.h>' | $(CXX) -E -x c++ - >/dev/null 2>&1; then s=yes; else s=no; fi; \
+	[ "$$(cat $@ 2>/dev/null)" = $$s ] || echo $$s >$@
+FORCE:
 
 # Install what the tests need when it is missing (Debian/Ubuntu; as root or through sudo).
 deps:
@@ -58,15 +67,15 @@ examples: $(PRAY) textures
 	  printf '%-12s' $$n; $(RUN) ./$(PRAY) --quiet -o out/$$n.$$ext $$f >/dev/null || exit 1; echo " -> out/$$n.$$ext"; \
 	done
 
-$(TESTS): $(TEST_SRC) tests/*.hpp pray.cpp pray.hpp
+$(TESTS): $(TEST_SRC) tests/*.hpp pray.cpp pray.hpp build/png
 	$(CXX) $(TESTFLAGS) $(TEST_SRC) -o $@ $(LDLIBS) -lpthread
 
 # The same tests with the renderer in single precision (PRAY_REAL=float).
-$(TESTS_FLOAT): $(TEST_SRC) tests/*.hpp pray.cpp pray.hpp
+$(TESTS_FLOAT): $(TEST_SRC) tests/*.hpp pray.cpp pray.hpp build/png
 	$(CXX) $(TESTFLAGS) -DPRAY_REAL=float $(TEST_SRC) -o $@ $(LDLIBS) -lpthread
 
 # The C example: pray.hpp must be usable from C.
-tests/embed$(EXE): examples/embed.c pray.cpp pray.hpp
+tests/embed$(EXE): examples/embed.c pray.cpp pray.hpp build/png
 	$(CC) -std=c99 -pedantic -Wall -Wextra -Werror -I. -c examples/embed.c -o tests/embed.o
 	$(CXX) -std=c++98 $(CXXFLAGS) -c pray.cpp -o tests/pray.o
 	$(CXX) tests/embed.o tests/pray.o -o $@ $(LDLIBS)
@@ -148,16 +157,10 @@ pov: $(PRAY)
 charts: $(PRAY) textures
 	bench/charts.sh
 
-# Every configuration macro on its own, float and double, C++98/11/17/20, warnings as errors.
-MATRIX_STDS = -std=c++98 -std=c++11 -std=c++17 -std=c++20
-MATRIX_DEFS = "" -DPRAY_REAL=float -DPRAY_NO_INTERP -DPRAY_NO_STDIO -DPRAY_NO_PNG -DPRAY_NO_THREADS \
-              -DPRAY_NO_DEFAULT_ALLOC "-DPRAY_MAX_ALLOC=1000000" "-DPRAY_MAIN" "-DPRAY_MAIN -DPRAY_REAL=float" \
-              $(foreach h,$(wildcard ports/*/prayconf.h),'-DPRAY_MAIN -DPRAY_USER_CONFIG="$(h)"')
+# Every configuration macro and port configuration at C++98 and the newest level, the levels
+# between with the default one, under g++ and clang++, warnings as errors (tests/matrix.sh).
 matrix:
-	@for s in $(MATRIX_STDS); do for d in $(MATRIX_DEFS); do \
-	  printf '%-12s %-36s ' "$$s" "$$d"; \
-	  $(CXX) $$s $(OPT) $(WARN) -Werror -fno-exceptions -fno-rtti $$d -c pray.cpp -o /dev/null || exit 1; \
-	  echo ok; done; done
+	sh tests/matrix.sh
 
 # Every port built, run under qemu-user or wine, its images compared with ./pray's (ports/README.md).
 ports:

@@ -84,12 +84,20 @@
 #define PRAY_HAS_DEFAULT_ALLOC 1
 #endif
 
-// PNG output through the system's stb_image_write, when it is there.
+// PNG output through the system's stb_image_write, when it is there. Its memory comes from the
+// context writing the PNG (section 11: png_alloc); an allocation it cannot have ends the encoding
+// there, so its own checks (asserts) are not needed.
 #define PRAY_HAS_PNG 0
-#if !defined(PRAY_NO_PNG) && PRAY_HAS_STDIO && defined(__has_include)
+#if !defined(PRAY_NO_PNG) && defined(__has_include)
 #if __has_include(<stb/stb_image_write.h>)
 #undef PRAY_HAS_PNG
 #define PRAY_HAS_PNG 1
+#include <setjmp.h>
+static void *png_alloc(void *p, size_t n);
+#define STBIW_MALLOC(n) png_alloc(NULL, n)
+#define STBIW_REALLOC(p, n) png_alloc(p, n)
+#define STBIW_FREE(p) png_alloc(p, 0)
+#define STBIW_ASSERT(x) ((void)0)
 #define STB_IMAGE_WRITE_STATIC
 #define STB_IMAGE_WRITE_IMPLEMENTATION
 #define STBI_WRITE_NO_STDIO
@@ -6427,13 +6435,51 @@ void png_sink(void *ud, void *data, int size) {
     s->put(data, (size_t)size);
 }
 
+// The PNG being encoded on this thread: its context, the blocks the encoder holds (a list of
+// their own, so a failed encoding can free them all), and where to go when an allocation fails.
+struct PngEncoding {
+    pray_ctx *c;
+    Block held;
+    jmp_buf failed;
+};
+#if !PRAY_HAS_THREADS
+PngEncoding *png_now;
+#elif __cplusplus >= 201103L
+thread_local PngEncoding *png_now;
+#elif defined(_MSC_VER)
+__declspec(thread) PngEncoding *png_now;
+#else
+__thread PngEncoding *png_now;
+#endif
+
+void png_hold(PngEncoding *e, void *p) {
+    Block *b = (Block *)p - 1;  // from the context's list to the encoding's
+    b->prev->next = b->next;
+    b->next->prev = b->prev;
+    b->prev = &e->held;
+    b->next = e->held.next;
+    e->held.next->prev = b;
+    e->held.next = b;
+}
+
 pray_status write_png(pray_ctx *c, const pray_image *img, Sink &out) {
     size_t n = (size_t)img->width * img->height * 3;
     unsigned char *buf = (unsigned char *)mem_alloc(c, n);
     if (!buf) return c->status;
     for (size_t i = 0; i < n; i++) buf[i] = (unsigned char)quantize(img->pixels[i], 255);
-    int ok = stbi_write_png_to_func(png_sink, &out, img->width, img->height, 3, buf, img->width * 3);
+    PngEncoding e;
+    e.c = c;
+    e.held.next = e.held.prev = &e.held;
+    png_now = &e;
+    // Called through a volatile pointer: never inlined here, where its locals would be live across the setjmp.
+    int (*volatile encode)(stbi_write_func *, void *, int, int, int, const void *, int) = stbi_write_png_to_func;
+    int ok = 0, nomem = 0;
+    if (!setjmp(e.failed)) ok = encode(png_sink, &out, img->width, img->height, 3, buf, img->width * 3);
+    else nomem = 1;  // png_alloc: the message is in the context
+    png_now = NULL;
+    while (e.held.next != &e.held) mem_free(c, e.held.next + 1);
     mem_free(c, buf);
+    if (nomem) return c->status;
     return ok ? PRAY_OK : fail(c, PRAY_ERR_NOMEM, "PNG encoder failed");
 }
 #endif
@@ -6566,6 +6612,21 @@ FILE *create_temp(pray_ctx *c, const char *path, char **tmp) {
 #endif
 
 } // namespace
+
+#if PRAY_HAS_PNG
+// stb_image_write's malloc (p NULL), realloc and free (n 0), on the context of png_now.
+static void *png_alloc(void *p, size_t n) {
+    PngEncoding *e = png_now;
+    if (!n) {
+        mem_free(e->c, p);
+        return NULL;
+    }
+    void *q = mem_realloc(e->c, p, n);
+    if (!q) longjmp(e->failed, 1);
+    png_hold(e, q);
+    return q;
+}
+#endif
 
 
 // ---------------------------------------------------------------------------------------------
@@ -7282,6 +7343,18 @@ pray_status pray_write_ppm(pray_ctx *c, const pray_image *img, int bits, pray_wr
     if (bits != 8 && bits != 16) return fail(c, PRAY_ERR_ARG, "bits must be 8 or 16");
     Sink s = {fn, ud};
     return write_ppm(c, img, bits, s);
+}
+
+pray_status pray_write_png(pray_ctx *c, const pray_image *img, pray_write_fn fn, void *ud) {
+    if (!image_ok(c, img)) return c->status;
+#if PRAY_HAS_PNG
+    Sink s = {fn, ud};
+    return write_png(c, img, s);
+#else
+    (void)fn;
+    (void)ud;
+    return fail(c, PRAY_ERR_ARG, "this build cannot write PNG");
+#endif
 }
 
 pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *path, int bits) {
@@ -9536,10 +9609,15 @@ pray_status pray_render_file(const char *program, const char *const *options, in
 
 namespace {
 
+#if PRAY_HAS_PNG
+#define PRAY_FORMATS ".tif, .ppm or .png"
+#else
+#define PRAY_FORMATS ".tif or .ppm"
+#endif
 const char *const USAGE =
     "usage: pray [options] program.ray\n"
     "Render a PRAY program. Options:\n"
-    "  -o FILE          output file (.tif, .ppm or .png); same as -D output=FILE\n"
+    "  -o FILE          output file (" PRAY_FORMATS "); same as -D output=FILE\n"
     "  -s WxH           image size in pixels; same as -D width=W -D height=H\n"
     "  -D name=value    set an option of the language; wins over `option` in the program\n"
     "  --stats          print statistics of the rendering to standard error\n"

@@ -325,6 +325,9 @@ pray_status pray_write_tiff(pray_ctx *ctx, const pray_image *img, int bits, pray
                             void *ud);
 pray_status pray_write_ppm(pray_ctx *ctx, const pray_image *img, int bits, pray_write_fn fn,
                            void *ud);
+/* PNG (8 bits) into a byte sink; PRAY_ERR_ARG when the build has no PNG writer (pray_features
+   lists "png" when it has). Its memory comes from the context and counts against its cap. */
+pray_status pray_write_png(pray_ctx *ctx, const pray_image *img, pray_write_fn fn, void *ud);
 
 /* One call: run a program file with optional fixed options ("name=value" strings). */
 pray_status pray_render_file(const char *program, const char *const *options, int noptions,

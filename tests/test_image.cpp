@@ -372,6 +372,18 @@ TEST_CASE("writers into a byte sink give the same bytes as the files") {
         CHECK(slurp(d / "x.tif") == tif);
         CHECK(slurp(d / "x.ppm") == ppm);
     }
+    // PNG: the same bytes through the sink as in the file, or refused by a build without it
+    std::string png;
+    pray_status st = pray_write_png(c, &img, testkit::print_sink, &png);
+    if (std::strstr(pray_features(), "png")) {
+        CHECK(st == PRAY_OK);
+        REQUIRE(pray_write_image(c, &img, (d / "x.png").c_str(), 8) == PRAY_OK);
+        CHECK(slurp(d / "x.png") == png);
+        CHECK(starts(png, "\x89PNG\r\n\x1a\n"));
+    } else {
+        CHECK(st == PRAY_ERR_ARG);
+        CHECK(png.empty());
+    }
     // upper-case extensions and .tiff are TIFF too
     CHECK(pray_write_image(c, &img, (d / "y.TIF").c_str(), 8) == PRAY_OK);
     CHECK(pray_write_image(c, &img, (d / "y.tiff").c_str(), 8) == PRAY_OK);

@@ -583,6 +583,7 @@ pray_status exercise(Failing &f, const std::string &prog, int threads) {
             st = pray_render(c, d, l, &img);
         if (st == PRAY_OK) st = pray_write_tiff(c, &img, 8, no_print, NULL);
         if (st == PRAY_OK) st = pray_write_ppm(c, &img, 16, no_print, NULL);
+        if (st == PRAY_OK && std::strstr(pray_features(), "png")) st = pray_write_png(c, &img, no_print, NULL);
         pray_image_free(c, &img);
         pray_release(c, m);
         pray_release(c, a);
