@@ -476,6 +476,8 @@ struct pray_ctx {
     pray_progress_fn progress_fn;
     void *progress_ud;
     pray_frame_fn frame_fn;
+    pray_write_fn warn_fn;  // pray_set_warning
+    void *warn_ud;
     void *frame_ud;
     Setup cur;       // in force now
     Setup base;      // what the host set; every run starts from it and ends back at it
@@ -6713,6 +6715,11 @@ void pray_set_untrusted(pray_ctx *c) {
     if (!c->running) c->cur = c->base;
     apply_memory_cap(c);
 }
+void pray_set_warning(pray_ctx *c, pray_write_fn fn, void *ud) {
+    if (!c) return;
+    c->warn_fn = fn;
+    c->warn_ud = ud;
+}
 void pray_set_print(pray_ctx *c, pray_write_fn fn, void *ud) {
     c->print_fn = fn;
     c->print_ud = ud;
@@ -8495,6 +8502,7 @@ struct Interp {
     int quit;
     int frames;
     Array<NameCount> names;  // output names used so far, and their frames
+    int warned_aspect;       // the run has said that its pixels are not square
 };
 
 Value vnum(double x) {
@@ -9209,6 +9217,23 @@ void frame_name(char *out, size_t n, const char *base, int frame) {
     else snprintf(out, n, "%.*s_%04d", keep, base, frame);
 }
 
+// Once a run: the camera's |X| : |Y| is not the image's width : height, so its pixels are not
+// square and the picture comes out stretched (more than 1 % either way).
+void warn_aspect(Interp &I, const Stmt *s) {
+    pray_ctx *c = I.c;
+    double w = c->cur.opt.v[OPT_WIDTH], h = c->cur.opt.v[OPT_HEIGHT];
+    double stretch = vlen(c->cur.cam_x) / vlen(c->cur.cam_y) * h / w;
+    if (!c->warn_fn || I.warned_aspect || (stretch < 1.01 && stretch > 1 / 1.01)) return;
+    I.warned_aspect = 1;
+    char line[400];
+    int n = snprintf(line, sizeof line,
+                     "%s:%d:%d: warning: the image is %.0f x %.0f pixels but the camera's |X| : |Y| is %.4g : 1, "
+                     "so the picture is stretched %s (make |X| / |Y| equal to width / height)\n",
+                     *ShownPath(I.name), s->line, s->col, w, h, vlen(c->cur.cam_x) / vlen(c->cur.cam_y),
+                     stretch < 1 ? "sideways" : "vertically");
+    if (n > 0) c->warn_fn(c->warn_ud, line, (size_t)n < sizeof line ? (size_t)n : sizeof line - 1);
+}
+
 pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
     pray_ctx *c = I.c;
     if (a[0].t != V_OBJECT)
@@ -9260,6 +9285,7 @@ pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
         }
     }
     frame_name(name, keep + 40, base, I.names[slot].frames);
+    warn_aspect(I, s);
     pray_image img;
     pray_status st = pray_render(c, (pray_object *)a[0].ref, all, &img);
     release_handle(c, all);
@@ -9648,6 +9674,8 @@ int progress_bar(void *, int done, int total) {
     return 0;
 }
 
+void to_stderr(void *, const void *p, size_t n) { fwrite(p, 1, n, stderr); }
+
 int exit_code(pray_status st) {
     switch (st) {
     case PRAY_OK: return 0;
@@ -9774,6 +9802,7 @@ int main(int argc, char **argv) {
         return rc;
     }
     if (!quiet && stderr_is_terminal()) pray_set_progress(c, progress_bar, NULL);
+    pray_set_warning(c, to_stderr, NULL);
     the_ctx = c;
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);

@@ -118,6 +118,10 @@ void pray_set_memory_limit(pray_ctx *ctx, size_t bytes);
 void pray_set_untrusted(pray_ctx *ctx);
 /* Where `print` writes (default: standard output; NULL fn discards). */
 void pray_set_print(pray_ctx *ctx, pray_write_fn fn, void *ud);
+/* Where warnings go (default: nowhere; the command-line program writes them to standard error):
+   one line each, "name:line:col: warning: message\n". A run warns once when the camera's
+   |X| : |Y| differs from width : height by more than 1 % (the picture would come out stretched). */
+void pray_set_warning(pray_ctx *ctx, pray_write_fn fn, void *ud);
 /* Progress callback for renders (default none). */
 void pray_set_progress(pray_ctx *ctx, pray_progress_fn fn, void *ud);
 /* Frame callback for `rendertiff` (default none: frames are written to files). */

@@ -605,6 +605,43 @@ TEST_CASE("command line: --version and --help exit with 0") {
     CHECK(out.find("-D") != std::string::npos);
 }
 
+TEST_CASE("a camera whose |X| : |Y| is not width : height: one warning a run, on standard error") {
+    // the API: the warning goes where pray_set_warning says, once however many frames
+    const std::string prog = "option \"width\", 40\noption \"height\", 20\nS = sphere(color({1}), [0, 0, 0], 1)\n"
+                             "rendertiff S\nrendertiff S\n";
+    pray_ctx *c = pray_new();
+    std::string warned;
+    pray_set_warning(c, testkit::print_sink, &warned);
+    pray_set_frame(c, [](void *, const pray_image *, const char *) { return PRAY_OK; }, NULL);
+    REQUIRE(pray_run_string(c, "s.ray", prog.data(), prog.size()) == PRAY_OK);
+    CHECK(warned == "s.ray:4:1: warning: the image is 40 x 20 pixels but the camera's |X| : |Y| is 1 : 1, so the "
+                    "picture is stretched sideways (make |X| / |Y| equal to width / height)\n");
+    // in step (|X| = 2 |Y|), or within 1 %: nothing
+    warned.clear();
+    const std::string fits = "option \"width\", 40\noption \"height\", 20\n"
+                             "perspective <2, 0, 0>, <0, 0, -1>, [0, -4, 0], [0, 0, 0]\nrendertiff sphere(color({1}), [0, 0, 0], 1)\n"
+                             "perspective <1.009, 0, 0>, <0, 0, -0.5>, [0, -4, 0], [0, 0, 0]\nrendertiff sphere(color({1}), [0, 0, 0], 1)\n";
+    REQUIRE(pray_run_string(c, "f.ray", fits.data(), fits.size()) == PRAY_OK);
+    CHECK(warned == "");
+    // taller than the camera: stretched vertically
+    const std::string tall = "option \"height\", 40\noption \"width\", 20\nrendertiff sphere(color({1}), [0, 0, 0], 1)\n";
+    REQUIRE(pray_run_string(c, "t.ray", tall.data(), tall.size()) == PRAY_OK);
+    CHECK(warned.find("t.ray:3:1: warning: the image is 20 x 40 pixels but the camera's |X| : |Y| is 1 : 1, so the "
+                      "picture is stretched vertically") == 0);
+    pray_free(c);
+
+    // the command line: on standard error, the image is still written, exit status 0
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    TempDir d;
+    std::string err;
+    CHECK(run_cmd("./pray --quiet -s 64x32 -o " + sq(d / "x.ppm") + " examples/redsph.ray 2>&1 >/dev/null", &err, false) == 0);
+    CHECK(err == "examples/redsph.ray:9:1: warning: the image is 64 x 32 pixels but the camera's |X| : |Y| is 1 : 1, "
+                 "so the picture is stretched sideways (make |X| / |Y| equal to width / height)\n");
+    CHECK(d.listing() == "x.ppm");
+    CHECK(run_cmd("./pray --quiet -s 64x64 -o " + sq(d / "y.ppm") + " examples/redsph.ray 2>&1 >/dev/null", &err, false) == 0);
+    CHECK(err == "");
+}
+
 TEST_CASE("command line: -D and -s win over the program's options") {
     REQUIRE_MESSAGE(have_pray(), NO_PRAY);
     TempDir d;
