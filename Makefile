@@ -10,6 +10,7 @@
 #   make charts     speed against accuracy and the benchmarks, drawn (bench/charts.sh), docs/images/bench-*.png
 #   make ports      build, run and compare every port (ports/check; installs cross compilers, qemu, wine)
 #   make check-bad  the catalogue of bad inputs (tests/bad/run.sh); the last step of check
+#   make cmake-check  pray as a CMake and pkg-config package: tests/cmake/run.sh builds a consumer
 #   make sanitize   the tests and the bad inputs under AddressSanitizer and UBSan
 #   make fuzz       build the libFuzzer harness and fuzz for FUZZ_SECONDS (needs clang)
 #   make fuzz-tiff  the same for the TIFF reader (textures and font atlases)
@@ -93,6 +94,12 @@ check: deps $(PRAY) textures $(TESTS) $(TESTS_FLOAT) tests/embed$(EXE)
 check-bad: $(PRAY)
 	@echo "== bad inputs (tests/bad)"
 	PRAY=./$(PRAY) tests/bad/run.sh
+
+# The consumer of tests/cmake/ built with add_subdirectory, find_package and pkg-config, in a
+# temporary directory (needs cmake and pkg-config).
+.PHONY: cmake-check
+cmake-check:
+	tests/cmake/run.sh
 
 # The doctest suite and ./pray built with AddressSanitizer and UBSan into build/sanitize/, then
 # the suite (whose command-line tests use the plain ./pray) and the bad inputs run with them.

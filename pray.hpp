@@ -356,6 +356,8 @@ pray_status pray_render_file(const char *program, const char *const *options, in
    2. Building
    Copy pray.hpp and pray.cpp into your project and compile pray.cpp with it. It needs a C++98
    compiler and the C library's math; no exceptions or RTTI. `-DPRAY_MAIN` adds main().
+   With CMake: add_subdirectory of pray's directory or find_package(pray), then link the target
+   pray::pray; an installed pray is also known to pkg-config as "pray" (README.md).
 
    3. A host program
        pray_ctx *c = pray_new();

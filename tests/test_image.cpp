@@ -510,7 +510,7 @@ TEST_CASE("a failed program or render writes no image") {
 // The command line
 // =============================================================================================
 namespace {
-bool have_pray() { return exists("./pray") && exists("examples/csg.ray"); }
+bool have_pray() { return exists(testkit::pray_program()) && exists("examples/csg.ray"); }
 const char *NO_PRAY = "./pray or examples/ missing: run the tests from the repository root after make";
 } // namespace
 
@@ -518,14 +518,14 @@ TEST_CASE("command line: renders CSG.RAY, exit status 0") {
     REQUIRE_MESSAGE(have_pray(), NO_PRAY);
     TempDir d;
     std::string out;
-    int rc = run_cmd("./pray --quiet -s 32x32 -o " + sq(d / "x.ppm") + " examples/csg.ray", &out);
+    int rc = run_cmd(testkit::pray_shell() + " --quiet -s 32x32 -o " + sq(d / "x.ppm") + " examples/csg.ray", &out);
     CHECK_MESSAGE(rc == 0, out);
     std::string s = slurp(d / "x.ppm");
     CHECK(starts(s, "P6\n32 32\n255\n"));
     CHECK(s.size() == 13 + 32 * 32 * 3);
     CHECK(d.listing() == "x.ppm");
     // the same without --quiet: no terminal, so no progress bar either
-    rc = run_cmd("./pray -s 32x32 -o " + sq(d / "y.tif") + " examples/csg.ray", &out);
+    rc = run_cmd(testkit::pray_shell() + " -s 32x32 -o " + sq(d / "y.tif") + " examples/csg.ray", &out);
     CHECK(rc == 0);
     CHECK(out == "");
     CHECK(starts(slurp(d / "y.tif"), std::string("II*\0", 4)));
@@ -539,17 +539,17 @@ TEST_CASE("command line: a program error exits with 1, names the place and write
     REQUIRE_MESSAGE(have_pray(), NO_PRAY);
     TempDir d;
     std::string out;
-    int rc = run_cmd("./pray -s 8x8 -o " + sq(d / "x.ppm") + " examples/redsphx.ray", &out);
+    int rc = run_cmd(testkit::pray_shell() + " -s 8x8 -o " + sq(d / "x.ppm") + " examples/redsphx.ray", &out);
     CHECK(rc == 1);
     CHECK(out.find("redsphx.ray:5:") != std::string::npos);
     CHECK(out.find("Centre") != std::string::npos);
     CHECK(d.listing() == "");
     // the message is "file:line:col: error: ..." on standard error; nothing on standard output
     std::string only_out;
-    CHECK(run_cmd("./pray -s 8x8 -o " + sq(d / "x.ppm") + " examples/redsphx.ray 2>/dev/null", &only_out, false) == 1);
+    CHECK(run_cmd(testkit::pray_shell() + " -s 8x8 -o " + sq(d / "x.ppm") + " examples/redsphx.ray 2>/dev/null", &only_out, false) == 1);
     CHECK(only_out == "");
     std::string only_err;
-    CHECK(run_cmd("./pray -s 8x8 -o " + sq(d / "x.ppm") + " examples/redsphx.ray 2>&1 >/dev/null", &only_err, false) == 1);
+    CHECK(run_cmd(testkit::pray_shell() + " -s 8x8 -o " + sq(d / "x.ppm") + " examples/redsphx.ray 2>&1 >/dev/null", &only_err, false) == 1);
     size_t at = only_err.find("redsphx.ray:5:");
     REQUIRE(at != std::string::npos);
     size_t col_end = only_err.find(':', at + 14);
@@ -560,7 +560,7 @@ TEST_CASE("command line: a program error exits with 1, names the place and write
     CHECK(only_err.compare(col_end, 9, ": error: ") == 0);
     // an error in rendertiff itself, after an image name was chosen
     spit(d / "bad.ray", "option \"width\", 4\noption \"height\", 4\nrendertiff sphere(color({1}), [0, 0, 0], 1), 5\n");
-    rc = run_cmd("./pray -o " + sq(d / "y.ppm") + " " + sq(d / "bad.ray"), &out);
+    rc = run_cmd(testkit::pray_shell() + " -o " + sq(d / "y.ppm") + " " + sq(d / "bad.ray"), &out);
     CHECK(rc == 1);
     CHECK(out.find("bad.ray:3:") != std::string::npos);
     CHECK(d.listing() == "bad.ray");
@@ -575,7 +575,7 @@ TEST_CASE("command line: usage errors exit with 2") {
     for (const char *a : cases) {
         CAPTURE(a);
         std::string out;
-        int rc = run_cmd("./pray -o " + sq(d / "x.ppm") + " " + a, &out);
+        int rc = run_cmd(testkit::pray_shell() + " -o " + sq(d / "x.ppm") + " " + a, &out);
         CHECK(rc == 2);
         CHECK(out != "");
     }
@@ -586,10 +586,10 @@ TEST_CASE("command line: unreadable program or unwritable output exits with 3") 
     REQUIRE_MESSAGE(have_pray(), NO_PRAY);
     TempDir d;
     std::string out;
-    int rc = run_cmd("./pray -o " + sq(d / "x.ppm") + " " + sq(d / "missing.ray"), &out);
+    int rc = run_cmd(testkit::pray_shell() + " -o " + sq(d / "x.ppm") + " " + sq(d / "missing.ray"), &out);
     CHECK(rc == 3);
     CHECK(out.find("missing.ray") != std::string::npos);
-    rc = run_cmd("./pray -s 8x8 -o " + sq(d / "nodir/x.ppm") + " examples/csg.ray", &out);
+    rc = run_cmd(testkit::pray_shell() + " -s 8x8 -o " + sq(d / "nodir/x.ppm") + " examples/csg.ray", &out);
     CHECK(rc == 3);
     CHECK(out.find("nodir") != std::string::npos);
     CHECK(d.listing() == "");
@@ -598,9 +598,9 @@ TEST_CASE("command line: unreadable program or unwritable output exits with 3") 
 TEST_CASE("command line: --version and --help exit with 0") {
     REQUIRE_MESSAGE(have_pray(), NO_PRAY);
     std::string out;
-    CHECK(run_cmd("./pray --version", &out) == 0);
+    CHECK(run_cmd(testkit::pray_shell() + " --version", &out) == 0);
     CHECK(out.find(PRAY_VERSION_STRING) != std::string::npos);
-    CHECK(run_cmd("./pray --help", &out) == 0);
+    CHECK(run_cmd(testkit::pray_shell() + " --help", &out) == 0);
     CHECK(out.find("usage") != std::string::npos);
     CHECK(out.find("-D") != std::string::npos);
 }
@@ -648,15 +648,15 @@ TEST_CASE("command line: -D and -s win over the program's options") {
     spit(d / "w.ray", "option \"width\", 64\noption \"height\", 8\noption \"output\", \"" + (d / "prog.ppm") +
                           "\"\nrendertiff sphere(color({1}), [0, 0, 0], 1)\n");
     std::string out;
-    int rc = run_cmd("./pray -D width=16 -o " + sq(d / "w.ppm") + " " + sq(d / "w.ray"), &out);
+    int rc = run_cmd(testkit::pray_shell() + " -D width=16 -o " + sq(d / "w.ppm") + " " + sq(d / "w.ray"), &out);
     CHECK_MESSAGE(rc == 0, out);
     CHECK(starts(slurp(d / "w.ppm"), "P6\n16 8\n255\n"));
     CHECK(!exists(d / "prog.ppm"));  // -o wins over the output option
-    rc = run_cmd("./pray -s 5x6 -D bits=16 -o " + sq(d / "s.ppm") + " " + sq(d / "w.ray"), &out);
+    rc = run_cmd(testkit::pray_shell() + " -s 5x6 -D bits=16 -o " + sq(d / "s.ppm") + " " + sq(d / "w.ray"), &out);
     CHECK_MESSAGE(rc == 0, out);
     CHECK(starts(slurp(d / "s.ppm"), "P6\n5 6\n65535\n"));
     // without -o the program's output option holds
-    rc = run_cmd("./pray -D height=3 " + sq(d / "w.ray"), &out);
+    rc = run_cmd(testkit::pray_shell() + " -D height=3 " + sq(d / "w.ray"), &out);
     CHECK_MESSAGE(rc == 0, out);
     CHECK(starts(slurp(d / "prog.ppm"), "P6\n64 3\n255\n"));
 }
@@ -701,7 +701,7 @@ TEST_CASE("the temporary file is new, unique and no link: a planted link is neit
     spit(d / "p.ray", "rendertiff sphere(color({1}), [0, 0, 0], 1)\n");
     fs::create_symlink("victim.txt", d / "u.ppm.tmp");
     std::string out;
-    CHECK(run_cmd("cd " + sq(d.path) + " && " + fs::absolute("pray").string() + " --untrusted -s 8x8 -o u.ppm p.ray", &out) == 0);
+    CHECK(run_cmd("cd " + sq(d.path) + " && " + fs::absolute(testkit::pray_program()).string() + " --untrusted -s 8x8 -o u.ppm p.ray", &out) == 0);
     CHECK(slurp(d / "victim.txt") == "victim");
     CHECK(whole_ppm(slurp(d / "u.ppm")) == 8);
 }
@@ -740,7 +740,7 @@ TEST_CASE("command line: renders to one output at once leave one whole image (8 
     // eight widths: a file that mixes two renders has a header that does not fit its length (with
     // one temporary name for all, runs failed to rename or left such a file in each round)
     std::string script = "cd " + sq(d.path) + " && for w in 601 602 603 604 605 606 607 608; do (" +
-                         fs::absolute("pray").string() + " -s ${w}x400 -o out.ppm p.ray || echo FAILED $w) & done; wait";
+                         fs::absolute(testkit::pray_program()).string() + " -s ${w}x400 -o out.ppm p.ray || echo FAILED $w) & done; wait";
     for (int round = 0; round < 4; round++) {
         CAPTURE(round);
         std::string out;
@@ -757,7 +757,7 @@ TEST_CASE("command line: SIGINT or SIGTERM while writing removes the temporary f
     REQUIRE_MESSAGE(have_pray(), NO_PRAY);
     TempDir d;
     spit(d / "p.ray", "rendertiff nothing\n");
-    std::string prog = fs::absolute("pray").string(), out = d / "out.ppm", ray = d / "p.ray";
+    std::string prog = fs::absolute(testkit::pray_program()).string(), out = d / "out.ppm", ray = d / "p.ray";
     // the test's own handlers (doctest's) must not run in a child before it becomes ./pray:
     // the signals wait, blocked, until the child has their default disposition
     sigset_t both, before;
@@ -819,20 +819,20 @@ TEST_CASE("command line: pray refuses to write over its own program") {
     spit(d / "scene.tif", prog);
     fs::create_symlink("p.ppm", d / "alias.ppm");
     std::string out;
-    CHECK(run_cmd("./pray -s 8x8 -o " + sq(d / "p.ppm") + " " + sq(d / "p.ppm"), &out) == 3);
+    CHECK(run_cmd(testkit::pray_shell() + " -s 8x8 -o " + sq(d / "p.ppm") + " " + sq(d / "p.ppm"), &out) == 3);
     CHECK(out == d / "p.ppm" + ":1:1: error: cannot write '" + (d / "p.ppm") +
                      "': it is the program being run (choose another output name)\n");
     // another name for the same file
-    CHECK(run_cmd("./pray -s 8x8 -o " + sq(d / "alias.ppm") + " " + sq(d / "p.ppm"), &out) == 3);
-    CHECK(run_cmd("cd " + sq(d.path) + " && " + fs::absolute("pray").string() + " -s 8x8 -o ./p.ppm p.ppm", &out) == 3);
+    CHECK(run_cmd(testkit::pray_shell() + " -s 8x8 -o " + sq(d / "alias.ppm") + " " + sq(d / "p.ppm"), &out) == 3);
+    CHECK(run_cmd("cd " + sq(d.path) + " && " + fs::absolute(testkit::pray_program()).string() + " -s 8x8 -o ./p.ppm p.ppm", &out) == 3);
     // the default name of scene.tif is scene.tif
-    CHECK(run_cmd("./pray -s 8x8 " + sq(d / "scene.tif"), &out) == 3);
+    CHECK(run_cmd(testkit::pray_shell() + " -s 8x8 " + sq(d / "scene.tif"), &out) == 3);
     CHECK(out.find("it is the program being run") != std::string::npos);
     CHECK(slurp(d / "p.ppm") == prog);
     CHECK(slurp(d / "scene.tif") == prog);
     CHECK(d.listing() == "alias.ppm p.ppm scene.tif");
     // another output is fine
-    CHECK(run_cmd("./pray -s 8x8 -o " + sq(d / "q.ppm") + " " + sq(d / "p.ppm"), &out) == 0);
+    CHECK(run_cmd(testkit::pray_shell() + " -s 8x8 -o " + sq(d / "q.ppm") + " " + sq(d / "p.ppm"), &out) == 0);
 }
 
 TEST_CASE("command line: a FIFO, a directory or a device as program or texture is an error, never a hang") {
@@ -840,7 +840,7 @@ TEST_CASE("command line: a FIFO, a directory or a device as program or texture i
     TempDir d;
     REQUIRE(mkfifo((d / "fifo.tif").c_str(), 0600) == 0);
     REQUIRE(mkfifo((d / "fifo.ray").c_str(), 0600) == 0);
-    const std::string pray = "timeout 20 " + fs::absolute("pray").string() + " -s 8x8 -o out.ppm ";
+    const std::string pray = "timeout 20 " + fs::absolute(testkit::pray_program()).string() + " -s 8x8 -o out.ppm ";
     const char *textures[] = {"fifo.tif", ".", "/dev/zero", "/dev/null"};
     for (const char *t : textures)
         for (const char *mode : {"", "--untrusted "}) {

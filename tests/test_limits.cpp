@@ -126,7 +126,7 @@ TEST_CASE("limit maxline and maxmem while a program is read: a file or a stream 
     // ends it; one message, no empty line after it
     auto pray_cmd = [](const std::string &args) {
         std::string out;
-        FILE *p = popen(("t=; command -v timeout >/dev/null && t='timeout 60'; $t ./pray " + args + " 2>&1").c_str(), "r");
+        FILE *p = popen(("t=; command -v timeout >/dev/null && t='timeout 60'; $t " + testkit::pray_shell() + " " + args + " 2>&1").c_str(), "r");
         REQUIRE(p);
         char buf[4096];
         size_t n;

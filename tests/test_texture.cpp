@@ -2074,7 +2074,7 @@ TEST_CASE("textures: a missing texture file stops the program on its line, namin
 }
 
 TEST_CASE("textures: on the command line a missing texture exits with 1 and writes no image") {
-    if (!fs::exists("./pray")) {
+    if (!fs::exists(testkit::pray_program())) {
         MESSAGE("skipped: ./pray not built (make builds it before make check runs the tests)");
         return;
     }
@@ -2082,7 +2082,7 @@ TEST_CASE("textures: on the command line a missing texture exits with 1 and writ
     spit(d / "tex.ray", "M = color({1})\noption \"width\", 4\noption \"height\", 4\n"
                         "T = tiff(M, M, \"missing-wood.tif\")\nrendertiff sphere(T, [0,0,0], 1), none\n");
     std::string out;
-    int rc = run_cmd("./pray --quiet -o " + sq(d / "x.tif") + " " + sq(d / "tex.ray"), &out);
+    int rc = run_cmd(testkit::pray_shell() + " --quiet -o " + sq(d / "x.tif") + " " + sq(d / "tex.ray"), &out);
     CHECK(rc == 1);
     CHECK(contains(out, "tex.ray:4:"));
     CHECK(contains(out, "missing-wood.tif"));
@@ -2095,7 +2095,7 @@ TEST_CASE("textures: on the command line a missing texture exits with 1 and writ
         pray_image v = w.view();
         REQUIRE(pray_write_image(c, &v, (d / "missing-wood.tif").c_str(), 8) == PRAY_OK);
     }
-    rc = run_cmd("./pray --quiet -o " + sq(d / "x.tif") + " " + sq(d / "tex.ray"), &out);
+    rc = run_cmd(testkit::pray_shell() + " --quiet -o " + sq(d / "x.tif") + " " + sq(d / "tex.ray"), &out);
     CHECK_MESSAGE(rc == 0, out);
     CHECK(d.listing() == "missing-wood.tif tex.ray x.tif");
 }

@@ -6,10 +6,23 @@
 #include "../pray.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
 namespace testkit {
+
+// The command-line program the tests start: $PRAY (CTest sets it to the program it built), else
+// ./pray, where make builds it. pray_shell() is the same, quoted for the shell.
+inline std::string pray_program() {
+    const char *p = std::getenv("PRAY");
+    return p && *p ? p : "./pray";
+}
+inline std::string pray_shell() {
+    std::string q = "'";
+    for (char ch : pray_program()) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+    return q + "'";
+}
 
 struct Frame {
     std::string name;  // the file name rendertiff would have written
