@@ -634,11 +634,11 @@ TEST_CASE("a camera whose |X| : |Y| is not width : height: one warning a run, on
     REQUIRE_MESSAGE(have_pray(), NO_PRAY);
     TempDir d;
     std::string err;
-    CHECK(run_cmd("./pray --quiet -s 64x32 -o " + sq(d / "x.ppm") + " examples/redsph.ray 2>&1 >/dev/null", &err, false) == 0);
+    CHECK(run_cmd(testkit::pray_shell() + " --quiet -s 64x32 -o " + sq(d / "x.ppm") + " examples/redsph.ray 2>&1 >/dev/null", &err, false) == 0);
     CHECK(err == "examples/redsph.ray:9:1: warning: the image is 64 x 32 pixels but the camera's |X| : |Y| is 1 : 1, "
                  "so the picture is stretched sideways (make |X| / |Y| equal to width / height)\n");
     CHECK(d.listing() == "x.ppm");
-    CHECK(run_cmd("./pray --quiet -s 64x64 -o " + sq(d / "y.ppm") + " examples/redsph.ray 2>&1 >/dev/null", &err, false) == 0);
+    CHECK(run_cmd(testkit::pray_shell() + " --quiet -s 64x64 -o " + sq(d / "y.ppm") + " examples/redsph.ray 2>&1 >/dev/null", &err, false) == 0);
     CHECK(err == "");
 }
 
