@@ -48,7 +48,8 @@ typedef enum pray_status {
     PRAY_ERR_SYNTAX = 3,  /* the PRAY program is malformed */
     PRAY_ERR_RUNTIME = 4, /* the PRAY program failed while running (type error, ...) */
     PRAY_ERR_LIMIT = 5,   /* a limit was reached (maxsteps, image size, ...) */
-    PRAY_ERR_ARG = 6      /* a bad argument to an API function */
+    PRAY_ERR_ARG = 6,     /* a bad argument to an API function */
+    PRAY_ERR_CANCELLED = 7 /* stopped by pray_cancel or by the progress callback */
 } pray_status;
 
 /* The text of a status code ("ok", "out of memory", ...). Never NULL. */
@@ -120,6 +121,8 @@ void pray_set_untrusted(pray_ctx *ctx);
 void pray_set_print(pray_ctx *ctx, pray_write_fn fn, void *ud);
 /* Progress callback for renders (default none). */
 void pray_set_progress(pray_ctx *ctx, pray_progress_fn fn, void *ud);
+/* Stop the call running on the context (CANCEL). */
+void pray_cancel(pray_ctx *ctx);
 /* Frame callback for `rendertiff` (default none: frames are written to files). */
 void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
 /* The temporary file an image is being written to now (see pray_write_image), else NULL. For a
@@ -250,7 +253,13 @@ pray_light *pray_light_scale(pray_ctx *ctx, pray_light *l, double s);
 pray_light *pray_light_translate(pray_ctx *ctx, pray_light *l, pray_vec offset);
 pray_light *pray_light_rotate(pray_ctx *ctx, pray_light *l, pray_vec degrees);
 
-/* Drop a reference (any of the three handle kinds; NULL is ignored). */
+/* Drop a reference. NULL is ignored; a handle of another context or of the wrong kind is refused
+   (PRAY_ERR_ARG in the context's message) and left alone. pray_release takes any of the four
+   kinds and checks which it is. */
+void pray_object_release(pray_ctx *ctx, pray_object *obj);
+void pray_model_release(pray_ctx *ctx, pray_model *model);
+void pray_light_release(pray_ctx *ctx, pray_light *light);
+void pray_texture_release(pray_ctx *ctx, pray_texture *tex);
 void pray_release(pray_ctx *ctx, void *handle);
 
 /* Camera and background, as the statements of the same names. */
