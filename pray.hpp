@@ -360,17 +360,31 @@ pray_status pray_render_file(const char *program, const char *const *options, in
    compiler and the C library's math; no exceptions or RTTI. `-DPRAY_MAIN` adds main().
 
    3. A host program
-       pray_ctx *c = pray_new();
-       pray_model *red = pray_phong(c, rgb(0.8,0.1,0.1), rgb(0.3,0.3,0.3), rgb(0,0,0), 3);
-       pray_object *s = pray_sphere(c, red, vec(0,0,0), 0.2);
-       pray_light *l = pray_dirlight(c, rgb(1,1,1), vec(1,1,1));
-       pray_image img;
-       if (pray_render(c, s, l, &img) == PRAY_OK) {
-           pray_write_image(c, &img, "red.tif", 8);
-           pray_image_free(c, &img);
-       } else fprintf(stderr, "%s\n", pray_error(c));
-       pray_free(c);
+   Everything a context makes belongs to it: objects, models, lights, textures, prepared scenes
+   and rendered images. pray_free frees all that is left of them; pray_image_free,
+   pray_scene_free and the releases free one earlier. Copy the pixels of an image that must
+   outlive its context. A NULL from a failed call passes through the calls it is given to, so
+   one check at the end finds the first failure's message:
+       #include <stdio.h>
+       #include "pray.hpp"
+       int main(void) {
+           pray_rgb red = {0.8, 0.1, 0.1}, grey = {0.3, 0.3, 0.3};
+           pray_rgb black = {0, 0, 0}, white = {1, 1, 1};
+           pray_vec centre = {0, 0, 0}, towards = {1, 1, 1};
+           pray_ctx *c = pray_new();
+           pray_model *m = pray_phong(c, red, grey, black, 3);
+           pray_object *s = pray_sphere(c, m, centre, 0.2);
+           pray_light *l = pray_dirlight(c, white, towards);
+           pray_image img;
+           int ok = pray_render(c, s, l, &img) == PRAY_OK &&
+                    pray_write_image(c, &img, "red.tif", 8) == PRAY_OK;
+           if (!ok) fprintf(stderr, "%s\n", pray_error(c));
+           pray_free(c);
+           return ok ? 0 : 1;
+       }
    Running the same scene as a program: pray_run_string(c, "red.ray", text, strlen(text)).
+   Every indented block of this manual that starts with #include is a whole program, compiled
+   as C and as C++ and run by the tests.
 
    4. Errors
    Every failing call returns a status (or NULL) and leaves "where: error: what" in
