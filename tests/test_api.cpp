@@ -318,6 +318,26 @@ TEST_CASE("api: handles, scenes and images of another context are refused") {
     std::string tiff;
     CHECK(pray_write_tiff(a, &img, 8, testkit::print_sink, &tiff) == PRAY_OK);
     CHECK(tiff.size() == 8 + 2 + 12 * 12 + 4 + 6 + 16 + 8 * 8 * 3);
+    // textures too
+    pray_texture *t = pray_texture_tiff(b, tiff.data(), tiff.size(), "t");
+    REQUIRE(t);
+    const Case textures[] = {
+        {"error: pray_tiff: the texture belongs to another context", [&] { return !pray_tiff(a, ma, ma, t); }},
+        {"error: pray_tiffbump: the texture belongs to another context", [&] { return !pray_tiffbump(a, ma, 1, t); }},
+        {"error: pray_text: the font belongs to another context",
+         [&] { return !pray_text(a, ma, "A", ORIGIN, ONE, UP, 1, t, 1); }},
+        {"error: pray_texture_release: the texture belongs to another context",
+         [&] { pray_texture_release(a, t); return true; }},
+    };
+    for (const Case &k : textures) {
+        CAPTURE(k.message);
+        pray_clear_error(a);
+        CHECK(k.refused());
+        CHECK(std::string(pray_error(a)) == k.message);
+    }
+    int tw = 0, th = 0;
+    pray_texture_size(t, &tw, &th);
+    CHECK((tw == 8 && th == 8));
     // both contexts freed with all they made (under AddressSanitizer: no leak, no use after free)
     pray_free(a);
     pray_free(b);
@@ -546,5 +566,28 @@ TEST_CASE("api: pray_cancel from another thread stops an endless program and a l
     REQUIRE(pray_render(f, fo, fl, &fresh) == PRAY_OK);
     CHECK(pixels_of(mine) == pixels_of(fresh));
     pray_free(f);
+    pray_free(c);
+}
+
+TEST_CASE("api: a prepared scene needs nothing it was made from") {
+    pray_ctx *c = pray_new();
+    pray_model *m = pray_phong(c, GREY, GREY, GREY, 3);
+    pray_model *glass = pray_transparent(c, GREY, 1.5);
+    pray_object *a = pray_sphere(c, m, ORIGIN, 0.5), *b = pray_sphere(c, glass, ONE, 0.5);
+    pray_object *both = pray_csg(c, PRAY_UNION, a, b);
+    pray_scene *sc = pray_prepare(c, both);
+    REQUIRE(sc);
+    pray_object_release(c, a);
+    pray_object_release(c, b);
+    pray_object_release(c, both);
+    pray_model_release(c, m);
+    pray_model_release(c, glass);
+    pray_vec from = {0, 0, 5}, down = {0, 0, -1};
+    pray_hit hits[2];
+    CHECK(pray_intersect(c, sc, from, down, HUGE_VAL, hits, 2) == 2);
+    CHECK(hits[1].t == doctest::Approx(5.5));
+    CHECK(hits[1].entering == 0);
+    pray_scene_free(c, sc);
+    CHECK(pray_last_status(c) == PRAY_OK);
     pray_free(c);
 }
