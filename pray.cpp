@@ -6220,7 +6220,7 @@ void adaptive_band(Worker &k, int y0, int y1) {
                 }
                 put_pixel(job, i, j, cscale(sum, 1.0 / ((double)A * A)));
             }
-        if (X1 == SW - 1) break;
+        if (X1 == SW - 1 || cancelled(job->c)) break;  // (pray_cancel: checked per tile)
         for (int y = 0; y < n; y++)  // the last column is the next tile's first
             for (int x = 0; x < n; x++) {
                 Sample &v = k.cache[y * n + x];

@@ -464,6 +464,9 @@ TEST_CASE("api: pray_cancel stops a program, a preparation, a render and a file 
     SUBCASE("preparing a scene, and the render of it, at every allocation") {
         // each allocation of the call in turn: the call stops with the cancel, or ends before
         // it comes (the last allocations are the image's and the workers')
+        for (double adaptive : {0.0, 0.1}) {
+        CAPTURE(adaptive);
+        pray_option(c, "adaptive", adaptive);
         int stopped = 0, total = 0;
         for (int at = 1; at < 400; at++) {
             pray_image img;
@@ -483,6 +486,7 @@ TEST_CASE("api: pray_cancel stops a program, a preparation, a render and a file 
         }
         CHECK(total > 10);
         CHECK(stopped == total);  // every allocation comes before a check
+        }
         pray_scene *sc = nullptr;
         k.calls = 0;
         k.at = 3;
@@ -504,6 +508,17 @@ TEST_CASE("api: pray_cancel stops a program, a preparation, a render and a file 
         CHECK(dir_names(dir) == std::vector<std::string>{"x.ppm"});
         remove((dir + "/x.ppm").c_str());
         rmdir(dir.c_str());
+        // a byte sink has what was written before the cancel: the header and no row
+        std::string got;
+        auto sink = [](void *ud, const void *, size_t n) {
+            Cancel *x = (Cancel *)ud;
+            x->calls += (int)n;
+            pray_cancel(x->c);
+        };
+        k.calls = 0;
+        CHECK(pray_write_ppm(c, &img, 8, sink, &k) == PRAY_ERR_CANCELLED);
+        CHECK(k.calls == (int)strlen("P6\n32 32\n255\n"));
+        CHECK(std::string(pray_error(c)) == "error: cancelled");
     }
     pray_free(c);
 }
