@@ -7386,7 +7386,10 @@ struct CollectHits {
 int pray_intersect(pray_ctx *c, pray_scene *q, pray_vec origin, pray_vec dir, double tmax, pray_hit *hits,
                    int max_hits) {
     if (!c) return -1;
-    if (!q) return fail(c, PRAY_ERR_ARG, "pray_intersect: no scene"), -1;
+    if (!q) {  // (the chain rule, as for handles)
+        if (c->status == PRAY_OK) fail(c, PRAY_ERR_ARG, "pray_intersect: no scene");
+        return -1;
+    }
     if (owner_of(q) != c) return fail(c, PRAY_ERR_ARG, "pray_intersect: the scene belongs to another context"), -1;
     if (max_hits > 0 && !hits) return fail(c, PRAY_ERR_ARG, "pray_intersect: no room for the hits"), -1;
     if (!vfinite(origin) || !vfinite(dir) || vlen(dir) == 0 || tmax != tmax) {

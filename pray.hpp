@@ -89,10 +89,10 @@ typedef void *(*pray_alloc_fn)(void *ud, void *ptr, size_t osize, size_t nsize);
 /* Output of the PRAY `print` statement, and any byte sink (image writers). */
 typedef void (*pray_write_fn)(void *ud, const void *data, size_t n);
 /* Progress of a render: rows done of rows total, after each band of a few rows (not while the
-   scene is prepared). Called on the render's threads (the caller's and its workers), one call at
-   a time, `done` increasing; it must be safe to call on another thread than the host expects
-   and must not call pray on the same context, except pray_cancel. Return non-zero to cancel:
-   the render fails with PRAY_ERR_CANCELLED ("cancelled by the progress callback"). */
+   scene is prepared). Called on any of the render's threads (the caller's or a worker), one
+   call at a time, `done` increasing: it must be thread-safe, and must not call pray on the same
+   context except pray_cancel. Return non-zero to cancel: the render fails with
+   PRAY_ERR_CANCELLED ("cancelled by the progress callback"). */
 typedef int (*pray_progress_fn)(void *ud, int done, int total);
 /* A frame rendered by `rendertiff`. When set, it is called instead of writing the file; `name` is
    the file name the frame would have been written to. Return PRAY_OK to continue. */
@@ -106,8 +106,8 @@ typedef pray_status (*pray_frame_fn)(void *ud, const pray_image *img, const char
      recorded anywhere (pray_error(NULL) is "error: no context").
    - A NULL handle (object, model, light, texture, scene): the call fails; "pray_f: no model" is
      recorded only when no failure is recorded yet, so a chain of calls keeps the message of its
-     first failure (clear it with pray_clear_error). Other NULL pointers (names, texts, buffers,
-     callbacks that are needed) fail with a message always.
+     first failure (clear it with pray_clear_error). Releases and frees ignore NULL. Other NULL
+     pointers (names, texts, buffers, callbacks that are needed) fail with a message always.
    - A handle, scene or image of another context is refused: PRAY_ERR_ARG, "pray_f: the model
      belongs to another context"; it is left alone.
    - What pray returns (handles, scenes, images) belongs to the context and dies with pray_free at
@@ -147,6 +147,12 @@ void pray_set_untrusted(pray_ctx *ctx);
 void pray_set_print(pray_ctx *ctx, pray_write_fn fn, void *ud);
 /* Progress callback for renders (default none). */
 void pray_set_progress(pray_ctx *ctx, pray_progress_fn fn, void *ud);
+/* Frame callback for `rendertiff` (default none: frames are written to files). The image passed
+   to it is freed when it returns. */
+void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
+/* The temporary file an image is being written to now (see pray_write_image), else NULL. For a
+   signal handler that removes it before the program dies: reading it is async-signal-safe. */
+const char *pray_temp_file(const pray_ctx *ctx);
 /* Stop the call running on the context: pray_run_string, pray_run_file, pray_render,
    pray_prepare, pray_write_image, pray_write_tiff or pray_write_ppm. Safe from any thread and
    from a signal handler: it only sets a flag. The call stops at its next check (each statement
@@ -157,12 +163,6 @@ void pray_set_progress(pray_ctx *ctx, pray_progress_fn fn, void *ud);
    forgotten. A host that must not lose one keeps its own flag too and checks it between calls.
    Other functions ignore the flag. */
 void pray_cancel(pray_ctx *ctx);
-/* Frame callback for `rendertiff` (default none: frames are written to files). The image passed
-   to it is freed when it returns. */
-void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
-/* The temporary file an image is being written to now (see pray_write_image), else NULL. For a
-   signal handler that removes it before the program dies: reading it is async-signal-safe. */
-const char *pray_temp_file(const pray_ctx *ctx);
 
 /* ---------------------------------------------------------------------------------------------
    Options: the same names as the PRAY `option` statement: width, height (pixels, default 256),
@@ -218,8 +218,8 @@ int pray_frames(const pray_ctx *ctx);
    Building scenes directly. Every maker returns a new handle, or NULL on error (see the
    conventions above: a NULL handle given to a maker keeps the message of the failure that made
    it, so a chain of calls can be checked once at its end). Handles are reference counted: what
-   a maker is given keeps its own reference, so you may release yours at once; pray_*_release
-   drops yours, pray_free all.
+   a maker makes holds the handles it was given, so you may release yours at once;
+   pray_*_release drops yours, pray_free all.
    ------------------------------------------------------------------------------------------- */
 /* Models. */
 pray_model *pray_phong(pray_ctx *ctx, pray_rgb diffuse, pray_rgb specular, pray_rgb ambient,
@@ -231,8 +231,9 @@ pray_model *pray_model_add(pray_ctx *ctx, pray_model *a, pray_model *b);
 pray_model *pray_model_scale(pray_ctx *ctx, pray_model *m, pray_rgb factor);
 
 /* Textures: a TIFF file (a regular file, decoded once per context run, however often it is
-   asked for), or TIFF data in memory (copied; `name`, NULL for "texture", is used in messages). Baseline TIFF: bilevel, grey, palette, RGB(A); 1, 4, 8,
-   16 bits; strips or tiles; no compression, PackBits or LZW (with the horizontal predictor). */
+   asked for), or TIFF data in memory (decoded at once; `name`, NULL for "texture", is used in
+   messages). Baseline TIFF: bilevel, grey, palette, RGB(A); 1, 4, 8, 16 bits; strips or tiles;
+   no compression, PackBits or LZW (with the horizontal predictor). */
 pray_texture *pray_texture_file(pray_ctx *ctx, const char *path);
 pray_texture *pray_texture_tiff(pray_ctx *ctx, const void *data, size_t size, const char *name);
 /* Width and height of a texture in pixels (0 for NULL), and its colour at texel (x, y) (rows
@@ -365,7 +366,7 @@ int pray_intersect(pray_ctx *ctx, pray_scene *scene, pray_vec origin, pray_vec d
 void pray_scene_free(pray_ctx *ctx, pray_scene *scene);
 /* Free the pixels of an image pray_render made in this context and set *img to 0 x 0, NULL
    pixels: freeing it twice is harmless, a copy of the struct is not. An empty image is ignored;
-   one of another context is refused. */
+   one of another context is refused; pixels pray did not allocate are undefined, as for free. */
 void pray_image_free(pray_ctx *ctx, pray_image *img);
 
 /* Write an image; the format comes from the extension: .tif/.tiff (bits 8 or 16), .ppm (bits 8
