@@ -84,6 +84,7 @@ embed: tests/embed$(EXE)
 
 check: deps $(PRAY) textures $(TESTS) $(TESTS_FLOAT) tests/embed$(EXE)
 	$(RUN) ./tests/embed$(EXE) tests/embed.ppm
+	CC="$(CC)" CXX="$(CXX)" RUN="$(RUN)" sh tests/manual_examples.sh
 	@echo "== tests, PRAY_REAL=float"
 	$(RUN) ./$(TESTS_FLOAT)
 	@echo "== tests, PRAY_REAL=double"

@@ -48,6 +48,7 @@
 #include <float.h>
 #include <limits.h>
 #include <math.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -431,10 +432,12 @@ const double MAX_IMAGE_PIXELS = 268435456.0;
 // =============================================================================================
 
 // Every block carries this header, so a context can free all it ever made.
+// The owner is how a handle or an image knows its context (it also keeps the payload 16-byte
+// aligned on 64-bit targets).
 struct Block {
     Block *prev, *next;
     size_t size;
-    size_t pad;  // keeps the payload 16-byte aligned on 64-bit targets
+    pray_ctx *owner;
 };
 
 } // namespace
@@ -493,6 +496,8 @@ struct pray_ctx {
     char *volatile temp_name;  // the temporary file being written now (pray_temp_file)
     unsigned temp_serial;    // makes temporary names unique
     double written;          // bytes of image files written by this run (option maxoutput)
+    volatile sig_atomic_t cancel;  // pray_cancel: the running call stops at its next check
+    int calls;               // cancellable public calls running (a run renders and writes)
 };
 
 namespace {
@@ -524,6 +529,18 @@ pray_status fail_nomem(pray_ctx *c) {
     return fail(c, PRAY_ERR_NOMEM, "out of memory");
 }
 
+// A public call that pray_cancel can stop. The outermost one forgets a cancel made before it
+// started; the work checks `cancelled` in its loops (statements, voxels, rows of the image).
+struct Call {
+    pray_ctx *c;
+    explicit Call(pray_ctx *x) : c(x) {
+        if (c->calls++ == 0) c->cancel = 0;
+    }
+    ~Call() { c->calls--; }
+};
+inline bool cancelled(const pray_ctx *c) { return c->cancel != 0; }
+pray_status fail_cancelled(pray_ctx *c) { return fail(c, PRAY_ERR_CANCELLED, "cancelled"); }
+
 // The context's cap: the host's, lowered by option maxmem (MiB) when that is set.
 void apply_memory_cap(pray_ctx *c) {
     size_t cap = c->host_limit;
@@ -552,6 +569,7 @@ void *mem_alloc(pray_ctx *c, size_t n) {
         return NULL;
     }
     b->size = n;
+    b->owner = c;
     b->prev = &c->blocks;
     b->next = c->blocks.next;
     c->blocks.next->prev = b;
@@ -565,6 +583,9 @@ void *mem_zalloc(pray_ctx *c, size_t n) {
     if (p) memset(p, 0, n);
     return p;
 }
+
+// The context a block of mem_alloc belongs to.
+inline const pray_ctx *owner_of(const void *p) { return ((const Block *)p - 1)->owner; }
 
 void mem_free(pray_ctx *c, void *p) {
     if (!p) return;
@@ -822,9 +843,12 @@ const int MAX_MODEL_DEPTH = 256;
 // The parts a model is evaluated through, each use of a shared part counted: what shading one
 // point costs at most (`M = M + M` forty times would otherwise be 2^40 parts).
 const int MAX_MODEL_PARTS = 4096;
+// Every handle begins with this; HANDLE_MAGIC tells a live handle from other memory (pray_release).
+const unsigned HANDLE_MAGIC = 0x70726179u;  // "pray"
 struct Handle {
     int refs;
     int kind;
+    unsigned magic;
 };
 enum ObjKind { O_SPHERE, O_PLANE, O_CYLINDER, O_ONE, O_NOTHING, O_UNION, O_INTER, O_DIFF, O_COMPL };
 struct LightSrc {
@@ -902,6 +926,7 @@ void *handle_new(pray_ctx *c, size_t size, int kind) {
     if (!h) return NULL;
     h->refs = 1;
     h->kind = kind;
+    h->magic = HANDLE_MAGIC;
     return h;
 }
 void retain(void *p) {
@@ -942,6 +967,7 @@ void release_handle(pray_ctx *c, void *p) {
     }
     default: break;
     }
+    h->magic = 0;
     mem_free(c, p);
 }
 
@@ -3646,6 +3672,11 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
             // (the eye's pieces are each only a slab deep)
             bool crowded = !B.pieces && start[ncell] > (double)ncell * LB_MAX_CAND / 2;
             for (int cel = 0; ok && cel < ncell; cel++) {
+                if (cancelled(c)) {
+                    fail_cancelled(c);
+                    ok = false;
+                    break;
+                }
                 int *col = B.list + F.base + cel, stride = F.n[0] * F.n[1];  // the cell's voxels
                 bool whole = true;  // first the zones that meet few enough primitives: -2
                 int most = B.pieces ? LB_MAX_CAND / 2 : LB_MAX_CAND;
@@ -3866,7 +3897,11 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
             memset(start.p, 0, sizeof(int) * (size_t)(nv + 1));
         }
         for (int pass = 0; pass < 2 && st == PRAY_OK; pass++) {
-            for (int i = 0; i < np; i++) {
+            for (int i = 0; i < np && st == PRAY_OK; i++) {
+                if (cancelled(c)) {
+                    st = fail_cancelled(c);
+                    break;
+                }
                 const Box &bx = eff[i];
                 int lo[3], hi[3];
                 bool any = true;
@@ -3899,6 +3934,10 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         for (int z = 0; z < a->n[2] && st == PRAY_OK; z++)
             for (int y = 0; y < a->n[1] && st == PRAY_OK; y++)
                 for (int x = 0; x < a->n[0] && st == PRAY_OK; x++) {
+                    if (x == 0 && cancelled(c)) {  // (per row of voxels)
+                        st = fail_cancelled(c);
+                        break;
+                    }
                     int ix[3] = {x, y, z}, ix1[3] = {x + 1, y + 1, z + 1};
                     long v = voxel_index(a, ix);
                     int k0 = start[(int)v], k1 = start[(int)v + 1];
@@ -3980,6 +4019,10 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         if (!kids || !solid) st = c->status;
         for (int j = 0; st == PRAY_OK && j < nn; j++) solid[j] = -1;
         for (int L = 0; st == PRAY_OK && L < a->off.n; L++) {
+            if (cancelled(c)) {
+                st = fail_cancelled(c);
+                break;
+            }
             int where = list_plan(c, s, a->data.p + a->off[L], kids, solid, &a->plan);
             if (where == -2 || !a->plan_at.push(c, where) || !a->clear.push(c, list_clear(s, a->data.p + a->off[L])))
                 st = c->status;
@@ -5884,6 +5927,7 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     // snapped before compaction, over every primitive flattened, so that the reference and the
     // simplified scene give the same surviving primitives the same numbers
     if (s->root == -3 || snap_coincident(c, s) || scene_compact(c, s)) return c->status;
+    if (cancelled(c)) return fail_cancelled(c);
     c->stats.primitives_declared = root->nprims;
     for (int i = 0; lights && i < lights->n; i++) {
         const LightSrc &src = lights->src[i];
@@ -6186,7 +6230,7 @@ void adaptive_band(Worker &k, int y0, int y1) {
                 }
                 put_pixel(job, i, j, cscale(sum, 1.0 / ((double)A * A)));
             }
-        if (X1 == SW - 1) break;
+        if (X1 == SW - 1 || cancelled(job->c)) break;  // (pray_cancel: checked per tile)
         for (int y = 0; y < n; y++)  // the last column is the next tile's first
             for (int x = 0; x < n; x++) {
                 Sample &v = k.cache[y * n + x];
@@ -6208,7 +6252,7 @@ void render_band(Worker &k, int band) {
         return;
     }
     Ray rays[RAY_BATCH];
-    for (int j = y0; j < y1; j++) {
+    for (int j = y0; j < y1 && !cancelled(job->c); j++) {
         set_row_background(k, j);
         if (s->antialias > 1) {  // pixel() makes each row of samples ahead
             for (int i = 0; i < W; i++) put_pixel(job, i, j, pixel(k, i, j));
@@ -6233,6 +6277,7 @@ void worker_main(void *arg) {
         render_band(k, band);
         job->mu.lock();
         if (k.tr.over) job->cancelled = job->over = 1;
+        if (cancelled(job->c)) job->cancelled = 1;
         int y0 = band * job->band_rows;
         int rows = y0 + job->band_rows > job->s->height ? job->s->height - y0 : job->band_rows;
         job->rows_done += rows;
@@ -6288,7 +6333,8 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
         job.mu.destroy();
         if (job.over)
             st = fail(c, PRAY_ERR_LIMIT, "a sample of the image needs more than %ld rays (option maxrays)", s->maxrays);
-        else if (job.cancelled) st = fail(c, PRAY_ERR_LIMIT, "render cancelled");
+        else if (job.cancelled)
+            st = cancelled(c) ? fail_cancelled(c) : fail(c, PRAY_ERR_CANCELLED, "cancelled by the progress callback");
     }
     for (int i = 0; wbuf && i < made; i++) {
         const Counters &k = worker_at(wbuf, stride, i).w.k;
@@ -6395,6 +6441,10 @@ pray_status write_tiff(pray_ctx *c, const pray_image *img, int bits, Sink &out) 
     if (!row) return c->status;
     out.put(h, sizeof h);
     for (unsigned long y = 0; y < H; y++) {
+        if (cancelled(c)) {
+            mem_free(c, row);
+            return fail_cancelled(c);
+        }
         const float *px = img->pixels + (size_t)y * W * 3;
         for (size_t i = 0; i < (size_t)W * 3; i++) {
             if (bits == 8) row[i] = (unsigned char)quantize(px[i], 255);
@@ -6416,6 +6466,10 @@ pray_status write_ppm(pray_ctx *c, const pray_image *img, int bits, Sink &out) {
     if (!row) return c->status;
     out.put(head, (size_t)n);
     for (int y = 0; y < img->height; y++) {
+        if (cancelled(c)) {
+            mem_free(c, row);
+            return fail_cancelled(c);
+        }
         const float *px = img->pixels + (size_t)y * img->width * 3;
         for (size_t i = 0; i < (size_t)img->width * 3; i++) {
             if (bits == 8) row[i] = (unsigned char)quantize(px[i], 255);
@@ -6469,19 +6523,23 @@ pray_status write_png(pray_ctx *c, const pray_image *img, Sink &out) {
     unsigned char *buf = (unsigned char *)mem_alloc(c, n);
     if (!buf) return c->status;
     for (size_t i = 0; i < n; i++) buf[i] = (unsigned char)quantize(img->pixels[i], 255);
+    if (cancelled(c)) {
+        mem_free(c, buf);
+        return fail_cancelled(c);
+    }
     PngEncoding e;
     e.c = c;
     e.held.next = e.held.prev = &e.held;
     png_now = &e;
     // Called through a volatile pointer: never inlined here, where its locals would be live across the setjmp.
     int (*volatile encode)(stbi_write_func *, void *, int, int, int, const void *, int) = stbi_write_png_to_func;
-    int ok = 0, nomem = 0;
+    int ok = 0, stopped = 0;
     if (!setjmp(e.failed)) ok = encode(png_sink, &out, img->width, img->height, 3, buf, img->width * 3);
-    else nomem = 1;  // png_alloc: the message is in the context
+    else stopped = 1;  // png_alloc: out of memory or cancelled, the message is in the context
     png_now = NULL;
     while (e.held.next != &e.held) mem_free(c, e.held.next + 1);
     mem_free(c, buf);
-    if (nomem) return c->status;
+    if (stopped) return c->status;
     return ok ? PRAY_OK : fail(c, PRAY_ERR_NOMEM, "PNG encoder failed");
 }
 #endif
@@ -6616,12 +6674,17 @@ FILE *create_temp(pray_ctx *c, const char *path, char **tmp) {
 } // namespace
 
 #if PRAY_HAS_PNG
-// stb_image_write's malloc (p NULL), realloc and free (n 0), on the context of png_now.
+// stb_image_write's malloc (p NULL), realloc and free (n 0), on the context of png_now; where
+// the encoder grows its buffers, it can be cancelled.
 static void *png_alloc(void *p, size_t n) {
     PngEncoding *e = png_now;
     if (!n) {
         mem_free(e->c, p);
         return NULL;
+    }
+    if (cancelled(e->c)) {
+        fail_cancelled(e->c);
+        longjmp(e->failed, 1);
     }
     void *q = mem_realloc(e->c, p, n);
     if (!q) longjmp(e->failed, 1);
@@ -6643,6 +6706,7 @@ const char *pray_status_text(pray_status s) {
     case PRAY_ERR_RUNTIME: return "runtime error";
     case PRAY_ERR_LIMIT: return "limit reached";
     case PRAY_ERR_ARG: return "bad argument";
+    case PRAY_ERR_CANCELLED: return "cancelled";
     }
     return "unknown status";
 }
@@ -6698,15 +6762,18 @@ const char *pray_error(const pray_ctx *c) { return c ? c->msg : "error: no conte
 const char *pray_temp_file(const pray_ctx *c) { return c ? c->temp_name : NULL; }
 pray_status pray_last_status(const pray_ctx *c) { return c ? c->status : PRAY_ERR_ARG; }
 void pray_clear_error(pray_ctx *c) {
+    if (!c) return;
     c->status = PRAY_OK;
     c->msg[0] = 0;
 }
 void pray_set_memory_limit(pray_ctx *c, size_t bytes) {
+    if (!c) return;
     c->host_limit = bytes;
     apply_memory_cap(c);
 }
 
 void pray_set_untrusted(pray_ctx *c) {
+    if (!c) return;
     c->untrusted = 1;
     for (int i = 0; i < OPT_COUNT; i++) {
         double top = OPTS[i].untrusted;
@@ -6721,20 +6788,28 @@ void pray_set_warning(pray_ctx *c, pray_write_fn fn, void *ud) {
     c->warn_ud = ud;
 }
 void pray_set_print(pray_ctx *c, pray_write_fn fn, void *ud) {
+    if (!c) return;
     c->print_fn = fn;
     c->print_ud = ud;
     c->print_set = 1;
 }
 void pray_set_progress(pray_ctx *c, pray_progress_fn fn, void *ud) {
+    if (!c) return;
     c->progress_fn = fn;
     c->progress_ud = ud;
 }
 void pray_set_frame(pray_ctx *c, pray_frame_fn fn, void *ud) {
+    if (!c) return;
     c->frame_fn = fn;
     c->frame_ud = ud;
 }
 
+void pray_cancel(pray_ctx *c) {
+    if (c) c->cancel = 1;
+}
+
 pray_status pray_option(pray_ctx *c, const char *name, double value) {
+    if (!c) return PRAY_ERR_ARG;
     int i = name ? opt_find(name) : -1;
     if (i < 0) return opt_unknown(c, name ? name : "");
     if (i == OPT_OUTPUT) return fail(c, PRAY_ERR_ARG, "option 'output' takes a string");
@@ -6755,6 +6830,7 @@ pray_status pray_option(pray_ctx *c, const char *name, double value) {
 }
 
 pray_status pray_option_string(pray_ctx *c, const char *name, const char *value) {
+    if (!c) return PRAY_ERR_ARG;
     int i = name ? opt_find(name) : -1;
     if (i < 0) return opt_unknown(c, name ? name : "");
     if (i != OPT_OUTPUT) return fail(c, PRAY_ERR_ARG, "option '%s' takes a number", name);
@@ -6774,6 +6850,7 @@ pray_status pray_option_string(pray_ctx *c, const char *name, const char *value)
 }
 
 pray_status pray_option_fix(pray_ctx *c, const char *name, const char *text) {
+    if (!c) return PRAY_ERR_ARG;
     int i = name ? opt_find(name) : -1;
     if (i < 0) return opt_unknown(c, name ? name : "");
     c->fixed &= ~(1u << i);
@@ -6791,12 +6868,37 @@ pray_status pray_option_fix(pray_ctx *c, const char *name, const char *text) {
 }
 
 double pray_option_get(const pray_ctx *c, const char *name) {
-    int i = name ? opt_find(name) : -1;
+    int i = c && name ? opt_find(name) : -1;
     if (i < 0 || i == OPT_OUTPUT) return HUGE_VAL - HUGE_VAL;
     return c->cur.opt.v[i];
 }
 
 namespace {
+// A handle given to the public function `fn` as its `what`: false when it is NULL, not a live
+// handle of that kind (any of the four for kind 0), or made by another context. For NULL the
+// message "fn: no what" is recorded only when no failure is recorded yet (the chain rule: the
+// message of the failure that made the NULL is kept).
+bool handle_ok(pray_ctx *c, const void *p, int kind, const char *fn, const char *what) {
+    if (!p) {
+        if (c->status == PRAY_OK) fail(c, PRAY_ERR_ARG, "%s: no %s", fn, what);
+        return false;
+    }
+    const Handle *h = (const Handle *)p;
+    if (h->magic != HANDLE_MAGIC || (kind ? h->kind != kind : h->kind == H_KIDS || h->kind == H_STRING))
+        return fail(c, PRAY_ERR_ARG, "%s: the %s is not a live handle of its kind", fn, what), false;
+    if (owner_of(p) != c) return fail(c, PRAY_ERR_ARG, "%s: the %s belongs to another context", fn, what), false;
+    return true;
+}
+bool model_ok(pray_ctx *c, const pray_model *m, const char *fn, const char *what = "model") {
+    return handle_ok(c, m, H_MODEL, fn, what);
+}
+bool object_ok(pray_ctx *c, const pray_object *o, const char *fn, const char *what = "object") {
+    return handle_ok(c, o, H_OBJECT, fn, what);
+}
+bool light_ok(pray_ctx *c, const pray_light *l, const char *fn, const char *what = "light") {
+    return handle_ok(c, l, H_LIGHT, fn, what);
+}
+
 bool bad_rgb(pray_ctx *c, pray_rgb v, const char *what) {
     if (cfinite(v)) return false;
     fail(c, PRAY_ERR_ARG, "%s: intensity is not finite", what);
@@ -6821,6 +6923,7 @@ bool bad_radius(pray_ctx *c, double r, const char *what) {
 } // namespace
 
 pray_model *pray_phong(pray_ctx *c, pray_rgb d, pray_rgb s, pray_rgb a, double e) {
+    if (!c) return NULL;
     if (bad_rgb(c, d, "phong") || bad_rgb(c, s, "phong") || bad_rgb(c, a, "phong")) return NULL;
     if (!finite_num(e) || e < 0) {
         fail(c, PRAY_ERR_ARG, "phong: exponent must be a number >= 0, not %g", e);
@@ -6837,6 +6940,7 @@ pray_model *pray_phong(pray_ctx *c, pray_rgb d, pray_rgb s, pray_rgb a, double e
 }
 
 pray_model *pray_mirror(pray_ctx *c, pray_rgb w) {
+    if (!c) return NULL;
     if (bad_rgb(c, w, "mirror")) return NULL;
     pray_model *m = model_new(c);
     if (m) m->reflect = w;
@@ -6844,6 +6948,7 @@ pray_model *pray_mirror(pray_ctx *c, pray_rgb w) {
 }
 
 pray_model *pray_transparent(pray_ctx *c, pray_rgb w, double index) {
+    if (!c) return NULL;
     if (bad_rgb(c, w, "transparent")) return NULL;
     if (!finite_num(index) || index <= 0) {
         fail(c, PRAY_ERR_ARG, "transparent: refraction index must be > 0, not %g", index);
@@ -6858,6 +6963,7 @@ pray_model *pray_transparent(pray_ctx *c, pray_rgb w, double index) {
 }
 
 pray_model *pray_color(pray_ctx *c, pray_rgb col) {
+    if (!c) return NULL;
     if (bad_rgb(c, col, "color")) return NULL;
     pray_model *m = model_new(c);
     if (m) m->emit = col;
@@ -6865,16 +6971,18 @@ pray_model *pray_color(pray_ctx *c, pray_rgb col) {
 }
 
 pray_model *pray_model_add(pray_ctx *c, pray_model *a, pray_model *b) {
-    return a && b ? model_sum(c, a, b) : NULL;
+    if (!c || !model_ok(c, a, "pray_model_add", "model a") || !model_ok(c, b, "pray_model_add", "model b")) return NULL;
+    return model_sum(c, a, b);
 }
 
 pray_model *pray_model_scale(pray_ctx *c, pray_model *m, pray_rgb f) {
-    if (!m || bad_rgb(c, f, "model scale")) return NULL;
+    if (!c || !model_ok(c, m, "pray_model_scale") || bad_rgb(c, f, "model scale")) return NULL;
     return model_times(c, m, f);
 }
 
 pray_object *pray_sphere(pray_ctx *c, pray_model *m, pray_vec centre, double r) {
-    if (!m || bad_vec(c, centre, "sphere", false) || bad_radius(c, r, "sphere")) return NULL;
+    if (!c || !model_ok(c, m, "pray_sphere") || bad_vec(c, centre, "sphere", false) || bad_radius(c, r, "sphere"))
+        return NULL;
     pray_object *o = obj_new(c, O_SPHERE, m);
     if (!o) return NULL;
     o->p = centre;
@@ -6883,7 +6991,8 @@ pray_object *pray_sphere(pray_ctx *c, pray_model *m, pray_vec centre, double r) 
 }
 
 pray_object *pray_plane(pray_ctx *c, pray_model *m, pray_vec point, pray_vec normal) {
-    if (!m || bad_vec(c, point, "plane", false) || bad_vec(c, normal, "plane normal", true))
+    if (!c || !model_ok(c, m, "pray_plane") || bad_vec(c, point, "plane", false) ||
+        bad_vec(c, normal, "plane normal", true))
         return NULL;
     pray_object *o = obj_new(c, O_PLANE, m);
     if (!o) return NULL;
@@ -6893,7 +7002,8 @@ pray_object *pray_plane(pray_ctx *c, pray_model *m, pray_vec point, pray_vec nor
 }
 
 pray_object *pray_cylinder(pray_ctx *c, pray_model *m, pray_vec point, pray_vec axis, double r) {
-    if (!m || bad_vec(c, point, "cylinder", false) || bad_vec(c, axis, "cylinder axis", true) ||
+    if (!c || !model_ok(c, m, "pray_cylinder") || bad_vec(c, point, "cylinder", false) ||
+        bad_vec(c, axis, "cylinder axis", true) ||
         bad_radius(c, r, "cylinder"))
         return NULL;
     pray_object *o = obj_new(c, O_CYLINDER, m);
@@ -6904,7 +7014,9 @@ pray_object *pray_cylinder(pray_ctx *c, pray_model *m, pray_vec point, pray_vec 
     return o;
 }
 
-pray_object *pray_one(pray_ctx *c, pray_model *m) { return m ? obj_new(c, O_ONE, m) : NULL; }
+pray_object *pray_one(pray_ctx *c, pray_model *m) {
+    return c && model_ok(c, m, "pray_one") ? obj_new(c, O_ONE, m) : NULL;
+}
 
 namespace {
 bool bad_pair(pray_ctx *c, pray_vec u, pray_vec v, const char *what) {
@@ -6922,7 +7034,7 @@ bool bad_pair(pray_ctx *c, pray_vec u, pray_vec v, const char *what) {
 } // namespace
 
 pray_object *pray_planemap(pray_ctx *c, pray_model *m, pray_vec point, pray_vec normal, pray_vec u, pray_vec v) {
-    if (!m || bad_pair(c, u, v, "planemap")) return NULL;
+    if (!c || !model_ok(c, m, "pray_planemap") || bad_pair(c, u, v, "planemap")) return NULL;
     pray_object *o = pray_plane(c, m, point, normal);
     if (!o) return NULL;
     o->map = MAP_PLANE;
@@ -6932,7 +7044,7 @@ pray_object *pray_planemap(pray_ctx *c, pray_model *m, pray_vec point, pray_vec 
 }
 
 pray_object *pray_spheremap(pray_ctx *c, pray_model *m, pray_vec centre, double r, pray_vec north, pray_vec zero) {
-    if (!m || bad_pair(c, north, zero, "spheremap")) return NULL;
+    if (!c || !model_ok(c, m, "pray_spheremap") || bad_pair(c, north, zero, "spheremap")) return NULL;
     pray_object *o = pray_sphere(c, m, centre, r);
     if (!o) return NULL;
     o->map = MAP_SPHERE;
@@ -6943,14 +7055,15 @@ pray_object *pray_spheremap(pray_ctx *c, pray_model *m, pray_vec centre, double 
 
 pray_texture *pray_texture_file(pray_ctx *c, const char *path) {
     if (!c || !path || !*path) {
-        if (c) fail(c, PRAY_ERR_ARG, "no texture file name");
+        if (c) fail(c, PRAY_ERR_ARG, "pray_texture_file: no file name");
         return NULL;
     }
     return texture_file(c, "", 0, path, FIND_AS_NAMED);
 }
 
 pray_texture *pray_texture_tiff(pray_ctx *c, const void *data, size_t n, const char *name) {
-    if (!c || !data) return NULL;
+    if (!c) return NULL;
+    if (!data) return fail(c, PRAY_ERR_ARG, "pray_texture_tiff: no data"), (pray_texture *)NULL;
     return texture_make(c, name ? name : "texture", (const unsigned char *)data, n);
 }
 
@@ -6966,7 +7079,9 @@ pray_rgb pray_texture_pixel(const pray_texture *t, int x, int y) {
 }
 
 pray_model *pray_tiff(pray_ctx *c, pray_model *m0, pray_model *m1, pray_texture *t) {
-    if (!m0 || !m1 || !t) return NULL;
+    if (!c || !model_ok(c, m0, "pray_tiff", "model m0") || !model_ok(c, m1, "pray_tiff", "model m1") ||
+        !handle_ok(c, t, H_TEXTURE, "pray_tiff", "texture"))
+        return NULL;
     pray_model *m = model_node(c, M_TEX, m0, m1);
     if (m) {
         m->tex = t;
@@ -6976,7 +7091,7 @@ pray_model *pray_tiff(pray_ctx *c, pray_model *m0, pray_model *m1, pray_texture 
 }
 
 pray_model *pray_tiffbump(pray_ctx *c, pray_model *a, double amount, pray_texture *t) {
-    if (!a || !t) return NULL;
+    if (!c || !model_ok(c, a, "pray_tiffbump") || !handle_ok(c, t, H_TEXTURE, "pray_tiffbump", "texture")) return NULL;
     if (!finite_num(amount)) {
         fail(c, PRAY_ERR_ARG, "tiffbump: the amount is not finite");
         return NULL;
@@ -6991,7 +7106,7 @@ pray_model *pray_tiffbump(pray_ctx *c, pray_model *a, double amount, pray_textur
 }
 
 pray_model *pray_move(pray_ctx *c, pray_model *a, double x, double y) {
-    if (!a) return NULL;
+    if (!c || !model_ok(c, a, "pray_move")) return NULL;
     if (!finite_num(x) || !finite_num(y)) {
         fail(c, PRAY_ERR_ARG, "move: the shift is not finite");
         return NULL;
@@ -7020,7 +7135,9 @@ bool glyph_ink(const pray_texture *font, int code, int row, int col, int cw, int
 
 pray_object *pray_text(pray_ctx *c, pray_model *m, const char *text, pray_vec P, pray_vec X, pray_vec Y, double h,
                        pray_texture *font, double spacing) {
-    if (!c || !m || !text) return NULL;
+    if (!c || !model_ok(c, m, "pray_text") || (font && !handle_ok(c, font, H_TEXTURE, "pray_text", "font")))
+        return NULL;
+    if (!text) return fail(c, PRAY_ERR_ARG, "pray_text: no text"), (pray_object *)NULL;
     if (bad_vec(c, P, "text", false) || bad_pair(c, X, Y, "text")) return NULL;
     if (!finite_num(h) || h <= 0) {
         fail(c, PRAY_ERR_ARG, "text: the thickness must be a positive number, not %g", h);
@@ -7111,10 +7228,10 @@ pray_object *pray_text(pray_ctx *c, pray_model *m, const char *text, pray_vec P,
     }
     return all;
 }
-pray_object *pray_nothing(pray_ctx *c) { return obj_new(c, O_NOTHING, NULL); }
+pray_object *pray_nothing(pray_ctx *c) { return c ? obj_new(c, O_NOTHING, NULL) : NULL; }
 
 pray_object *pray_csg(pray_ctx *c, pray_op op, pray_object *a, pray_object *b) {
-    if (!a || !b) return NULL;
+    if (!c || !object_ok(c, a, "pray_csg", "object a") || !object_ok(c, b, "pray_csg", "object b")) return NULL;
     int k = op == PRAY_UNION ? O_UNION : op == PRAY_INTERSECTION ? O_INTER : op == PRAY_DIFFERENCE ? O_DIFF : -1;
     if (k < 0) {
         fail(c, PRAY_ERR_ARG, "unknown CSG operation %d", (int)op);
@@ -7123,10 +7240,12 @@ pray_object *pray_csg(pray_ctx *c, pray_op op, pray_object *a, pray_object *b) {
     return csg_op(c, k, a, b);
 }
 
-pray_object *pray_complement(pray_ctx *c, pray_object *a) { return a ? complement_of(c, a) : NULL; }
+pray_object *pray_complement(pray_ctx *c, pray_object *a) {
+    return c && object_ok(c, a, "pray_complement") ? complement_of(c, a) : NULL;
+}
 
 pray_object *pray_scale(pray_ctx *c, pray_object *a, double s) {
-    if (!a) return NULL;
+    if (!c || !object_ok(c, a, "pray_scale")) return NULL;
     if (!finite_num(s) || s == 0) {
         fail(c, PRAY_ERR_ARG, "scale factor must be a finite number other than 0, not %g", s);
         return NULL;
@@ -7134,11 +7253,11 @@ pray_object *pray_scale(pray_ctx *c, pray_object *a, double s) {
     return obj_transform(c, a, xf_scale(s));
 }
 pray_object *pray_translate(pray_ctx *c, pray_object *a, pray_vec v) {
-    if (!a || bad_vec(c, v, "translation", false)) return NULL;
+    if (!c || !object_ok(c, a, "pray_translate") || bad_vec(c, v, "translation", false)) return NULL;
     return obj_transform(c, a, xf_translate(v));
 }
 pray_object *pray_rotate(pray_ctx *c, pray_object *a, pray_vec deg) {
-    if (!a || bad_vec(c, deg, "rotation", false)) return NULL;
+    if (!c || !object_ok(c, a, "pray_rotate") || bad_vec(c, deg, "rotation", false)) return NULL;
     return obj_transform(c, a, xf_rotate(deg));
 }
 int pray_object_primitives(const pray_object *a) {
@@ -7146,6 +7265,7 @@ int pray_object_primitives(const pray_object *a) {
 }
 
 pray_light *pray_dirlight(pray_ctx *c, pray_rgb i, pray_vec d) {
+    if (!c) return NULL;
     if (bad_rgb(c, i, "dirlight") || bad_vec(c, d, "dirlight direction", true)) return NULL;
     pray_light *l = light_new(c, 1);
     if (!l) return NULL;
@@ -7155,6 +7275,7 @@ pray_light *pray_dirlight(pray_ctx *c, pray_rgb i, pray_vec d) {
     return l;
 }
 pray_light *pray_pointlight(pray_ctx *c, pray_rgb i, pray_vec p) {
+    if (!c) return NULL;
     if (bad_rgb(c, i, "pointlight") || bad_vec(c, p, "pointlight", false)) return NULL;
     pray_light *l = light_new(c, 1);
     if (!l) return NULL;
@@ -7164,10 +7285,11 @@ pray_light *pray_pointlight(pray_ctx *c, pray_rgb i, pray_vec p) {
     return l;
 }
 pray_light *pray_light_add(pray_ctx *c, pray_light *a, pray_light *b) {
-    return a && b ? light_union(c, a, b) : NULL;
+    if (!c || !light_ok(c, a, "pray_light_add", "light a") || !light_ok(c, b, "pray_light_add", "light b")) return NULL;
+    return light_union(c, a, b);
 }
 pray_light *pray_light_scale(pray_ctx *c, pray_light *l, double s) {
-    if (!l) return NULL;
+    if (!c || !light_ok(c, l, "pray_light_scale")) return NULL;
     if (!finite_num(s) || s == 0) {
         fail(c, PRAY_ERR_ARG, "scale factor must be a finite number other than 0, not %g", s);
         return NULL;
@@ -7175,16 +7297,30 @@ pray_light *pray_light_scale(pray_ctx *c, pray_light *l, double s) {
     return light_transform(c, l, xf_scale(s));
 }
 pray_light *pray_light_translate(pray_ctx *c, pray_light *l, pray_vec v) {
-    if (!l || bad_vec(c, v, "translation", false)) return NULL;
+    if (!c || !light_ok(c, l, "pray_light_translate") || bad_vec(c, v, "translation", false)) return NULL;
     return light_transform(c, l, xf_translate(v));
 }
 pray_light *pray_light_rotate(pray_ctx *c, pray_light *l, pray_vec deg) {
-    if (!l || bad_vec(c, deg, "rotation", false)) return NULL;
+    if (!c || !light_ok(c, l, "pray_light_rotate") || bad_vec(c, deg, "rotation", false)) return NULL;
     return light_transform(c, l, xf_rotate(deg));
 }
 
+// Releases: NULL is ignored; a handle of the wrong kind or of another context is refused with a
+// message and left alone.
 void pray_release(pray_ctx *c, void *h) {
-    if (c && h) release_handle(c, h);
+    if (c && h && handle_ok(c, h, 0, "pray_release", "handle")) release_handle(c, h);
+}
+void pray_object_release(pray_ctx *c, pray_object *o) {
+    if (c && o && object_ok(c, o, "pray_object_release")) release_handle(c, o);
+}
+void pray_model_release(pray_ctx *c, pray_model *m) {
+    if (c && m && model_ok(c, m, "pray_model_release")) release_handle(c, m);
+}
+void pray_light_release(pray_ctx *c, pray_light *l) {
+    if (c && l && light_ok(c, l, "pray_light_release")) release_handle(c, l);
+}
+void pray_texture_release(pray_ctx *c, pray_texture *t) {
+    if (c && t && handle_ok(c, t, H_TEXTURE, "pray_texture_release", "texture")) release_handle(c, t);
 }
 
 namespace {
@@ -7215,12 +7351,15 @@ pray_status set_camera(pray_ctx *c, int parallel, pray_vec x, pray_vec y, pray_v
 } // namespace
 
 pray_status pray_perspective(pray_ctx *c, pray_vec x, pray_vec y, pray_vec e, pray_vec p) {
+    if (!c) return PRAY_ERR_ARG;
     return set_camera(c, 0, x, y, e, p);
 }
 pray_status pray_parallel(pray_ctx *c, pray_vec x, pray_vec y, pray_vec e, pray_vec p) {
+    if (!c) return PRAY_ERR_ARG;
     return set_camera(c, 1, x, y, e, p);
 }
 pray_status pray_background(pray_ctx *c, pray_rgb top, pray_rgb bottom) {
+    if (!c) return PRAY_ERR_ARG;
     if (bad_rgb(c, top, "background") || bad_rgb(c, bottom, "background")) return c->status;
     c->cur.bg_top = top;
     c->cur.bg_bottom = bottom;
@@ -7229,10 +7368,16 @@ pray_status pray_background(pray_ctx *c, pray_rgb top, pray_rgb bottom) {
 }
 
 pray_status pray_render(pray_ctx *c, pray_object *root, pray_light *lights, pray_image *out) {
-    if (!c || !out) return PRAY_ERR_ARG;
-    out->width = out->height = 0;
-    out->pixels = NULL;
+    if (out) {
+        out->width = out->height = 0;
+        out->pixels = NULL;
+    }
+    if (!c) return PRAY_ERR_ARG;
+    Call call(c);
+    if (!out) return fail(c, PRAY_ERR_ARG, "pray_render: no image to render into");
     if (!root) return c->status != PRAY_OK ? c->status : fail(c, PRAY_ERR_ARG, "no object to render");
+    if (!object_ok(c, root, "pray_render", "object") || (lights && !light_ok(c, lights, "pray_render", "light")))
+        return c->status;
     int W = opt_int(c, OPT_WIDTH), H = opt_int(c, OPT_HEIGHT);
     if ((double)W * H > MAX_IMAGE_PIXELS)
         return fail(c, PRAY_ERR_LIMIT, "image of %d x %d pixels is too large", W, H);
@@ -7265,7 +7410,11 @@ pray_status pray_render(pray_ctx *c, pray_object *root, pray_light *lights, pray
     return st;
 }
 
-void pray_stats_get(const pray_ctx *c, pray_stats *out) { *out = c->stats; }
+void pray_stats_get(const pray_ctx *c, pray_stats *out) {
+    if (!out) return;
+    if (c) *out = c->stats;
+    else memset(out, 0, sizeof *out);
+}
 
 struct pray_scene {
     Scene s;
@@ -7273,7 +7422,8 @@ struct pray_scene {
 };
 
 pray_scene *pray_prepare(pray_ctx *c, pray_object *root) {
-    if (!c || !root) return NULL;
+    if (!c || !object_ok(c, root, "pray_prepare")) return NULL;
+    Call call(c);
     pray_scene *q = (pray_scene *)mem_zalloc(c, sizeof(pray_scene));
     if (!q) return NULL;
     if (scene_build(c, &q->s, root, NULL, false) || !scratch_init(c, &q->w, &q->s)) {
@@ -7308,7 +7458,13 @@ struct CollectHits {
 
 int pray_intersect(pray_ctx *c, pray_scene *q, pray_vec origin, pray_vec dir, double tmax, pray_hit *hits,
                    int max_hits) {
-    if (!c || !q || (max_hits > 0 && !hits)) return -1;
+    if (!c) return -1;
+    if (!q) {  // (the chain rule, as for handles)
+        if (c->status == PRAY_OK) fail(c, PRAY_ERR_ARG, "pray_intersect: no scene");
+        return -1;
+    }
+    if (owner_of(q) != c) return fail(c, PRAY_ERR_ARG, "pray_intersect: the scene belongs to another context"), -1;
+    if (max_hits > 0 && !hits) return fail(c, PRAY_ERR_ARG, "pray_intersect: no room for the hits"), -1;
     if (!vfinite(origin) || !vfinite(dir) || vlen(dir) == 0 || tmax != tmax) {
         fail(c, PRAY_ERR_ARG, "pray_intersect: the ray must have a finite origin and direction");
         return -1;
@@ -7326,34 +7482,51 @@ int pray_intersect(pray_ctx *c, pray_scene *q, pray_vec origin, pray_vec dir, do
 
 void pray_scene_free(pray_ctx *c, pray_scene *q) {
     if (!c || !q) return;
+    if (owner_of(q) != c) {
+        fail(c, PRAY_ERR_ARG, "pray_scene_free: the scene belongs to another context");
+        return;
+    }
     scratch_release(c, &q->w);
     scene_release(c, &q->s);
     mem_free(c, q);
 }
 
 void pray_image_free(pray_ctx *c, pray_image *img) {
-    if (!img) return;
+    if (!c || !img) return;
+    if (img->pixels && owner_of(img->pixels) != c) {
+        fail(c, PRAY_ERR_ARG, "pray_image_free: the image belongs to another context");
+        return;
+    }
     mem_free(c, img->pixels);
     img->pixels = NULL;
     img->width = img->height = 0;
 }
 
 pray_status pray_write_tiff(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
+    if (!c) return PRAY_ERR_ARG;
+    Call call(c);
     if (!image_ok(c, img)) return c->status;
+    if (!fn) return fail(c, PRAY_ERR_ARG, "pray_write_tiff: no write function");
     if (bits != 8 && bits != 16) return fail(c, PRAY_ERR_ARG, "bits must be 8 or 16");
     Sink s = {fn, ud};
     return write_tiff(c, img, bits, s);
 }
 
 pray_status pray_write_ppm(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
+    if (!c) return PRAY_ERR_ARG;
+    Call call(c);
     if (!image_ok(c, img)) return c->status;
+    if (!fn) return fail(c, PRAY_ERR_ARG, "pray_write_ppm: no write function");
     if (bits != 8 && bits != 16) return fail(c, PRAY_ERR_ARG, "bits must be 8 or 16");
     Sink s = {fn, ud};
     return write_ppm(c, img, bits, s);
 }
 
 pray_status pray_write_png(pray_ctx *c, const pray_image *img, pray_write_fn fn, void *ud) {
+    if (!c) return PRAY_ERR_ARG;
+    Call call(c);
     if (!image_ok(c, img)) return c->status;
+    if (!fn) return fail(c, PRAY_ERR_ARG, "pray_write_png: no write function");
 #if PRAY_HAS_PNG
     Sink s = {fn, ud};
     return write_png(c, img, s);
@@ -7365,6 +7538,8 @@ pray_status pray_write_png(pray_ctx *c, const pray_image *img, pray_write_fn fn,
 }
 
 pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *path, int bits) {
+    if (!c) return PRAY_ERR_ARG;
+    Call call(c);
     if (!image_ok(c, img)) return c->status;
     if (!path || !*path) return fail(c, PRAY_ERR_ARG, "no file name");
     if (bits != 8 && bits != 16) return fail(c, PRAY_ERR_ARG, "bits must be 8 or 16");
@@ -9324,6 +9499,7 @@ void print_out(pray_ctx *c, const char *s, size_t n) {
 pray_status exec_block(Interp &I, Stmt **body, int n);
 
 pray_status step(Interp &I, const Stmt *s) {
+    if (cancelled(I.c)) return perr(I.c, I.name, s->line, s->col, PRAY_ERR_CANCELLED, "cancelled");
     I.steps += 1;
     double lim = I.c->cur.opt.v[OPT_MAXSTEPS];
     if (lim > 0 && I.steps > lim)
@@ -9518,6 +9694,7 @@ void reset_run(pray_ctx *c) {
 
 pray_status pray_run_string(pray_ctx *c, const char *name, const char *text, size_t len) {
     if (!c) return PRAY_ERR_ARG;
+    Call call(c);
     reset_run(c);
     if (!text) return fail(c, PRAY_ERR_ARG, "no program text");
 #if PRAY_HAS_INTERP
@@ -9567,6 +9744,7 @@ bool read_program(pray_ctx *c, FILE *f, Text *t) {
 // A path of "-" reads standard input, named stdin.ray in messages.
 pray_status pray_run_file(pray_ctx *c, const char *path) {
     if (!c) return PRAY_ERR_ARG;
+    Call call(c);
     if (!path) return fail(c, PRAY_ERR_ARG, "no program file");
 #if PRAY_HAS_STDIO
     bool in = strcmp(path, "-") == 0;

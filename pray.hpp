@@ -48,7 +48,8 @@ typedef enum pray_status {
     PRAY_ERR_SYNTAX = 3,  /* the PRAY program is malformed */
     PRAY_ERR_RUNTIME = 4, /* the PRAY program failed while running (type error, ...) */
     PRAY_ERR_LIMIT = 5,   /* a limit was reached (maxsteps, image size, ...) */
-    PRAY_ERR_ARG = 6      /* a bad argument to an API function */
+    PRAY_ERR_ARG = 6,     /* a bad argument to an API function */
+    PRAY_ERR_CANCELLED = 7 /* stopped by pray_cancel or by the progress callback */
 } pray_status;
 
 /* The text of a status code ("ok", "out of memory", ...). Never NULL. */
@@ -65,13 +66,17 @@ typedef struct pray_vec { double x, y, z; } pray_vec; /* a point or a vector */
 typedef struct pray_rgb { double r, g, b; } pray_rgb; /* an intensity; 1 = full */
 
 /* A rendered image: width*height pixels, 3 floats each (R, G, B), rows from the top.
-   Values are linear and may exceed 1; writers clamp to [0, 1]. Free with pray_image_free. */
+   Values are linear and may exceed 1; writers clamp to [0, 1]. The pixels of an image that
+   pray_render made belong to its context, like its handles: pray_image_free frees them early,
+   pray_free at the latest. Images you fill yourself can be written (pray_write_*), never freed
+   by pray. */
 typedef struct pray_image {
     int width, height;
     float *pixels;
 } pray_image;
 
-/* Opaque handles. All belong to the context that made them and die with it. */
+/* Opaque handles. All belong to the context that made them and die with it; another context
+   refuses them. */
 typedef struct pray_ctx pray_ctx;       /* one context per thread of use */
 typedef struct pray_object pray_object; /* a solid: a primitive or a CSG tree */
 typedef struct pray_model pray_model;   /* a lighting model (material) */
@@ -83,26 +88,47 @@ typedef struct pray_texture pray_texture; /* a decoded TIFF image, for textures 
 typedef void *(*pray_alloc_fn)(void *ud, void *ptr, size_t osize, size_t nsize);
 /* Output of the PRAY `print` statement, and any byte sink (image writers). */
 typedef void (*pray_write_fn)(void *ud, const void *data, size_t n);
-/* Progress of a render: rows done of rows total. Return non-zero to cancel (PRAY_ERR_LIMIT). */
+/* Progress of a render: rows done of rows total, after each band of a few rows (not while the
+   scene is prepared). Called on any of the render's threads (the caller's or a worker), one
+   call at a time, `done` increasing: it must be thread-safe, and must not call pray on the same
+   context except pray_cancel. Return non-zero to cancel: the render fails with
+   PRAY_ERR_CANCELLED ("cancelled by the progress callback"). */
 typedef int (*pray_progress_fn)(void *ud, int done, int total);
 /* A frame rendered by `rendertiff`. When set, it is called instead of writing the file; `name` is
    the file name the frame would have been written to. Return PRAY_OK to continue. */
 typedef pray_status (*pray_frame_fn)(void *ud, const pray_image *img, const char *name);
 
 /* ---------------------------------------------------------------------------------------------
-   Context.
+   Conventions of every function below, unless its comment says otherwise:
+   - A failing call returns a status other than PRAY_OK (makers: NULL; others -1 or NaN as said)
+     and leaves its message in pray_error(ctx) and its status in pray_last_status(ctx).
+   - A NULL context: PRAY_ERR_ARG, NULL, -1 or NaN; void functions do nothing. Nothing is
+     recorded anywhere (pray_error(NULL) is "error: no context").
+   - A NULL handle (object, model, light, texture, scene): the call fails; "pray_f: no model" is
+     recorded only when no failure is recorded yet, so a chain of calls keeps the message of its
+     first failure (clear it with pray_clear_error). Releases and frees ignore NULL. Other NULL
+     pointers (names, texts, buffers, callbacks that are needed) fail with a message always.
+   - A handle, scene or image of another context is refused: PRAY_ERR_ARG, "pray_f: the model
+     belongs to another context"; it is left alone.
+   - What pray returns (handles, scenes, images) belongs to the context and dies with pray_free at
+     the latest. Strings returned are pray's, valid until the next call on the context.
+   - A context is used by one thread at a time (pray_cancel excepted).
    ------------------------------------------------------------------------------------------- */
-/* A new context with the default allocator (malloc). NULL when out of memory. */
+/* A new context with the default allocator (malloc). NULL when out of memory, or when built
+   with PRAY_NO_DEFAULT_ALLOC. */
 pray_ctx *pray_new(void);
-/* A new context with your allocator; every byte pray uses goes through it. */
+/* A new context with your allocator; every byte pray uses goes through it. NULL when alloc is
+   NULL or fails. */
 pray_ctx *pray_new_with(pray_alloc_fn alloc, void *ud);
-/* Free the context and everything made in it (objects, models, lights, but not images). */
+/* Free the context and all that is left of what was made in it: handles, prepared scenes and
+   rendered images. Pointers to them are dangling from here on. */
 void pray_free(pray_ctx *ctx);
 /* The last error: "name:line:col: error: message" for program errors, "error: message" else.
    "" when there was none. Valid until the next call on the context. */
 const char *pray_error(const pray_ctx *ctx);
 /* The status of the last failing call (PRAY_OK if none failed since pray_clear_error). */
 pray_status pray_last_status(const pray_ctx *ctx);
+/* Forget the last error: status PRAY_OK, message "". */
 void pray_clear_error(pray_ctx *ctx);
 /* Cap the bytes a context may hold at once (0 = no cap). Over the cap, calls fail with
    PRAY_ERR_NOMEM. Option maxmem (MiB) can lower the cap further, never raise it. */
@@ -116,7 +142,8 @@ void pray_set_memory_limit(pray_ctx *ctx, size_t bytes);
    and DOS links inside the directory are followed); an `output` set by a program must be a plain
    file name. */
 void pray_set_untrusted(pray_ctx *ctx);
-/* Where `print` writes (default: standard output; NULL fn discards). */
+/* Where `print` writes (default: standard output; NULL fn discards). Called on the calling
+   thread, during pray_run_*. */
 void pray_set_print(pray_ctx *ctx, pray_write_fn fn, void *ud);
 /* Where warnings go (default: nowhere; the command-line program writes them to standard error):
    one line each, "name:line:col: warning: message\n". A run warns once when the camera's
@@ -124,11 +151,22 @@ void pray_set_print(pray_ctx *ctx, pray_write_fn fn, void *ud);
 void pray_set_warning(pray_ctx *ctx, pray_write_fn fn, void *ud);
 /* Progress callback for renders (default none). */
 void pray_set_progress(pray_ctx *ctx, pray_progress_fn fn, void *ud);
-/* Frame callback for `rendertiff` (default none: frames are written to files). */
+/* Frame callback for `rendertiff` (default none: frames are written to files). The image passed
+   to it is freed when it returns. */
 void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
 /* The temporary file an image is being written to now (see pray_write_image), else NULL. For a
    signal handler that removes it before the program dies: reading it is async-signal-safe. */
 const char *pray_temp_file(const pray_ctx *ctx);
+/* Stop the call running on the context: pray_run_string, pray_run_file, pray_render,
+   pray_prepare, pray_write_image, pray_write_tiff, pray_write_ppm or pray_write_png. Safe from any thread and
+   from a signal handler: it only sets a flag. The call stops at its next check (each statement
+   of a program; each row of voxels while a scene is prepared; each row of an image rendered or
+   written) with PRAY_ERR_CANCELLED, "error: cancelled" (with the place in a program). It leaves
+   no file behind and no image; a byte sink has got part of one, to be thrown away. One of those
+   calls starting clears the flag: a cancel made when none runs, or just before one starts, is
+   forgotten. A host that must not lose one keeps its own flag too and checks it between calls.
+   Other functions ignore the flag. */
+void pray_cancel(pray_ctx *ctx);
 
 /* ---------------------------------------------------------------------------------------------
    Options: the same names as the PRAY `option` statement: width, height (pixels, default 256),
@@ -162,7 +200,7 @@ pray_status pray_option_string(pray_ctx *ctx, const char *name, const char *valu
 /* Set an option from its text (as `-D name=value` does) and fix it: later pray_option calls and
    `option` statements of programs no longer change it. This is how the command line wins. */
 pray_status pray_option_fix(pray_ctx *ctx, const char *name, const char *value);
-/* The value of a numeric option; NaN for an unknown name or "output". */
+/* The value of a numeric option; NaN for an unknown name, "output" or a NULL argument. */
 double pray_option_get(const pray_ctx *ctx, const char *name);
 
 /* ---------------------------------------------------------------------------------------------
@@ -177,13 +215,15 @@ pray_status pray_run_string(pray_ctx *ctx, const char *name, const char *text, s
    option maxline and holds to the memory cap, so an endless input ends in an error. Its images
    never replace it: an output naming the program file itself fails with PRAY_ERR_IO. */
 pray_status pray_run_file(pray_ctx *ctx, const char *path);
-/* The number of frames the last run rendered. */
+/* The number of frames the last run rendered (0 for a NULL context). */
 int pray_frames(const pray_ctx *ctx);
 
 /* ---------------------------------------------------------------------------------------------
-   Building scenes directly. Every maker returns NULL on error (message in the context); a NULL
-   argument makes the result NULL without a new message, so a chain of calls can be checked once
-   at its end. Handles are reference counted: pass them freely; pray_release drops yours.
+   Building scenes directly. Every maker returns a new handle, or NULL on error (see the
+   conventions above: a NULL handle given to a maker keeps the message of the failure that made
+   it, so a chain of calls can be checked once at its end). Handles are reference counted: what
+   a maker makes holds the handles it was given, so you may release yours at once;
+   pray_*_release drops yours, pray_free all.
    ------------------------------------------------------------------------------------------- */
 /* Models. */
 pray_model *pray_phong(pray_ctx *ctx, pray_rgb diffuse, pray_rgb specular, pray_rgb ambient,
@@ -195,11 +235,13 @@ pray_model *pray_model_add(pray_ctx *ctx, pray_model *a, pray_model *b);
 pray_model *pray_model_scale(pray_ctx *ctx, pray_model *m, pray_rgb factor);
 
 /* Textures: a TIFF file (a regular file, decoded once per context run, however often it is
-   asked for), or TIFF data in memory. Baseline TIFF: bilevel, grey, palette, RGB(A); 1, 4, 8,
-   16 bits; strips or tiles; no compression, PackBits or LZW (with the horizontal predictor). */
+   asked for), or TIFF data in memory (decoded at once; `name`, NULL for "texture", is used in
+   messages). Baseline TIFF: bilevel, grey, palette, RGB(A); 1, 4, 8, 16 bits; strips or tiles;
+   no compression, PackBits or LZW (with the horizontal predictor). */
 pray_texture *pray_texture_file(pray_ctx *ctx, const char *path);
 pray_texture *pray_texture_tiff(pray_ctx *ctx, const void *data, size_t size, const char *name);
-/* Width and height of a texture in pixels, and its colour at texel (x, y) (rows from the top). */
+/* Width and height of a texture in pixels (0 for NULL), and its colour at texel (x, y) (rows
+   from the top; black for NULL or outside). Any context's texture, no context needed. */
 void pray_texture_size(const pray_texture *tex, int *width, int *height);
 pray_rgb pray_texture_pixel(const pray_texture *tex, int x, int y);
 /* Textured models: m0 where the texture is 0 blended per channel into m1 where it is 1; m with
@@ -242,7 +284,7 @@ pray_object *pray_complement(pray_ctx *ctx, pray_object *a);
 pray_object *pray_scale(pray_ctx *ctx, pray_object *a, double s);
 pray_object *pray_translate(pray_ctx *ctx, pray_object *a, pray_vec offset);
 pray_object *pray_rotate(pray_ctx *ctx, pray_object *a, pray_vec degrees);
-/* Primitives in the tree (what `print` shows as "object (N primitives)"). */
+/* Primitives in the tree (what `print` shows as "object (N primitives)"); 0 for NULL. */
 int pray_object_primitives(const pray_object *a);
 
 /* Lights. */
@@ -254,7 +296,14 @@ pray_light *pray_light_scale(pray_ctx *ctx, pray_light *l, double s);
 pray_light *pray_light_translate(pray_ctx *ctx, pray_light *l, pray_vec offset);
 pray_light *pray_light_rotate(pray_ctx *ctx, pray_light *l, pray_vec degrees);
 
-/* Drop a reference (any of the three handle kinds; NULL is ignored). */
+/* Drop your reference; the handle is freed when nothing made from it uses it. NULL is
+   ignored; a handle of another context or of the wrong kind is refused (PRAY_ERR_ARG) and left
+   alone. pray_release takes any of the four kinds and checks which it is (it cannot tell a
+   freed handle from a live one: that is undefined, as for free). */
+void pray_object_release(pray_ctx *ctx, pray_object *obj);
+void pray_model_release(pray_ctx *ctx, pray_model *model);
+void pray_light_release(pray_ctx *ctx, pray_light *light);
+void pray_texture_release(pray_ctx *ctx, pray_texture *tex);
 void pray_release(pray_ctx *ctx, void *handle);
 
 /* Camera and background, as the statements of the same names. */
@@ -292,8 +341,10 @@ typedef struct pray_stats {
 } pray_stats;
 
 /* Render `root` lit by `lights` (NULL = no light) with the context's camera, background and
-   options into `out` (allocated here; free with pray_image_free). */
+   options into `out`. *out is always set: the image, or 0 x 0 and NULL pixels on failure (an
+   image it held before is not freed). The image belongs to the context (pray_image_free). */
 pray_status pray_render(pray_ctx *ctx, pray_object *root, pray_light *lights, pray_image *out);
+/* The statistics (all zero for a NULL context; nothing for a NULL out). */
 void pray_stats_get(const pray_ctx *ctx, pray_stats *out);
 
 /* Ray queries, for picking and for checking the renderer: prepare a solid once with the
@@ -307,12 +358,19 @@ typedef struct pray_hit {
     int entering;      /* 1 where the ray enters the solid, 0 where it leaves */
     pray_vec normal;   /* unit normal facing out of the solid */
 } pray_hit;
+/* A prepared scene, or NULL. It keeps no reference to root: release root when you like. It
+   belongs to the context (pray_scene_free frees it early). */
 pray_scene *pray_prepare(pray_ctx *ctx, pray_object *root);
-/* Up to max_hits hits with 0 < t < tmax (HUGE_VAL for all) in order; returns how many there
-   are in all (which may exceed max_hits), or -1 on error. */
+/* Up to max_hits hits with 0 < t < tmax (HUGE_VAL for all) in order into hits (NULL when
+   max_hits is 0); returns how many there are in all (which may exceed max_hits), or -1 on
+   error. */
 int pray_intersect(pray_ctx *ctx, pray_scene *scene, pray_vec origin, pray_vec direction, double tmax,
                    pray_hit *hits, int max_hits);
+/* Free a scene of this context (NULL is ignored). */
 void pray_scene_free(pray_ctx *ctx, pray_scene *scene);
+/* Free the pixels of an image pray_render made in this context and set *img to 0 x 0, NULL
+   pixels: freeing it twice is harmless, a copy of the struct is not. An empty image is ignored;
+   one of another context is refused; pixels pray did not allocate are undefined, as for free. */
 void pray_image_free(pray_ctx *ctx, pray_image *img);
 
 /* Write an image; the format comes from the extension: .tif/.tiff (bits 8 or 16), .ppm (bits 8
@@ -322,9 +380,9 @@ void pray_image_free(pray_ctx *ctx, pray_image *img);
    PRAY_8_3_NAMES "NAXXXXXX" + the suffix, NA its first two characters), created
    exclusively and never through a link (POSIX, Windows, DJGPP; where only stdio is there, after
    checking that no such file exists), with mode 0666 less the umask. Option maxoutput counts the
-   bytes written. */
+   bytes written. Any image will do: yours, or one of any context. */
 pray_status pray_write_image(pray_ctx *ctx, const pray_image *img, const char *path, int bits);
-/* The same formats into a byte sink. */
+/* The same formats into a byte sink `fn` (needed), called on the calling thread. */
 pray_status pray_write_tiff(pray_ctx *ctx, const pray_image *img, int bits, pray_write_fn fn,
                             void *ud);
 pray_status pray_write_ppm(pray_ctx *ctx, const pray_image *img, int bits, pray_write_fn fn,
@@ -333,7 +391,8 @@ pray_status pray_write_ppm(pray_ctx *ctx, const pray_image *img, int bits, pray_
    lists "png" when it has). Its memory comes from the context and counts against its cap. */
 pray_status pray_write_png(pray_ctx *ctx, const pray_image *img, pray_write_fn fn, void *ud);
 
-/* One call: run a program file with optional fixed options ("name=value" strings). */
+/* One call: run a program file with optional fixed options ("name=value" strings) in a context of
+   its own; the message (or "") is copied into `message` (may be NULL) of message_size bytes. */
 pray_status pray_render_file(const char *program, const char *const *options, int noptions,
                              char *message, size_t message_size);
 
@@ -360,24 +419,47 @@ pray_status pray_render_file(const char *program, const char *const *options, in
    pray::pray; an installed pray is also known to pkg-config as "pray" (README.md).
 
    3. A host program
-       pray_ctx *c = pray_new();
-       pray_model *red = pray_phong(c, rgb(0.8,0.1,0.1), rgb(0.3,0.3,0.3), rgb(0,0,0), 3);
-       pray_object *s = pray_sphere(c, red, vec(0,0,0), 0.2);
-       pray_light *l = pray_dirlight(c, rgb(1,1,1), vec(1,1,1));
-       pray_image img;
-       if (pray_render(c, s, l, &img) == PRAY_OK) {
-           pray_write_image(c, &img, "red.tif", 8);
-           pray_image_free(c, &img);
-       } else fprintf(stderr, "%s\n", pray_error(c));
-       pray_free(c);
+   Everything a context makes belongs to it: objects, models, lights, textures, prepared scenes
+   and rendered images. pray_free frees all that is left of them; pray_image_free,
+   pray_scene_free and the releases free one earlier. Copy the pixels of an image that must
+   outlive its context. A NULL from a failed call passes through the calls it is given to, so
+   one check at the end finds the first failure's message:
+       #include <stdio.h>
+       #include "pray.hpp"
+       int main(void) {
+           pray_rgb red = {0.8, 0.1, 0.1}, grey = {0.3, 0.3, 0.3};
+           pray_rgb black = {0, 0, 0}, white = {1, 1, 1};
+           pray_vec centre = {0, 0, 0}, towards = {1, 1, 1};
+           pray_ctx *c = pray_new();
+           pray_model *m = pray_phong(c, red, grey, black, 3);
+           pray_object *s = pray_sphere(c, m, centre, 0.2);
+           pray_light *l = pray_dirlight(c, white, towards);
+           pray_image img;
+           int ok = pray_render(c, s, l, &img) == PRAY_OK &&
+                    pray_write_image(c, &img, "red.tif", 8) == PRAY_OK;
+           if (!ok) fprintf(stderr, "%s\n", pray_error(c));
+           pray_free(c);
+           return ok ? 0 : 1;
+       }
    Running the same scene as a program: pray_run_string(c, "red.ray", text, strlen(text)).
+   Every indented block of this manual that starts with #include is a whole program, compiled
+   as C and as C++ and run by the tests.
 
    4. Errors
    Every failing call returns a status (or NULL) and leaves "where: error: what" in
    pray_error(ctx). Program errors carry "name:line:col". pray never calls exit or abort.
+   A NULL argument, or a handle of another context, is refused with a status, never a crash
+   (see the conventions before the declarations).
 
-   5. Threads
+   5. Threads and cancelling
    A context is used by one thread at a time; two contexts may render at once. No global state.
+   A render runs on option threads threads, the caller's among them. The progress callback is
+   called on any of them, one call at a time; it must not call pray on the context, except
+   pray_cancel. pray_cancel may be called from any thread or a signal handler while a program
+   runs, a scene is prepared, or an image is rendered or written: the call returns
+   PRAY_ERR_CANCELLED within a statement, a row of voxels or a row of pixels. Nothing is left
+   half made (frames a program finished before stay) and the context works as before. The flag
+   is cleared when such a call starts, so a cancel made between calls is forgotten.
 
    6. Rendering, and how it is made fast
    A ray's visible surface is found by sweeping the crossings of the primitives along it through
@@ -437,6 +519,8 @@ pray_status pray_render_file(const char *program, const char *const *options, in
 
    9. Status codes
    PRAY_OK 0, PRAY_ERR_NOMEM 1, PRAY_ERR_IO 2, PRAY_ERR_SYNTAX 3, PRAY_ERR_RUNTIME 4,
-   PRAY_ERR_LIMIT 5, PRAY_ERR_ARG 6. The command line exits with 0 (ok), 1 (error in the
-   program), 2 (usage) or 3 (input/output).
+   PRAY_ERR_LIMIT 5, PRAY_ERR_ARG 6, PRAY_ERR_CANCELLED 7 (pray_cancel or the progress
+   callback; never a limit). The command line exits with 0 (ok), 1 (error in the program),
+   2 (usage) or 3 (input/output); it does not cancel: Ctrl-C removes the file being written and
+   ends it.
 */

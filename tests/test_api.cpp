@@ -1,0 +1,636 @@
+// The public API's contract: NULL arguments, handles of another context, ownership of images,
+// and cancellation (pray_cancel, the progress callback).
+#include <doctest/doctest.h>
+
+#include "testkit.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <functional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <dirent.h>
+#include <unistd.h>
+
+namespace {
+
+const pray_rgb GREY = {0.5, 0.5, 0.5}, WHITE = {1, 1, 1};
+const pray_vec ORIGIN = {0, 0, 0}, UP = {0, 0, 1}, ONE = {1, 1, 1};
+
+pray_object *ball(pray_ctx *c) {
+    pray_model *m = pray_phong(c, GREY, GREY, GREY, 3);
+    pray_object *o = pray_sphere(c, m, ORIGIN, 0.5);
+    pray_release(c, m);
+    return o;
+}
+
+std::vector<float> pixels_of(const pray_image &img) {
+    return std::vector<float>(img.pixels, img.pixels + (size_t)img.width * img.height * 3);
+}
+
+// The names in a directory, . and .. left out.
+std::vector<std::string> dir_names(const std::string &dir) {
+    std::vector<std::string> v;
+    DIR *d = opendir(dir.c_str());
+    if (!d) return v;
+    while (dirent *e = readdir(d))
+        if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) v.push_back(e->d_name);
+    closedir(d);
+    return v;
+}
+
+std::string temp_dir() {
+    char tmpl[] = "/tmp/pray_api_XXXXXX";
+    const char *d = mkdtemp(tmpl);
+    REQUIRE(d != nullptr);
+    return d;
+}
+
+} // namespace
+
+TEST_CASE("api: every function takes a NULL context and returns its error value") {
+    pray_image img = {3, 4, (float *)&img};  // pray_render empties it even without a context
+    pray_stats st;
+    std::memset(&st, 0xff, sizeof st);
+    CHECK(std::string(pray_error(nullptr)) == "error: no context");
+    CHECK(pray_last_status(nullptr) == PRAY_ERR_ARG);
+    CHECK(pray_temp_file(nullptr) == nullptr);
+    CHECK(pray_frames(nullptr) == 0);
+    CHECK(pray_option(nullptr, "width", 10) == PRAY_ERR_ARG);
+    CHECK(pray_option_string(nullptr, "output", "a.tif") == PRAY_ERR_ARG);
+    CHECK(pray_option_fix(nullptr, "width", "10") == PRAY_ERR_ARG);
+    CHECK(std::isnan(pray_option_get(nullptr, "width")));
+    CHECK(pray_run_string(nullptr, "a.ray", "print 1\n", 8) == PRAY_ERR_ARG);
+    CHECK(pray_run_file(nullptr, "a.ray") == PRAY_ERR_ARG);
+    CHECK(pray_phong(nullptr, GREY, GREY, GREY, 1) == nullptr);
+    CHECK(pray_mirror(nullptr, GREY) == nullptr);
+    CHECK(pray_transparent(nullptr, GREY, 1.5) == nullptr);
+    CHECK(pray_color(nullptr, GREY) == nullptr);
+    CHECK(pray_texture_file(nullptr, "a.tif") == nullptr);
+    CHECK(pray_texture_tiff(nullptr, "II", 2, "a") == nullptr);
+    CHECK(pray_nothing(nullptr) == nullptr);
+    CHECK(pray_dirlight(nullptr, WHITE, ONE) == nullptr);
+    CHECK(pray_pointlight(nullptr, WHITE, ONE) == nullptr);
+    CHECK(pray_perspective(nullptr, ONE, UP, ONE, ORIGIN) == PRAY_ERR_ARG);
+    CHECK(pray_parallel(nullptr, ONE, UP, ONE, ORIGIN) == PRAY_ERR_ARG);
+    CHECK(pray_background(nullptr, GREY, GREY) == PRAY_ERR_ARG);
+    CHECK(pray_render(nullptr, nullptr, nullptr, &img) == PRAY_ERR_ARG);
+    CHECK((img.width == 0 && img.height == 0 && img.pixels == nullptr));  // out is always emptied
+    pray_stats_get(nullptr, &st);
+    CHECK((st.primitives == 0 && st.rays_primary == 0 && st.threads == 0));
+    CHECK(pray_prepare(nullptr, nullptr) == nullptr);
+    pray_hit h;
+    CHECK(pray_intersect(nullptr, nullptr, ORIGIN, UP, HUGE_VAL, &h, 1) == -1);
+    CHECK(pray_write_image(nullptr, &img, "a.tif", 8) == PRAY_ERR_ARG);
+    CHECK(pray_write_tiff(nullptr, &img, 8, nullptr, nullptr) == PRAY_ERR_ARG);
+    CHECK(pray_write_ppm(nullptr, &img, 8, nullptr, nullptr) == PRAY_ERR_ARG);
+    // the void ones do nothing
+    pray_free(nullptr);
+    pray_clear_error(nullptr);
+    pray_set_memory_limit(nullptr, 1);
+    pray_set_untrusted(nullptr);
+    pray_set_print(nullptr, nullptr, nullptr);
+    pray_set_progress(nullptr, nullptr, nullptr);
+    pray_set_frame(nullptr, nullptr, nullptr);
+    pray_cancel(nullptr);
+    pray_release(nullptr, &img);
+    pray_object_release(nullptr, nullptr);
+    pray_model_release(nullptr, nullptr);
+    pray_light_release(nullptr, nullptr);
+    pray_texture_release(nullptr, nullptr);
+    pray_scene_free(nullptr, nullptr);
+    pray_image_free(nullptr, &img);
+    pray_stats_get(nullptr, nullptr);
+    // functions of handles alone
+    int w = 7, ht = 7;
+    pray_texture_size(nullptr, &w, &ht);
+    CHECK((w == 0 && ht == 0));
+    pray_rgb px = pray_texture_pixel(nullptr, 0, 0);
+    CHECK((px.r == 0 && px.g == 0 && px.b == 0));
+    CHECK(pray_object_primitives(nullptr) == 0);
+    // the functions of a context and handles, with a NULL context and real handles
+    pray_ctx *c = pray_new();
+    pray_model *m = pray_phong(c, GREY, GREY, GREY, 3);
+    pray_object *o = pray_sphere(c, m, ORIGIN, 1);
+    pray_light *l = pray_dirlight(c, WHITE, ONE);
+    REQUIRE((m && o && l));
+    CHECK(pray_sphere(nullptr, m, ORIGIN, 1) == nullptr);
+    CHECK(pray_model_add(nullptr, m, m) == nullptr);
+    CHECK(pray_csg(nullptr, PRAY_UNION, o, o) == nullptr);
+    CHECK(pray_light_add(nullptr, l, l) == nullptr);
+    CHECK(pray_prepare(nullptr, o) == nullptr);
+    pray_release(nullptr, o);  // nothing happens: o is still there
+    CHECK(pray_object_primitives(o) == 1);
+    CHECK(pray_last_status(c) == PRAY_OK);
+    pray_free(c);
+}
+
+TEST_CASE("api: a NULL handle gives NULL, with a message naming the call unless one is there") {
+    pray_ctx *c = pray_new();
+    pray_object *o = ball(c);
+    pray_light *l = pray_dirlight(c, WHITE, ONE);
+    pray_model *m = pray_color(c, GREY);
+    struct Case {
+        const char *message;
+        std::function<const void *()> call;
+        bool chain = true;  // a NULL handle: no new message after a failure
+    };
+    const Case cases[] = {
+        {"error: pray_model_add: no model a", [&] { return (const void *)pray_model_add(c, nullptr, m); }},
+        {"error: pray_model_add: no model b", [&] { return (const void *)pray_model_add(c, m, nullptr); }},
+        {"error: pray_model_scale: no model", [&] { return (const void *)pray_model_scale(c, nullptr, GREY); }},
+        {"error: pray_sphere: no model", [&] { return (const void *)pray_sphere(c, nullptr, ORIGIN, 1); }},
+        {"error: pray_plane: no model", [&] { return (const void *)pray_plane(c, nullptr, ORIGIN, UP); }},
+        {"error: pray_cylinder: no model", [&] { return (const void *)pray_cylinder(c, nullptr, ORIGIN, UP, 1); }},
+        {"error: pray_one: no model", [&] { return (const void *)pray_one(c, nullptr); }},
+        {"error: pray_planemap: no model",
+         [&] { return (const void *)pray_planemap(c, nullptr, ORIGIN, UP, ONE, UP); }},
+        {"error: pray_spheremap: no model",
+         [&] { return (const void *)pray_spheremap(c, nullptr, ORIGIN, 1, UP, ONE); }},
+        {"error: pray_tiff: no texture", [&] { return (const void *)pray_tiff(c, m, m, nullptr); }},
+        {"error: pray_tiffbump: no model", [&] { return (const void *)pray_tiffbump(c, nullptr, 1, nullptr); }},
+        {"error: pray_move: no model", [&] { return (const void *)pray_move(c, nullptr, 1, 1); }},
+        {"error: pray_text: no model",
+         [&] { return (const void *)pray_text(c, nullptr, "A", ORIGIN, ONE, UP, 1, nullptr, 1); }},
+        {"error: pray_text: no text", [&] { return (const void *)pray_text(c, m, nullptr, ORIGIN, ONE, UP, 1, nullptr, 1); }, false},
+        {"error: pray_csg: no object a", [&] { return (const void *)pray_csg(c, PRAY_UNION, nullptr, o); }},
+        {"error: pray_csg: no object b", [&] { return (const void *)pray_csg(c, PRAY_UNION, o, nullptr); }},
+        {"error: pray_complement: no object", [&] { return (const void *)pray_complement(c, nullptr); }},
+        {"error: pray_scale: no object", [&] { return (const void *)pray_scale(c, nullptr, 2); }},
+        {"error: pray_translate: no object", [&] { return (const void *)pray_translate(c, nullptr, ONE); }},
+        {"error: pray_rotate: no object", [&] { return (const void *)pray_rotate(c, nullptr, ONE); }},
+        {"error: pray_light_add: no light b", [&] { return (const void *)pray_light_add(c, l, nullptr); }},
+        {"error: pray_light_scale: no light", [&] { return (const void *)pray_light_scale(c, nullptr, 2); }},
+        {"error: pray_light_translate: no light", [&] { return (const void *)pray_light_translate(c, nullptr, ONE); }},
+        {"error: pray_light_rotate: no light", [&] { return (const void *)pray_light_rotate(c, nullptr, ONE); }},
+        {"error: pray_prepare: no object", [&] { return (const void *)pray_prepare(c, nullptr); }},
+        {"error: pray_texture_file: no file name", [&] { return (const void *)pray_texture_file(c, nullptr); }, false},
+        {"error: pray_texture_tiff: no data", [&] { return (const void *)pray_texture_tiff(c, nullptr, 4, "t"); }, false},
+    };
+    for (const Case &k : cases) {
+        CAPTURE(k.message);
+        pray_clear_error(c);
+        CHECK(k.call() == nullptr);
+        CHECK(pray_last_status(c) == PRAY_ERR_ARG);
+        CHECK(std::string(pray_error(c)) == k.message);
+        // the chain rule: after a failure, its message stays (other NULL arguments: a new one)
+        pray_clear_error(c);
+        CHECK(pray_sphere(c, m, ORIGIN, -1) == nullptr);
+        std::string first = pray_error(c);
+        CHECK(k.call() == nullptr);
+        CHECK((std::string(pray_error(c)) == first) == k.chain);
+    }
+    // statuses, -1 and void functions
+    pray_clear_error(c);
+    pray_image img;
+    CHECK(pray_render(c, o, l, nullptr) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: pray_render: no image to render into");
+    pray_clear_error(c);
+    CHECK(pray_render(c, nullptr, l, &img) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: no object to render");
+    CHECK(img.pixels == nullptr);
+    pray_clear_error(c);
+    pray_vec d = {0, 0, -1}, from = {0, 0, 5};
+    CHECK(pray_intersect(c, nullptr, from, d, HUGE_VAL, nullptr, 0) == -1);
+    CHECK(std::string(pray_error(c)) == "error: pray_intersect: no scene");
+    pray_scene *sc = pray_prepare(c, o);
+    REQUIRE(sc);
+    CHECK(pray_intersect(c, sc, from, d, HUGE_VAL, nullptr, 4) == -1);
+    CHECK(std::string(pray_error(c)) == "error: pray_intersect: no room for the hits");
+    CHECK(pray_intersect(c, sc, from, d, HUGE_VAL, nullptr, 0) == 2);  // counting needs no room
+    pray_scene_free(c, sc);
+    pray_clear_error(c);
+    CHECK(pray_write_image(c, nullptr, "a.tif", 8) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: not a valid image");
+    CHECK(pray_option(c, nullptr, 1) == PRAY_ERR_ARG);
+    CHECK(pray_option_string(c, "output", nullptr) == PRAY_ERR_ARG);
+    CHECK(pray_option_fix(c, "width", nullptr) == PRAY_ERR_ARG);
+    CHECK(std::isnan(pray_option_get(c, nullptr)));
+    CHECK(pray_run_string(c, nullptr, nullptr, 0) == PRAY_ERR_ARG);
+    CHECK(pray_run_file(c, nullptr) == PRAY_ERR_ARG);
+    REQUIRE(pray_render(c, o, l, &img) == PRAY_OK);
+    CHECK(pray_write_tiff(c, &img, 8, nullptr, nullptr) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: pray_write_tiff: no write function");
+    CHECK(pray_write_ppm(c, &img, 8, nullptr, nullptr) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: pray_write_ppm: no write function");
+    pray_clear_error(c);
+    pray_release(c, nullptr);
+    pray_object_release(c, nullptr);
+    pray_scene_free(c, nullptr);
+    pray_image_free(c, nullptr);
+    pray_set_print(c, nullptr, nullptr);
+    CHECK(pray_last_status(c) == PRAY_OK);
+    pray_release(c, m);
+    pray_release(c, l);
+    pray_release(c, o);
+    pray_free(c);  // (img dies with it)
+}
+
+TEST_CASE("api: handles, scenes and images of another context are refused") {
+    pray_ctx *a = pray_new(), *b = pray_new();
+    pray_model *m = pray_phong(b, GREY, GREY, GREY, 3);
+    pray_object *o = pray_sphere(b, m, ORIGIN, 0.5);
+    pray_light *l = pray_dirlight(b, WHITE, ONE);
+    pray_scene *sc = pray_prepare(b, o);
+    pray_image img;
+    pray_option(b, "width", 8);
+    pray_option(b, "height", 8);
+    REQUIRE(pray_render(b, o, l, &img) == PRAY_OK);
+    REQUIRE((m && o && l && sc));
+    pray_model *ma = pray_color(a, GREY);
+    pray_object *oa = pray_sphere(a, ma, ORIGIN, 1);
+    pray_light *la = pray_dirlight(a, WHITE, ONE);
+    struct Case {
+        const char *message;
+        std::function<bool()> refused;  // the call failed
+    };
+    const Case cases[] = {
+        {"error: pray_model_add: the model b belongs to another context", [&] { return !pray_model_add(a, ma, m); }},
+        {"error: pray_model_scale: the model belongs to another context", [&] { return !pray_model_scale(a, m, GREY); }},
+        {"error: pray_sphere: the model belongs to another context", [&] { return !pray_sphere(a, m, ORIGIN, 1); }},
+        {"error: pray_plane: the model belongs to another context", [&] { return !pray_plane(a, m, ORIGIN, UP); }},
+        {"error: pray_cylinder: the model belongs to another context", [&] { return !pray_cylinder(a, m, ORIGIN, UP, 1); }},
+        {"error: pray_one: the model belongs to another context", [&] { return !pray_one(a, m); }},
+        {"error: pray_planemap: the model belongs to another context",
+         [&] { return !pray_planemap(a, m, ORIGIN, UP, ONE, UP); }},
+        {"error: pray_spheremap: the model belongs to another context",
+         [&] { return !pray_spheremap(a, m, ORIGIN, 1, UP, ONE); }},
+        {"error: pray_tiff: the model m0 belongs to another context", [&] { return !pray_tiff(a, m, ma, nullptr); }},
+        {"error: pray_tiffbump: the model belongs to another context", [&] { return !pray_tiffbump(a, m, 1, nullptr); }},
+        {"error: pray_move: the model belongs to another context", [&] { return !pray_move(a, m, 1, 1); }},
+        {"error: pray_text: the model belongs to another context",
+         [&] { return !pray_text(a, m, "A", ORIGIN, ONE, UP, 1, nullptr, 1); }},
+        {"error: pray_csg: the object a belongs to another context", [&] { return !pray_csg(a, PRAY_UNION, o, oa); }},
+        {"error: pray_csg: the object b belongs to another context", [&] { return !pray_csg(a, PRAY_DIFFERENCE, oa, o); }},
+        {"error: pray_complement: the object belongs to another context", [&] { return !pray_complement(a, o); }},
+        {"error: pray_scale: the object belongs to another context", [&] { return !pray_scale(a, o, 2); }},
+        {"error: pray_translate: the object belongs to another context", [&] { return !pray_translate(a, o, ONE); }},
+        {"error: pray_rotate: the object belongs to another context", [&] { return !pray_rotate(a, o, ONE); }},
+        {"error: pray_light_add: the light a belongs to another context", [&] { return !pray_light_add(a, l, la); }},
+        {"error: pray_light_scale: the light belongs to another context", [&] { return !pray_light_scale(a, l, 2); }},
+        {"error: pray_light_translate: the light belongs to another context",
+         [&] { return !pray_light_translate(a, l, ONE); }},
+        {"error: pray_light_rotate: the light belongs to another context", [&] { return !pray_light_rotate(a, l, ONE); }},
+        {"error: pray_prepare: the object belongs to another context", [&] { return !pray_prepare(a, o); }},
+        {"error: pray_render: the object belongs to another context",
+         [&] { pray_image x; return pray_render(a, o, la, &x) == PRAY_ERR_ARG && !x.pixels; }},
+        {"error: pray_render: the light belongs to another context",
+         [&] { pray_image x; return pray_render(a, oa, l, &x) == PRAY_ERR_ARG && !x.pixels; }},
+        {"error: pray_intersect: the scene belongs to another context",
+         [&] { return pray_intersect(a, sc, ONE, UP, HUGE_VAL, nullptr, 0) == -1; }},
+        {"error: pray_scene_free: the scene belongs to another context", [&] { pray_scene_free(a, sc); return true; }},
+        {"error: pray_image_free: the image belongs to another context",
+         [&] { pray_image_free(a, &img); return img.pixels != nullptr; }},
+        {"error: pray_release: the handle belongs to another context", [&] { pray_release(a, o); return true; }},
+        {"error: pray_object_release: the object belongs to another context",
+         [&] { pray_object_release(a, o); return true; }},
+        {"error: pray_model_release: the model belongs to another context",
+         [&] { pray_model_release(a, m); return true; }},
+        {"error: pray_light_release: the light belongs to another context",
+         [&] { pray_light_release(a, l); return true; }},
+    };
+    for (const Case &k : cases) {
+        CAPTURE(k.message);
+        pray_clear_error(a);
+        CHECK(k.refused());
+        CHECK(pray_last_status(a) == PRAY_ERR_ARG);
+        CHECK(std::string(pray_error(a)) == k.message);
+    }
+    // b's things are untouched: they still work in b
+    CHECK(pray_last_status(b) == PRAY_OK);
+    CHECK(pray_object_primitives(o) == 1);
+    pray_vec from = {0, 0, 5}, down = {0, 0, -1};
+    pray_hit hits[2];
+    CHECK(pray_intersect(b, sc, from, down, HUGE_VAL, hits, 2) == 2);
+    CHECK(hits[0].t == doctest::Approx(4.5));
+    CHECK(img.width == 8);
+    std::vector<float> before = pixels_of(img);
+    pray_image again;
+    REQUIRE(pray_render(b, o, l, &again) == PRAY_OK);
+    CHECK(pixels_of(again) == before);
+    // writing reads an image only: any context may write any image
+    std::string tiff;
+    CHECK(pray_write_tiff(a, &img, 8, testkit::print_sink, &tiff) == PRAY_OK);
+    CHECK(tiff.size() == 8 + 2 + 12 * 12 + 4 + 6 + 16 + 8 * 8 * 3);
+    // textures too
+    pray_texture *t = pray_texture_tiff(b, tiff.data(), tiff.size(), "t");
+    REQUIRE(t);
+    const Case textures[] = {
+        {"error: pray_tiff: the texture belongs to another context", [&] { return !pray_tiff(a, ma, ma, t); }},
+        {"error: pray_tiffbump: the texture belongs to another context", [&] { return !pray_tiffbump(a, ma, 1, t); }},
+        {"error: pray_text: the font belongs to another context",
+         [&] { return !pray_text(a, ma, "A", ORIGIN, ONE, UP, 1, t, 1); }},
+        {"error: pray_texture_release: the texture belongs to another context",
+         [&] { pray_texture_release(a, t); return true; }},
+    };
+    for (const Case &k : textures) {
+        CAPTURE(k.message);
+        pray_clear_error(a);
+        CHECK(k.refused());
+        CHECK(std::string(pray_error(a)) == k.message);
+    }
+    int tw = 0, th = 0;
+    pray_texture_size(t, &tw, &th);
+    CHECK((tw == 8 && th == 8));
+    // both contexts freed with all they made (under AddressSanitizer: no leak, no use after free)
+    pray_free(a);
+    pray_free(b);
+}
+
+TEST_CASE("api: releases check the kind of handle") {
+    pray_ctx *c = pray_new();
+    pray_model *m = pray_color(c, GREY);
+    pray_object *o = pray_sphere(c, m, ORIGIN, 1);
+    pray_scene *sc = pray_prepare(c, o);
+    REQUIRE(sc);
+    pray_object_release(c, (pray_object *)m);
+    CHECK(std::string(pray_error(c)) == "error: pray_object_release: the object is not a live handle of its kind");
+    pray_clear_error(c);
+    pray_light_release(c, (pray_light *)o);
+    CHECK(std::string(pray_error(c)) == "error: pray_light_release: the light is not a live handle of its kind");
+    pray_clear_error(c);
+    pray_release(c, sc);  // a scene is not a handle: pray_scene_free frees it
+    CHECK(std::string(pray_error(c)) == "error: pray_release: the handle is not a live handle of its kind");
+    pray_clear_error(c);
+    pray_csg(c, PRAY_UNION, (pray_object *)m, o);
+    CHECK(std::string(pray_error(c)) == "error: pray_csg: the object a is not a live handle of its kind");
+    pray_model_release(c, m);  // o keeps its own reference to the model
+    CHECK(pray_last_status(c) == PRAY_ERR_ARG);  // (the error before, not a new one)
+    pray_clear_error(c);
+    pray_object_release(c, o);
+    pray_scene_free(c, sc);
+    CHECK(pray_last_status(c) == PRAY_OK);
+    pray_free(c);
+}
+
+TEST_CASE("api: images belong to their context") {
+    pray_ctx *c = pray_new();
+    pray_option(c, "width", 16);
+    pray_option(c, "height", 16);
+    pray_object *o = ball(c);
+    pray_image kept, freed;
+    REQUIRE(pray_render(c, o, nullptr, &kept) == PRAY_OK);
+    REQUIRE(pray_render(c, o, nullptr, &freed) == PRAY_OK);
+    pray_image_free(c, &freed);
+    CHECK((freed.width == 0 && freed.height == 0 && freed.pixels == nullptr));
+    pray_image_free(c, &freed);  // twice: harmless, the struct was zeroed
+    CHECK(pray_last_status(c) == PRAY_OK);
+    CHECK(kept.pixels[0] >= 0);
+    pray_free(c);  // frees `kept` and `o`: under AddressSanitizer, nothing leaks
+}
+
+namespace {
+struct Cancel {
+    pray_ctx *c = nullptr;
+    int calls = 0, at = -1;  // pray_cancel on the at-th call
+};
+int cancel_progress(void *ud, int, int) { return ++((Cancel *)ud)->calls == 1; }
+// An allocator that cancels on its at-th call: deterministic cancellation inside any work.
+void *cancel_alloc(void *ud, void *p, size_t, size_t n) {
+    Cancel *k = (Cancel *)ud;
+    if (n && k->at >= 0 && ++k->calls == k->at) pray_cancel(k->c);
+    if (n == 0) {
+        free(p);
+        return nullptr;
+    }
+    return realloc(p, n);
+}
+void cancel_print(void *ud, const void *, size_t) { pray_cancel(((Cancel *)ud)->c); }
+
+const char *SCENE = "M = phong({0.8, 0.2, 0.2}, {0.3}, {0.1}, 5)\n"
+                    "S = sphere(M, [0, 0, 0], 0.5)\n"
+                    "i = 0\n"
+                    "while i < 40\n"
+                    "  S = S | sphere(M, [i / 40 - 0.5, 0, 0.3], 0.05)\n"
+                    "  i = i + 1\n"
+                    "endwhile\n"
+                    "L = dirlight({1}, <1, 1, 1>)\n";
+} // namespace
+
+TEST_CASE("api: cancelling from the progress callback stops the render and leaves no file") {
+    std::string dir = temp_dir(), name = dir + "/scene.ray";
+    std::string prog = std::string(SCENE) + "rendertiff S, L\nprint \"after\"\n";
+    pray_ctx *c = pray_new();
+    Cancel k;
+    std::string printed;
+    pray_set_print(c, testkit::print_sink, &printed);
+    pray_set_progress(c, cancel_progress, &k);
+    pray_option(c, "width", 64);
+    pray_option(c, "height", 64);
+    CHECK(pray_run_string(c, name.c_str(), prog.data(), prog.size()) == PRAY_ERR_CANCELLED);
+    CHECK(std::string(pray_error(c)) == name + ":9:1: error: cancelled by the progress callback");
+    CHECK(k.calls == 1);
+    CHECK(printed == "");
+    CHECK(pray_frames(c) == 0);
+    CHECK(dir_names(dir).empty());
+    CHECK(std::string(pray_status_text(PRAY_ERR_CANCELLED)) == "cancelled");
+    // the same context renders again when the callback lets it
+    pray_set_progress(c, nullptr, nullptr);
+    CHECK(pray_run_string(c, name.c_str(), prog.data(), prog.size()) == PRAY_OK);
+    CHECK(dir_names(dir) == std::vector<std::string>{"scene.tif"});
+    remove((dir + "/scene.tif").c_str());
+    rmdir(dir.c_str());
+    pray_free(c);
+}
+
+TEST_CASE("api: pray_cancel stops a program, a preparation, a render and a file being written") {
+    std::string prog = std::string(SCENE) + "print 1\nprint 2\n";
+    Cancel k;
+    pray_ctx *c = pray_new_with(cancel_alloc, &k);
+    k.c = c;
+    SUBCASE("a cancel made before the call is forgotten when it starts") {
+        pray_cancel(c);
+        std::string printed;
+        pray_set_print(c, testkit::print_sink, &printed);
+        CHECK(pray_run_string(c, "a.ray", prog.data(), prog.size()) == PRAY_OK);
+        CHECK(printed == "1\n2\n");
+    }
+    SUBCASE("a program stops at its next statement") {
+        pray_set_print(c, cancel_print, &k);
+        CHECK(pray_run_string(c, "a.ray", prog.data(), prog.size()) == PRAY_ERR_CANCELLED);
+        CHECK(std::string(pray_error(c)) == "a.ray:10:1: error: cancelled");
+    }
+    pray_object *o = ball(c);
+    pray_light *l = pray_dirlight(c, WHITE, ONE);
+    pray_option(c, "width", 32);
+    pray_option(c, "height", 32);
+    pray_option(c, "threads", 2);
+    SUBCASE("preparing a scene, and the render of it, at every allocation") {
+        // each allocation of the call in turn: the call stops with the cancel, or ends before
+        // it comes (the last allocations are the image's and the workers')
+        for (double adaptive : {0.0, 0.1}) {
+        CAPTURE(adaptive);
+        pray_option(c, "adaptive", adaptive);
+        int stopped = 0, total = 0;
+        for (int at = 1; at < 400; at++) {
+            pray_image img;
+            k.calls = 0;
+            k.at = at;
+            pray_status st = pray_render(c, o, l, &img);
+            k.at = -1;
+            if (k.calls < at) break;  // the call made fewer allocations than that
+            total++;
+            CAPTURE(at);
+            if (st == PRAY_ERR_CANCELLED) {
+                stopped++;
+                CHECK(std::string(pray_error(c)) == "error: cancelled");
+                CHECK(img.pixels == nullptr);
+            } else CHECK(st == PRAY_OK);
+            pray_image_free(c, &img);
+        }
+        CHECK(total > 10);
+        CHECK(stopped == total);  // every allocation comes before a check
+        }
+        pray_scene *sc = nullptr;
+        k.calls = 0;
+        k.at = 3;
+        sc = pray_prepare(c, o);
+        k.at = -1;
+        CHECK(sc == nullptr);
+        CHECK(pray_last_status(c) == PRAY_ERR_CANCELLED);
+    }
+    SUBCASE("writing a file: nothing is left") {
+        std::string dir = temp_dir();
+        pray_image img;
+        REQUIRE(pray_render(c, o, l, &img) == PRAY_OK);
+        k.calls = 0;
+        k.at = 2;  // the temporary name, then the writer's row
+        CHECK(pray_write_image(c, &img, (dir + "/x.ppm").c_str(), 8) == PRAY_ERR_CANCELLED);
+        k.at = -1;
+        CHECK(dir_names(dir).empty());
+        CHECK(pray_write_image(c, &img, (dir + "/x.ppm").c_str(), 8) == PRAY_OK);
+        CHECK(dir_names(dir) == std::vector<std::string>{"x.ppm"});
+        remove((dir + "/x.ppm").c_str());
+        rmdir(dir.c_str());
+        // a byte sink has what was written before the cancel: the header and no row
+        std::string got;
+        auto sink = [](void *ud, const void *, size_t n) {
+            Cancel *x = (Cancel *)ud;
+            x->calls += (int)n;
+            pray_cancel(x->c);
+        };
+        k.calls = 0;
+        CHECK(pray_write_ppm(c, &img, 8, sink, &k) == PRAY_ERR_CANCELLED);
+        CHECK(k.calls == (int)strlen("P6\n32 32\n255\n"));
+        CHECK(std::string(pray_error(c)) == "error: cancelled");
+        // PNG: the encoder stops where it asks for memory next, and frees what it held
+        if (std::strstr(pray_features(), "png")) {
+            std::string whole;
+            REQUIRE(pray_write_png(c, &img, testkit::print_sink, &whole) == PRAY_OK);
+            int stopped = 0, total = 0;
+            for (int at = 1; at < 1000; at++) {
+                std::string png;
+                k.calls = 0;
+                k.at = at;
+                pray_status st = pray_write_png(c, &img, testkit::print_sink, &png);
+                k.at = -1;
+                if (k.calls < at) break;
+                total++;
+                CAPTURE(at);
+                if (st == PRAY_ERR_CANCELLED) {
+                    stopped++;
+                    CHECK(std::string(pray_error(c)) == "error: cancelled");
+                } else {
+                    CHECK(st == PRAY_OK);
+                    CHECK(png == whole);
+                }
+            }
+            CHECK(total >= 3);
+            CHECK(stopped >= total - 1);  // a cancel at the last allocation comes after the last check
+            std::string again;
+            CHECK(pray_write_png(c, &img, testkit::print_sink, &again) == PRAY_OK);
+            CHECK(again == whole);
+        }
+    }
+    pray_free(c);
+}
+
+TEST_CASE("api: pray_cancel from another thread stops an endless program and a long render promptly") {
+    pray_ctx *c = pray_new();
+    std::atomic<bool> go{false};
+    auto canceller = [&] {
+        while (!go) std::this_thread::yield();
+        std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        pray_cancel(c);
+    };
+    typedef std::chrono::steady_clock Clock;
+    {
+        const char *prog = "i = 0\nwhile 1\n  i = i + 1\nendwhile\n";
+        pray_option(c, "maxsteps", 2e8);  // seconds of work: a cancel that fails ends, in a limit
+        std::thread t(canceller);
+        go = true;
+        Clock::time_point t0 = Clock::now();
+        pray_status st = pray_run_string(c, "loop.ray", prog, strlen(prog));
+        double s = std::chrono::duration<double>(Clock::now() - t0).count();
+        t.join();
+        CHECK(st == PRAY_ERR_CANCELLED);
+        std::string e = pray_error(c);
+        CHECK(e.find("loop.ray:") == 0);
+        CHECK(e.find(": error: cancelled") != std::string::npos);
+        CHECK(s < 5);
+    }
+    pray_object *o = ball(c);
+    pray_light *l = pray_dirlight(c, WHITE, ONE);
+    {
+        // far more work than 100 ms: 2048 x 2048 pixels, 16 samples each
+        pray_option(c, "width", 2048);
+        pray_option(c, "height", 2048);
+        pray_option(c, "antialias", 4);
+        go = false;
+        std::thread t(canceller);
+        go = true;
+        Clock::time_point t0 = Clock::now();
+        pray_image img;
+        pray_status st = pray_render(c, o, l, &img);
+        double s = std::chrono::duration<double>(Clock::now() - t0).count();
+        t.join();
+        CHECK(st == PRAY_ERR_CANCELLED);
+        CHECK(std::string(pray_error(c)) == "error: cancelled");
+        CHECK(img.pixels == nullptr);
+        CHECK(s < 5);
+    }
+    // the context works as before: the same image as a fresh context's
+    pray_option(c, "width", 24);
+    pray_option(c, "height", 24);
+    pray_option(c, "antialias", 1);
+    pray_image mine, fresh;
+    REQUIRE(pray_render(c, o, l, &mine) == PRAY_OK);
+    pray_ctx *f = pray_new();
+    pray_option(f, "width", 24);
+    pray_option(f, "height", 24);
+    pray_object *fo = ball(f);
+    pray_light *fl = pray_dirlight(f, WHITE, ONE);
+    REQUIRE(pray_render(f, fo, fl, &fresh) == PRAY_OK);
+    CHECK(pixels_of(mine) == pixels_of(fresh));
+    pray_free(f);
+    pray_free(c);
+}
+
+TEST_CASE("api: a prepared scene needs nothing it was made from") {
+    pray_ctx *c = pray_new();
+    pray_model *m = pray_phong(c, GREY, GREY, GREY, 3);
+    pray_model *glass = pray_transparent(c, GREY, 1.5);
+    pray_object *a = pray_sphere(c, m, ORIGIN, 0.5), *b = pray_sphere(c, glass, ONE, 0.5);
+    pray_object *both = pray_csg(c, PRAY_UNION, a, b);
+    pray_scene *sc = pray_prepare(c, both);
+    REQUIRE(sc);
+    pray_object_release(c, a);
+    pray_object_release(c, b);
+    pray_object_release(c, both);
+    pray_model_release(c, m);
+    pray_model_release(c, glass);
+    pray_vec from = {0, 0, 5}, down = {0, 0, -1};
+    pray_hit hits[2];
+    CHECK(pray_intersect(c, sc, from, down, HUGE_VAL, hits, 2) == 2);
+    CHECK(hits[1].t == doctest::Approx(5.5));
+    CHECK(hits[1].entering == 0);
+    pray_scene_free(c, sc);
+    CHECK(pray_last_status(c) == PRAY_OK);
+    pray_free(c);
+}
