@@ -349,6 +349,11 @@ TEST_CASE("pray_render_into: bad rectangles, strides and buffers are refused wit
     CHECK(pray_render_into(c, o, nullptr, &r, &b) == PRAY_ERR_LIMIT);
     CHECK(contains(pray_error(c), "option maxpixels"));
     pray_option(c, "maxpixels", 1e6);
+    // the render's own memory comes from the context, under its cap
+    pray_set_memory_limit(c, 1);
+    CHECK(pray_render_into(c, o, nullptr, &r, &b) == PRAY_ERR_NOMEM);
+    CHECK(contains(pray_error(c), "out of memory"));
+    pray_set_memory_limit(c, 0);
     // a good call after the bad ones: the sphere's red where it is, 1 x 1
     pray_rect one = {10, 5, 1, 1};
     CHECK(pray_render_into(c, o, nullptr, &one, &b) == PRAY_OK);
