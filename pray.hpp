@@ -365,8 +365,9 @@ pray_status pray_render_into(pray_ctx *ctx, pray_object *root, pray_light *light
 /* The primary ray through image point (px, py), in pixels from the image's top left corner
    (a pixel's centre is at x + 0.5, y + 0.5), for the context's camera and width and height
    options: *origin (the eye; for a parallel camera the point on the image plane) and *dir (a
-   unit vector). The render's rays are exactly these. PRAY_ERR_ARG for a NULL argument or a
-   point that is not finite. */
+   unit vector). The render's primary rays are exactly these: with antialias A, sample (a, b)
+   of pixel (x, y) is the ray of point (x + (a + 0.5) / A, y + (b + 0.5) / A). PRAY_ERR_ARG for
+   a NULL argument or a point that is not finite. */
 pray_status pray_camera_ray(pray_ctx *ctx, double px, double py, pray_vec *origin, pray_vec *dir);
 
 /* A texture from pixels in memory: width x height pixels, 3 floats each (R, G, B in 0 .. 1), rows
