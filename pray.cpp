@@ -6994,8 +6994,9 @@ pray_texture *pray_texture_rgb(pray_ctx *c, int w, int h, const float *rgb, cons
     }
     for (size_t i = 0; i < n; i++)
         if (!(rgb[i] >= 0 && rgb[i] <= 1)) {
-            fail(c, PRAY_ERR_ARG, "pray_texture_rgb: value %lu (pixel %lu, %lu) is %g, not in 0 .. 1", (unsigned long)(i % 3),
-                 (unsigned long)(i / 3 % (size_t)w), (unsigned long)(i / 3 / (size_t)w), (double)rgb[i]);
+            fail(c, PRAY_ERR_ARG, "pray_texture_rgb: value %lu (pixel %lu, %lu) is %g, not in 0 .. 1",
+                 (unsigned long)(i % 3), (unsigned long)(i / 3 % (size_t)w), (unsigned long)(i / 3 / (size_t)w),
+                 (double)rgb[i]);
             return NULL;
         }
     pray_texture *t = (pray_texture *)handle_new(c, sizeof(pray_texture), H_TEXTURE);

@@ -47,12 +47,14 @@ struct Ctx {
 
 bool contains(const std::string &s, const std::string &part) { return s.find(part) != std::string::npos; }
 
-// An 8 x 8 checker of two colours, values k / 255 (so that an 8-bit TIFF holds them exactly).
+// An n x n checker of two colours (green at half), values k / 255 (so that an 8-bit TIFF holds
+// them exactly).
 std::vector<float> checker(int n, float a, float b) {
     std::vector<float> px((size_t)n * n * 3);
     for (int y = 0; y < n; y++)
         for (int x = 0; x < n; x++)
-            for (int k = 0; k < 3; k++) px[((size_t)y * n + x) * 3 + k] = ((x + y) % 2 ? a : b) * (k == 1 ? 0.5f : 1.0f);
+            for (int k = 0; k < 3; k++)
+                px[((size_t)y * n + x) * 3 + k] = ((x + y) % 2 ? a : b) * (k == 1 ? 0.5f : 1.0f);
     for (float &v : px) v = (float)(std::lround(v * 255) / 255.0);
     return px;
 }
@@ -62,7 +64,6 @@ std::vector<float> checker(int n, float a, float b) {
 struct Scene {
     pray_object *root = nullptr;
     pray_light *lights = nullptr;
-    int floor_id = 0;  // the primitive number of the floor
     void build(pray_ctx *c) {
         std::vector<float> px = checker(8, 0.9f, 0.1f);
         pray_texture *t = pray_texture_rgb(c, 8, 8, px.data(), "checker");
@@ -80,7 +81,6 @@ struct Scene {
         pray_object *both = pray_csg(c, PRAY_UNION, solid, mball);
         root = pray_csg(c, PRAY_UNION, floor, both);
         REQUIRE(root);
-        floor_id = 0;
         pray_light *a = pray_dirlight(c, C3(0.7, 0.7, 0.7), P3(1, 2, -2));
         pray_light *b = pray_pointlight(c, C3(0.4, 0.4, 0.5), P3(-2, -3, 2));
         lights = pray_light_add(c, a, b);
@@ -535,7 +535,8 @@ TEST_CASE("pray_texture_register: a registered font atlas for text()") {
         for (int x = 2; x < 4; x++)
             for (int k = 0; k < 3; k++) px[(y * 32 + x) * 3 + k] = 0;
     const std::string prog = "option \"width\", 16\noption \"height\", 16\n"
-                             "rendertiff text(color({1}), \"A\", [-0.5, 0, -0.5], <1, 0, 0>, <0, 0, 1>, 0.1, \"font\", 1), none\n";
+                             "rendertiff text(color({1}), \"A\", [-0.5, 0, -0.5], <1, 0, 0>, <0, 0, 1>, 0.1, "
+                             "\"font\", 1), none\n";
     Ctx c;
     pray_texture *t = pray_texture_rgb(c, 32, 32, px.data(), "font");
     REQUIRE(pray_texture_register(c, "font", t) == PRAY_OK);
