@@ -440,6 +440,13 @@ struct Block {
     pray_ctx *owner;
 };
 
+// A texture the host registered under a name (pray_texture_register).
+struct TexName {
+    TexName *next;
+    pray_texture *tex;
+    char *name;
+};
+
 } // namespace
 
 // Options by index; the table in section 6 has their names, defaults and ranges.
@@ -489,6 +496,7 @@ struct pray_ctx {
     pray_stats stats;
     int frames;
     pray_texture *textures;  // files decoded in this run
+    TexName *tex_names;      // textures registered by the host, looked up before files
     const char *run_dir;     // directory of the running program: the start of its name
     size_t run_dir_len;      // (0: the current directory), for texture files
     FileId prog_id;          // the program file being run, which no image may replace
@@ -5304,6 +5312,14 @@ void texture_cache_clear(pray_ctx *c) {
     }
 }
 
+// Where the host's registration of exactly `name` is kept (pray_texture_register), else where
+// a new one would go: the end of the list.
+TexName **texture_name_at(pray_ctx *c, const char *name) {
+    TexName **at = &c->tex_names;
+    while (*at && strcmp((*at)->name, name) != 0) at = &(*at)->next;
+    return at;
+}
+
 // The place of coordinate u within the repeating image, in [0, 1); 0 for a coordinate that is
 // not a finite number, so that no coordinate whatever reaches beyond the texels.
 inline double tex_wrap(double u) {
@@ -5914,6 +5930,31 @@ void ray_most(const pray_ctx *c, Scene *s) {
     s->maxrays = (long)c->cur.opt.v[OPT_MAXRAYS];
 }
 
+// The camera and the image's size (options width and height) as the renderer sees them.
+void scene_camera(const pray_ctx *c, Scene *s) {
+    s->parallel = c->cur.parallel;
+    s->eye = r3of(c->cur.cam_eye);
+    s->point = r3of(c->cur.cam_point);
+    s->cx = r3of(c->cur.cam_x);
+    s->cy = r3of(c->cur.cam_y);
+    s->dir = r3of(vunit(vsub(c->cur.cam_point, c->cur.cam_eye)));
+    // Directions are the same for the camera scaled by any factor; a power of two keeps them
+    // exact, and brings vectors of 1e-200 or 1e200 into range (of floats, too).
+    double big = vmaxabs(c->cur.cam_point);
+    const pray_vec *cv[3] = {&c->cur.cam_eye, &c->cur.cam_x, &c->cur.cam_y};
+    for (int i = 0; i < 3; i++)
+        if (vmaxabs(*cv[i]) > big) big = vmaxabs(*cv[i]);
+    int e = 0;
+    frexp(big, &e);
+    double k = ldexp(1.0, -e);
+    s->keye = r3of(vmul(c->cur.cam_eye, k));
+    s->kpoint = r3of(vmul(c->cur.cam_point, k));
+    s->kcx = r3of(vmul(c->cur.cam_x, k));
+    s->kcy = r3of(vmul(c->cur.cam_y, k));
+    s->width = opt_int(c, OPT_WIDTH);
+    s->height = opt_int(c, OPT_HEIGHT);
+}
+
 // The scene as the renderer sees it: primitives, nodes, lights, camera and the acceleration
 // structure; `render`: for rendering with the camera (not for ray queries).
 pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *lights, bool render) {
@@ -5937,28 +5978,8 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
         L.v = src.point ? r3of(src.v) : r3of(vmul(vunit(src.v), -1.0));
         if (!s->lights.push(c, L)) return c->status;
     }
-    s->parallel = c->cur.parallel;
-    s->eye = r3of(c->cur.cam_eye);
-    s->point = r3of(c->cur.cam_point);
-    s->cx = r3of(c->cur.cam_x);
-    s->cy = r3of(c->cur.cam_y);
-    s->dir = r3of(vunit(vsub(c->cur.cam_point, c->cur.cam_eye)));
-    // Directions are the same for the camera scaled by any factor; a power of two keeps them
-    // exact, and brings vectors of 1e-200 or 1e200 into range (of floats, too).
-    double big = vmaxabs(c->cur.cam_point);
-    const pray_vec *cv[3] = {&c->cur.cam_eye, &c->cur.cam_x, &c->cur.cam_y};
-    for (int i = 0; i < 3; i++)
-        if (vmaxabs(*cv[i]) > big) big = vmaxabs(*cv[i]);
-    int e = 0;
-    frexp(big, &e);
-    double k = ldexp(1.0, -e);
-    s->keye = r3of(vmul(c->cur.cam_eye, k));
-    s->kpoint = r3of(vmul(c->cur.cam_point, k));
-    s->kcx = r3of(vmul(c->cur.cam_x, k));
-    s->kcy = r3of(vmul(c->cur.cam_y, k));
+    scene_camera(c, s);
     if (!opt_int(c, OPT_BRUTE) && accel_build(c, s, render)) return c->status;  // (the eye's buffer: after the camera)
-    s->width = opt_int(c, OPT_WIDTH);
-    s->height = opt_int(c, OPT_HEIGHT);
     s->depth = opt_int(c, OPT_DEPTH);
     s->shadows = opt_int(c, OPT_SHADOWS);
     s->antialias = opt_int(c, OPT_ANTIALIAS);
@@ -5990,9 +6011,11 @@ struct Worker {
 struct Job {
     pray_ctx *c;
     const Scene *s;
-    pray_image *out;
+    pray_rect r;       // the pixels wanted
+    pray_buffers out;  // where they go (stride set)
     Mutex mu;
     int next_band, bands, band_rows, rows_done;
+    int band0;         // the first band of the image that meets r (bands are the whole image's)
     int cancelled;
     int over;  // a sample wanted more rays than maxrays
     double adaptive;  // undersampling threshold, 0 = off
@@ -6024,12 +6047,15 @@ bool texture_between(const Scene *s, const Sample *const *x, int n, double th) {
     return model_varies(s->prims[h].mat, ss, tt, n < 4 ? n : 4, th);
 }
 
+// The primary ray through image point (px, py), in pixels from the top left corner.
+Ray image_ray(const Scene *s, double px, double py) {
+    return camera_ray(s, (real)(2.0 * px / s->width - 1.0), (real)(2.0 * py / s->height - 1.0));
+}
+
 // The primary ray of sample (a, b) of pixel (i, j), of A x A stratified samples.
 Ray sample_ray(const Scene *s, int i, int j, int a, int b) {
     int A = s->antialias;
-    real u = (real)(2.0 * (i + (a + 0.5) / A) / s->width - 1.0);
-    real v = (real)(2.0 * (j + (b + 0.5) / A) / s->height - 1.0);
-    return camera_ray(s, u, v);
+    return image_ray(s, i + (a + 0.5) / A, j + (b + 0.5) / A);
 }
 
 // Rays are made a stretch ahead of tracing them: the square root and divisions of each then
@@ -6049,11 +6075,51 @@ pray_rgb pixel(Worker &k, int i, int j) {
     return cscale(sum, 1.0 / ((double)A * A));
 }
 
+// A hit as pray_intersect reports it.
+void public_hit(const Scene *s, const Ray &ray, const Hit &h, pray_hit *o) {
+    const Prim &q = s->prims[h.prim];
+    o->t = (double)h.t;
+    o->primitive = q.id;
+    o->entering = h.root_enter;
+    R3 ng = prim_normal(q, ray.o + ray.d * h.t);
+    R3 nn = h.prim_enter == h.root_enter ? ng : ng * (real)-1;
+    o->normal = vmake((double)nn.x, (double)nn.y, (double)nn.z);
+}
+
+// Where pixel (i, j) of the image is kept in the caller's buffers, in pixels.
+size_t out_index(const Job *job, int i, int j) {
+    return (size_t)(j - job->r.y) * job->out.stride + (size_t)(i - job->r.x);
+}
+
 void put_pixel(const Job *job, int i, int j, pray_rgb c) {
-    float *px = job->out->pixels + ((size_t)j * job->s->width + i) * 3;
+    float *px = job->out.rgb + out_index(job, i, j) * 3;
     px[0] = (float)c.r;
     px[1] = (float)c.g;
     px[2] = (float)c.b;
+}
+
+// The per-pixel outputs of pixel (i, j): pray_intersect's first hit on the ray through its centre
+// (pray_camera_ray's ray, its direction made unit again as pray_intersect does).
+void put_first_hit(Worker &k, int i, int j) {
+    const Job *job = k.job;
+    Ray ray = image_ray(job->s, i + 0.5, j + 0.5);
+    ray.d = unit(ray.d);
+    FirstHit fh;
+    fh.found = false;
+    find_hits(job->s, &k.w, ray, REAL_INF, -1, fh);
+    pray_hit h;
+    h.primitive = -1;
+    h.t = HUGE_VAL;
+    h.normal = vmake(0, 0, 0);
+    if (fh.found) public_hit(job->s, ray, fh.h, &h);
+    size_t at = out_index(job, i, j);
+    if (job->out.primitive) job->out.primitive[at] = h.primitive;
+    if (job->out.depth) job->out.depth[at] = (float)h.t;
+    if (job->out.normal) {
+        job->out.normal[at * 3] = (float)h.normal.x;
+        job->out.normal[at * 3 + 1] = (float)h.normal.y;
+        job->out.normal[at * 3 + 2] = (float)h.normal.z;
+    }
 }
 
 void set_row_background(Worker &k, int j) {
@@ -6200,16 +6266,24 @@ void refine(Worker &k, const Tile &t, int x0, int y0, int x1, int y1) {
 
 // Undersampling: a band of tiles, left to right. Its pixels are averages of their samples, in
 // the order of pixel(): where every sample is traced, the same colour as full sampling.
+// Only the band's pixels in the rectangle wanted are written, and only the tiles that hold them
+// are sampled, after the tile before them: a tile's samples depend on nothing before it but the
+// column it is handed, and that column's values come from its own tile's samples only (its
+// cells are decided by their traced corners, and the first cell to reach a sample sets it).
+// So the rectangle's samples are those of the whole image.
 void adaptive_band(Worker &k, int y0, int y1) {
     const Job *job = k.job;
     const Scene *s = job->s;
     int A = s->antialias, T = job->tile, S = job->step, n = T + 1;
     int SW = s->width * A, SH = s->height * A;
+    int ry0 = y0 > job->r.y ? y0 : job->r.y, ry1 = y1 < job->r.y + job->r.height ? y1 : job->r.y + job->r.height;
+    int rx0 = job->r.x, rx1 = job->r.x + job->r.width;
+    int first = job->r.x * A / T;  // the tile that holds the rectangle's first column
     Tile t;
     t.Y0 = y0 * A;
     int Y1 = t.Y0 + T < SH - 1 ? t.Y0 + T : SH - 1;  // the band's last row of samples
     for (int q = 0; q < n * n; q++) k.cache[q].known = 0;
-    for (t.X0 = 0;; t.X0 += T) {
+    for (t.X0 = (first > 0 ? first - 1 : 0) * T;; t.X0 += T) {
         int X1 = t.X0 + T < SW - 1 ? t.X0 + T : SW - 1;
         for (int cy = t.Y0;; cy += S) {
             int yl = cy + S < Y1 ? cy + S : Y1;
@@ -6220,9 +6294,11 @@ void adaptive_band(Worker &k, int y0, int y1) {
             }
             if (yl == Y1) break;
         }
-        int i1 = X1 == SW - 1 ? s->width : (t.X0 + T) / A;
-        for (int j = y0; j < y1; j++)
-            for (int i = t.X0 / A; i < i1; i++) {
+        int i0 = t.X0 / A, i1 = X1 == SW - 1 ? s->width : (t.X0 + T) / A;
+        i0 = i0 > rx0 ? i0 : rx0;
+        i1 = i1 < rx1 ? i1 : rx1;
+        for (int j = ry0; j < ry1; j++)
+            for (int i = i0; i < i1; i++) {
                 pray_rgb sum = cmake(0, 0, 0);
                 for (int y = j * A; y < j * A + A; y++) {
                     const Sample *row = tile_at(k, t, i * A, y);
@@ -6230,7 +6306,7 @@ void adaptive_band(Worker &k, int y0, int y1) {
                 }
                 put_pixel(job, i, j, cscale(sum, 1.0 / ((double)A * A)));
             }
-        if (X1 == SW - 1 || cancelled(job->c)) break;  // (pray_cancel: checked per tile)
+        if (X1 == SW - 1 || i1 == rx1 || cancelled(job->c)) break;  // (pray_cancel: checked per tile)
         for (int y = 0; y < n; y++)  // the last column is the next tile's first
             for (int x = 0; x < n; x++) {
                 Sample &v = k.cache[y * n + x];
@@ -6240,26 +6316,37 @@ void adaptive_band(Worker &k, int y0, int y1) {
     }
 }
 
+// The rows of band `band` (of the whole image) that lie in the rectangle wanted: [*y0, *y1).
+void band_rows_in(const Job *job, int band, int *y0, int *y1) {
+    int a = band * job->band_rows, b = a + job->band_rows;
+    *y0 = a > job->r.y ? a : job->r.y;
+    *y1 = b < job->r.y + job->r.height ? b : job->r.y + job->r.height;
+}
+
 void render_band(Worker &k, int band) {
     Job *job = k.job;
     const Scene *s = job->s;
-    int W = s->width, H = s->height;
-    int y0 = band * job->band_rows, y1 = y0 + job->band_rows;
-    if (y1 > H) y1 = H;
+    int x0 = job->r.x, x1 = job->r.x + job->r.width, y0, y1;
+    band_rows_in(job, band, &y0, &y1);
     shadow_cache_clear(s, k.tr.w);
-    if (job->adaptive > 0) {
-        adaptive_band(k, y0, y1);
+    if (job->out.primitive || job->out.depth || job->out.normal)
+        for (int j = y0; j < y1; j++)
+            for (int i = x0; i < x1; i++) put_first_hit(k, i, j);
+    if (!job->out.rgb) return;
+    if (job->adaptive > 0) {  // (the whole band: its tiles are sampled from the top)
+        int b0 = band * job->band_rows, b1 = b0 + job->band_rows;
+        adaptive_band(k, b0, b1 < s->height ? b1 : s->height);
         return;
     }
     Ray rays[RAY_BATCH];
     for (int j = y0; j < y1 && !cancelled(job->c); j++) {
         set_row_background(k, j);
         if (s->antialias > 1) {  // pixel() makes each row of samples ahead
-            for (int i = 0; i < W; i++) put_pixel(job, i, j, pixel(k, i, j));
+            for (int i = x0; i < x1; i++) put_pixel(job, i, j, pixel(k, i, j));
             continue;
         }
-        for (int i0 = 0; i0 < W; i0 += RAY_BATCH) {
-            int n = W - i0 < RAY_BATCH ? W - i0 : RAY_BATCH;
+        for (int i0 = x0; i0 < x1; i0 += RAY_BATCH) {
+            int n = x1 - i0 < RAY_BATCH ? x1 - i0 : RAY_BATCH;
             for (int q = 0; q < n; q++) rays[q] = sample_ray(s, i0 + q, j, 0, 0);
             for (int q = 0; q < n; q++) put_pixel(job, i0 + q, j, trace(k.tr, rays[q], 1, -1, RAY_PRIMARY));
         }
@@ -6274,15 +6361,15 @@ void worker_main(void *arg) {
         int band = job->cancelled ? job->bands : job->next_band++;
         job->mu.unlock();
         if (band >= job->bands) return;
-        render_band(k, band);
+        render_band(k, job->band0 + band);
         job->mu.lock();
         if (k.tr.over) job->cancelled = job->over = 1;
         if (cancelled(job->c)) job->cancelled = 1;
-        int y0 = band * job->band_rows;
-        int rows = y0 + job->band_rows > job->s->height ? job->s->height - y0 : job->band_rows;
-        job->rows_done += rows;
+        int y0, y1;
+        band_rows_in(job, job->band0 + band, &y0, &y1);
+        job->rows_done += y1 - y0;
         pray_ctx *c = job->c;
-        if (!job->cancelled && c->progress_fn && c->progress_fn(c->progress_ud, job->rows_done, job->s->height))
+        if (!job->cancelled && c->progress_fn && c->progress_fn(c->progress_ud, job->rows_done, job->r.height))
             job->cancelled = 1;
         job->mu.unlock();
     }
@@ -6290,7 +6377,8 @@ void worker_main(void *arg) {
 
 Worker &worker_at(char *buf, size_t stride, int i) { return *(Worker *)(buf + LINE_SLACK + (size_t)i * stride); }
 
-pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
+// Render the rectangle r of the image into the buffers (stride set).
+pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const pray_buffers &out) {
     int nt = opt_int(c, OPT_THREADS);
     if (nt <= 0) nt = cpu_count();
     if (!PRAY_HAS_THREADS || nt < 1) nt = 1;
@@ -6299,14 +6387,16 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
     memset(&job, 0, sizeof job);
     job.c = c;
     job.s = s;
+    job.r = r;
     job.out = out;
-    job.adaptive = c->cur.opt.v[OPT_ADAPTIVE];
+    job.adaptive = out.rgb ? c->cur.opt.v[OPT_ADAPTIVE] : 0;
     job.step = s->antialias * (s->antialias > 1 ? ADAPT_PIXELS_AA : ADAPT_PIXELS);
     job.tile = job.step * (ADAPT_TILE > job.step ? ADAPT_TILE / job.step : 1);
     job.band_rows = job.adaptive > 0 ? job.tile / s->antialias : 4;
     for (int i = 0; job.adaptive > 0 && i < s->prims.n; i++)  // undersampling looks into textures
         if (!model_pyramids(c, (pray_model *)s->prims[i].mat)) return c->status;  // (marks the parts done)
-    job.bands = (s->height + job.band_rows - 1) / job.band_rows;
+    job.band0 = r.y / job.band_rows;
+    job.bands = (r.y + r.height - 1) / job.band_rows - job.band0 + 1;
     if (nt > job.bands) nt = job.bands;
     // everything a thread needs is allocated here, before any starts: the context's allocator
     // is used by one thread only
@@ -6356,7 +6446,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, pray_image *out) {
         scratch_release(c, &worker_at(wbuf, stride, i).w);
         worker_at(wbuf, stride, i).cache.release(c);
     }
-    c->stats.rays_primary_full += (double)s->width * s->height * s->antialias * s->antialias;
+    if (out.rgb) c->stats.rays_primary_full += (double)r.width * r.height * s->antialias * s->antialias;
     c->stats.threads = nt;
     mem_free(c, wbuf);
     mem_free(c, args);
@@ -7067,6 +7157,73 @@ pray_texture *pray_texture_tiff(pray_ctx *c, const void *data, size_t n, const c
     return texture_make(c, name ? name : "texture", (const unsigned char *)data, n);
 }
 
+pray_texture *pray_texture_rgb(pray_ctx *c, int w, int h, const float *rgb, const char *name) {
+    if (!c) return NULL;
+    if (!rgb) {
+        fail(c, PRAY_ERR_ARG, "pray_texture_rgb: no pixels");
+        return NULL;
+    }
+    if (w < 1 || h < 1 || w > 65536 || h > 65536) {
+        fail(c, PRAY_ERR_ARG, "pray_texture_rgb: image size %d x %d is out of range (1 to 65536 a side)", w, h);
+        return NULL;
+    }
+    size_t n = (size_t)w * (size_t)h * 3;
+    if ((double)n * sizeof(float) > c->cur.opt.v[OPT_TEXMEM] * 1048576.0) {
+        fail(c, PRAY_ERR_LIMIT, "pray_texture_rgb: a %d x %d texture is over the texture memory limit (option texmem)",
+             w, h);
+        return NULL;
+    }
+    for (size_t i = 0; i < n; i++)
+        if (!(rgb[i] >= 0 && rgb[i] <= 1)) {
+            fail(c, PRAY_ERR_ARG, "pray_texture_rgb: value %lu (pixel %lu, %lu) is %g, not in 0 .. 1",
+                 (unsigned long)(i % 3), (unsigned long)(i / 3 % (size_t)w), (unsigned long)(i / 3 / (size_t)w),
+                 (double)rgb[i]);
+            return NULL;
+        }
+    pray_texture *t = (pray_texture *)handle_new(c, sizeof(pray_texture), H_TEXTURE);
+    float *px = t ? (float *)mem_alloc(c, n * sizeof(float)) : NULL;
+    if (!name) name = "texture";
+    char *nm = px ? mem_strdup(c, name, strlen(name)) : NULL;
+    if (!nm) {
+        mem_free(c, px);
+        mem_free(c, t);
+        return NULL;
+    }
+    memcpy(px, rgb, n * sizeof(float));
+    t->w = w;
+    t->hgt = h;
+    t->rgb = px;
+    t->name = nm;
+    return t;
+}
+
+pray_status pray_texture_register(pray_ctx *c, const char *name, pray_texture *t) {
+    if (!c) return PRAY_ERR_ARG;
+    if (!name || !*name) return fail(c, PRAY_ERR_ARG, "pray_texture_register: no name");
+    if (t && !handle_ok(c, t, H_TEXTURE, "pray_texture_register", "texture")) return c->status;
+    TexName **at = texture_name_at(c, name), *e = *at;
+    if (!e && t) {
+        e = (TexName *)mem_zalloc(c, sizeof(TexName));
+        char *nm = e ? mem_strdup(c, name, strlen(name)) : NULL;
+        if (!nm) {
+            mem_free(c, e);
+            return c->status;
+        }
+        e->name = nm;
+        *at = e;
+    }
+    if (!e) return PRAY_OK;  // removing a name that is not registered
+    retain(t);
+    release_handle(c, e->tex);
+    e->tex = t;
+    if (!t) {  // removed
+        *at = e->next;
+        mem_free(c, e->name);
+        mem_free(c, e);
+    }
+    return PRAY_OK;
+}
+
 void pray_texture_size(const pray_texture *t, int *w, int *h) {
     if (w) *w = t ? t->w : 0;
     if (h) *h = t ? t->hgt : 0;
@@ -7367,17 +7524,9 @@ pray_status pray_background(pray_ctx *c, pray_rgb top, pray_rgb bottom) {
     return PRAY_OK;
 }
 
-pray_status pray_render(pray_ctx *c, pray_object *root, pray_light *lights, pray_image *out) {
-    if (out) {
-        out->width = out->height = 0;
-        out->pixels = NULL;
-    }
-    if (!c) return PRAY_ERR_ARG;
-    Call call(c);
-    if (!out) return fail(c, PRAY_ERR_ARG, "pray_render: no image to render into");
-    if (!root) return c->status != PRAY_OK ? c->status : fail(c, PRAY_ERR_ARG, "no object to render");
-    if (!object_ok(c, root, "pray_render", "object") || (lights && !light_ok(c, lights, "pray_render", "light")))
-        return c->status;
+namespace {
+// The image of the context's options may be rendered (its size and samples within the limits).
+pray_status image_limits(pray_ctx *c) {
     int W = opt_int(c, OPT_WIDTH), H = opt_int(c, OPT_HEIGHT);
     if ((double)W * H > MAX_IMAGE_PIXELS)
         return fail(c, PRAY_ERR_LIMIT, "image of %d x %d pixels is too large", W, H);
@@ -7388,26 +7537,93 @@ pray_status pray_render(pray_ctx *c, pray_object *root, pray_light *lights, pray
         return fail(c, PRAY_ERR_LIMIT, "image of %d x %d pixels%s is over the limit of %.0f samples (option maxpixels)",
                     W, H, how, lim);
     }
+    return PRAY_OK;
+}
+
+// The one way to render: rectangle r of the image into the buffers (stride set), both checked.
+pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, const pray_rect &r,
+                        const pray_buffers &out) {
     double t0 = clock_seconds();
     Scene s;
     pray_status st = scene_build(c, &s, root, lights, true);
     double t1 = clock_seconds();
     if (st == PRAY_OK) {
-        out->pixels = (float *)mem_zalloc(c, sizeof(float) * 3 * (size_t)W * (size_t)H);
-        if (!out->pixels) st = c->status;
-    }
-    if (st == PRAY_OK) {
-        out->width = W;
-        out->height = H;
         c->stats.primitives = s.prims.n;
         c->stats.nodes = s.nodes.n;
-        st = render_scene(c, &s, out);
+        st = render_scene(c, &s, r, out);
     }
     c->stats.time_prepare += t1 - t0;
     c->stats.time_render += clock_seconds() - t1;
     scene_release(c, &s);
+    return st;
+}
+// What pray_render and pray_render_into check of the scene.
+bool scene_ok(pray_ctx *c, pray_object *root, pray_light *lights, const char *fn) {
+    if (!root) {
+        if (c->status == PRAY_OK) fail(c, PRAY_ERR_ARG, "no object to render");
+        return false;
+    }
+    return object_ok(c, root, fn, "object") && (!lights || light_ok(c, lights, fn, "light"));
+}
+} // namespace
+
+pray_status pray_render(pray_ctx *c, pray_object *root, pray_light *lights, pray_image *out) {
+    if (out) {
+        out->width = out->height = 0;
+        out->pixels = NULL;
+    }
+    if (!c) return PRAY_ERR_ARG;
+    Call call(c);
+    if (!out) return fail(c, PRAY_ERR_ARG, "pray_render: no image to render into");
+    if (!scene_ok(c, root, lights, "pray_render") || image_limits(c)) return c->status;
+    int W = opt_int(c, OPT_WIDTH), H = opt_int(c, OPT_HEIGHT);
+    pray_rect r = {0, 0, W, H};
+    pray_buffers b = {NULL, NULL, NULL, NULL, (size_t)W};
+    b.rgb = (float *)mem_zalloc(c, sizeof(float) * 3 * (size_t)W * (size_t)H);
+    if (!b.rgb) return c->status;
+    out->pixels = b.rgb;
+    out->width = W;
+    out->height = H;
+    pray_status st = render_into(c, root, lights, r, b);
     if (st != PRAY_OK) pray_image_free(c, out);
     return st;
+}
+
+pray_status pray_render_into(pray_ctx *c, pray_object *root, pray_light *lights, const pray_rect *rect,
+                             const pray_buffers *out) {
+    if (!c) return PRAY_ERR_ARG;
+    Call call(c);
+    if (!out) return fail(c, PRAY_ERR_ARG, "pray_render_into: no buffers");
+    if (!out->rgb && !out->primitive && !out->depth && !out->normal)
+        return fail(c, PRAY_ERR_ARG, "pray_render_into: every buffer is NULL");
+    if (!scene_ok(c, root, lights, "pray_render_into") || image_limits(c)) return c->status;
+    int W = opt_int(c, OPT_WIDTH), H = opt_int(c, OPT_HEIGHT);
+    pray_rect r = {0, 0, W, H};
+    if (rect) r = *rect;
+    if (r.width < 1 || r.height < 1 || r.x < 0 || r.y < 0 || r.x > W - r.width || r.y > H - r.height)
+        return fail(c, PRAY_ERR_ARG, "pray_render_into: the rectangle of %d x %d pixels at (%d, %d) is not inside the "
+                    "image of %d x %d", r.width, r.height, r.x, r.y, W, H);
+    pray_buffers b = *out;
+    if (b.stride == 0) b.stride = (size_t)r.width;
+    if (b.stride < (size_t)r.width)
+        return fail(c, PRAY_ERR_ARG, "pray_render_into: the stride %lu is less than the rectangle's width %d",
+                    (unsigned long)b.stride, r.width);
+    if (b.stride > (size_t)-1 / 3 / (size_t)r.height)
+        return fail(c, PRAY_ERR_ARG, "pray_render_into: the stride %lu is too large", (unsigned long)b.stride);
+    return render_into(c, root, lights, r, b);
+}
+
+pray_status pray_camera_ray(pray_ctx *c, double px, double py, pray_vec *origin, pray_vec *dir) {
+    if (!c) return PRAY_ERR_ARG;
+    if (!origin || !dir) return fail(c, PRAY_ERR_ARG, "pray_camera_ray: no place for the ray");
+    if (!finite_num(px) || !finite_num(py)) return fail(c, PRAY_ERR_ARG, "pray_camera_ray: the point is not finite");
+    Scene s;
+    memset(&s, 0, sizeof s);
+    scene_camera(c, &s);
+    Ray r = image_ray(&s, px, py);
+    *origin = vmake((double)r.o.x, (double)r.o.y, (double)r.o.z);
+    *dir = vmake((double)r.d.x, (double)r.d.y, (double)r.d.z);
+    return PRAY_OK;
 }
 
 void pray_stats_get(const pray_ctx *c, pray_stats *out) {
@@ -7440,16 +7656,7 @@ struct CollectHits {
     pray_hit *out;
     int max, n;
     bool operator()(const Hit &h) {
-        if (n < max) {
-            const Prim &q = s->prims[h.prim];
-            pray_hit &o = out[n];
-            o.t = (double)h.t;
-            o.primitive = q.id;
-            o.entering = h.root_enter;
-            R3 ng = prim_normal(q, ray.o + ray.d * h.t);
-            R3 nn = h.prim_enter == h.root_enter ? ng : ng * (real)-1;
-            o.normal = vmake((double)nn.x, (double)nn.y, (double)nn.z);
-        }
+        if (n < max) public_hit(s, ray, h, &out[n]);
         n++;
         return true;
     }
@@ -8933,11 +9140,17 @@ pray_status bi_spheremap(Interp &I, const Expr *call, Value *a, Value *out) {
                 pray_spheremap(I.c, (pray_model *)a[0].ref, vec_of(a[1]), a[2].v[0], vec_of(a[3]), vec_of(a[4])), out);
 }
 
-// A texture named by the program: as written, else beside the program. An untrusted program's
-// files are read beside it only (open_read). Errors name the call.
+// A texture named by the program: one the host registered under that name, else a file as
+// written, else beside the program. An untrusted program's files are read beside it only
+// (open_read). Errors name the call.
 pray_texture *program_texture(Interp &I, const Expr *call, const Value &name) {
     pray_ctx *c = I.c;
     const char *path = ((const Str *)name.ref)->s;
+    TexName *reg = *texture_name_at(c, path);
+    if (reg) {
+        retain(reg->tex);
+        return reg->tex;
+    }
     const char *why = c->untrusted ? untrusted_path_problem(path) : NULL;
     if (why) {
         rerr(I, call, PRAY_ERR_RUNTIME, "untrusted program: '%s' is %s; files are read from the program's "

@@ -158,8 +158,8 @@ void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
    signal handler that removes it before the program dies: reading it is async-signal-safe. */
 const char *pray_temp_file(const pray_ctx *ctx);
 /* Stop the call running on the context: pray_run_string, pray_run_file, pray_render,
-   pray_prepare, pray_write_image, pray_write_tiff, pray_write_ppm or pray_write_png. Safe from any thread and
-   from a signal handler: it only sets a flag. The call stops at its next check (each statement
+   pray_render_into, pray_prepare, pray_write_image, pray_write_tiff, pray_write_ppm or
+   pray_write_png. Safe from any thread and from a signal handler: it only sets a flag. The call stops at its next check (each statement
    of a program; each row of voxels while a scene is prepared; each row of an image rendered or
    written) with PRAY_ERR_CANCELLED, "error: cancelled" (with the place in a program). It leaves
    no file behind and no image; a byte sink has got part of one, to be thrown away. One of those
@@ -395,6 +395,60 @@ pray_status pray_write_png(pray_ctx *ctx, const pray_image *img, pray_write_fn f
    its own; the message (or "") is copied into `message` (may be NULL) of message_size bytes. */
 pray_status pray_render_file(const char *program, const char *const *options, int noptions,
                              char *message, size_t message_size);
+
+/* ---------------------------------------------------------------------------------------------
+   Rendering into your own buffers, per-pixel outputs, host textures.
+   ------------------------------------------------------------------------------------------- */
+/* A rectangle of the image in pixels: columns x .. x+width-1, rows y .. y+height-1, row 0 at
+   the top. */
+typedef struct pray_rect { int x, y, width, height; } pray_rect;
+/* Where pray_render_into writes: any of the four may be NULL (not wanted), not all of them.
+   Pixel (x, y) of the rectangle is at element y*stride + x of every buffer (times 3 for rgb and
+   normal); nothing between rows is written. The caller owns the buffers.
+   The per-pixel outputs (primitive, depth, normal) are those of the first surface met by the
+   primary ray through the pixel's centre, pray_camera_ray(ctx, x + 0.5, y + 0.5, ...) in image
+   pixels: exactly pray_intersect's first hit for that ray on a scene prepared with the same
+   options, whatever antialias and adaptive do for the colour. */
+typedef struct pray_buffers {
+    float *rgb;       /* 3 floats per pixel: the colour, as pray_render's */
+    int *primitive;   /* the primitive seen (as pray_hit.primitive: declared order); -1: background */
+    float *depth;     /* its pray_hit.t (distance along the ray); +infinity for the background */
+    float *normal;    /* 3 floats per pixel: its pray_hit.normal; 0, 0, 0 for the background */
+    size_t stride;    /* pixels from one row to the next in every buffer: 0 = the rectangle's
+                         width, else at least that */
+} pray_buffers;
+/* Render as pray_render does, into the caller's buffers: the image of the context's width and
+   height options, or only the rectangle `rect` of it (NULL = the whole image). A rectangle's
+   colours are bit for bit those of the same pixels of the whole image, for every option and
+   any number of threads. Memory besides the buffers comes from the context. Errors:
+   PRAY_ERR_ARG (no context or buffers, all buffers NULL, a rectangle not inside the image, a
+   stride less than its width), and those of pray_render; on error the buffers hold partial
+   results. */
+pray_status pray_render_into(pray_ctx *ctx, pray_object *root, pray_light *lights, const pray_rect *rect,
+                             const pray_buffers *out);
+/* The primary ray through image point (px, py), in pixels from the image's top left corner
+   (a pixel's centre is at x + 0.5, y + 0.5), for the context's camera and width and height
+   options: *origin (the eye; for a parallel camera the point on the image plane) and *dir (a
+   unit vector). The render's primary rays are exactly these: with antialias A, sample (a, b)
+   of pixel (x, y) is the ray of point (x + (a + 0.5) / A, y + (b + 0.5) / A). PRAY_ERR_ARG for
+   a NULL argument or a point that is not finite. */
+pray_status pray_camera_ray(pray_ctx *ctx, double px, double py, pray_vec *origin, pray_vec *dir);
+
+/* A texture from pixels in memory: width x height pixels, 3 floats each (R, G, B in 0 .. 1), rows
+   from the top, copied; `name` (NULL: "texture") is used in messages. Like a texture file it may
+   take at most option texmem MiB; sides are 1 to 65536. NULL on error (PRAY_ERR_ARG: NULL
+   pixels, a bad size, a value that is not in 0 .. 1; PRAY_ERR_LIMIT: over texmem;
+   PRAY_ERR_NOMEM). Release it with pray_texture_release. */
+pray_texture *pray_texture_rgb(pray_ctx *ctx, int width, int height, const float *rgb, const char *name);
+/* Register `tex` under `name`: a program's texture and font names (tiff, tiffbump, text) are
+   looked up first among the registered names, by exact string match before any path handling,
+   and then as files. So a registered name needs no file access: it works in builds with
+   PRAY_NO_STDIO and in untrusted mode. The context keeps a reference until the name is
+   registered again (which replaces it), removed (tex NULL; a name not registered is fine) or the
+   context is freed; registrations last across runs. A registered texture was checked against
+   texmem when it was made and is not counted again by runs. PRAY_ERR_ARG for a NULL context, a
+   NULL or empty name, or a texture of another context. */
+pray_status pray_texture_register(pray_ctx *ctx, const char *name, pray_texture *tex);
 
 #ifdef __cplusplus
 }

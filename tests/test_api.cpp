@@ -90,7 +90,16 @@ TEST_CASE("api: every function takes a NULL context and returns its error value"
     CHECK(pray_write_image(nullptr, &img, "a.tif", 8) == PRAY_ERR_ARG);
     CHECK(pray_write_tiff(nullptr, &img, 8, nullptr, nullptr) == PRAY_ERR_ARG);
     CHECK(pray_write_ppm(nullptr, &img, 8, nullptr, nullptr) == PRAY_ERR_ARG);
+    CHECK(pray_write_png(nullptr, &img, nullptr, nullptr) == PRAY_ERR_ARG);
+    float rgb[3] = {0, 0, 0};
+    pray_buffers bufs = {rgb, nullptr, nullptr, nullptr, 0};
+    CHECK(pray_render_into(nullptr, nullptr, nullptr, nullptr, &bufs) == PRAY_ERR_ARG);
+    pray_vec ro, rd;
+    CHECK(pray_camera_ray(nullptr, 0.5, 0.5, &ro, &rd) == PRAY_ERR_ARG);
+    CHECK(pray_texture_rgb(nullptr, 1, 1, rgb, "t") == nullptr);
+    CHECK(pray_texture_register(nullptr, "t", nullptr) == PRAY_ERR_ARG);
     // the void ones do nothing
+    pray_set_warning(nullptr, nullptr, nullptr);
     pray_free(nullptr);
     pray_clear_error(nullptr);
     pray_set_memory_limit(nullptr, 1);
@@ -282,6 +291,12 @@ TEST_CASE("api: handles, scenes and images of another context are refused") {
          [&] { pray_image x; return pray_render(a, o, la, &x) == PRAY_ERR_ARG && !x.pixels; }},
         {"error: pray_render: the light belongs to another context",
          [&] { pray_image x; return pray_render(a, oa, l, &x) == PRAY_ERR_ARG && !x.pixels; }},
+        {"error: pray_render_into: the object belongs to another context",
+         [&] { float px[3]; pray_buffers x = {px, nullptr, nullptr, nullptr, 0}; pray_rect r = {0, 0, 1, 1};
+               return pray_render_into(a, o, la, &r, &x) == PRAY_ERR_ARG; }},
+        {"error: pray_render_into: the light belongs to another context",
+         [&] { float px[3]; pray_buffers x = {px, nullptr, nullptr, nullptr, 0}; pray_rect r = {0, 0, 1, 1};
+               return pray_render_into(a, oa, l, &r, &x) == PRAY_ERR_ARG; }},
         {"error: pray_intersect: the scene belongs to another context",
          [&] { return pray_intersect(a, sc, ONE, UP, HUGE_VAL, nullptr, 0) == -1; }},
         {"error: pray_scene_free: the scene belongs to another context", [&] { pray_scene_free(a, sc); return true; }},
@@ -326,6 +341,8 @@ TEST_CASE("api: handles, scenes and images of another context are refused") {
         {"error: pray_tiffbump: the texture belongs to another context", [&] { return !pray_tiffbump(a, ma, 1, t); }},
         {"error: pray_text: the font belongs to another context",
          [&] { return !pray_text(a, ma, "A", ORIGIN, ONE, UP, 1, t, 1); }},
+        {"error: pray_texture_register: the texture belongs to another context",
+         [&] { return pray_texture_register(a, "t", t) == PRAY_ERR_ARG; }},
         {"error: pray_texture_release: the texture belongs to another context",
          [&] { pray_texture_release(a, t); return true; }},
     };
