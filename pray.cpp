@@ -5168,8 +5168,8 @@ FILE *open_read(pray_ctx *c, const char *dir, size_t dlen, const char *name, int
     memcpy(p, dir, dlen);
     memcpy(p + dlen, name, n + 1);
     bool relative = name[0] && name[0] != '/' && name[0] != '\\' && name[1] != ':';
-    const char *first = how == FIND_BESIDE && relative && dlen ? p + dlen : p;  // as written first
-    if (how == FIND_AS_NAMED) first = p + dlen;
+    const char *first = how == FIND_CONFINED ? p : p + dlen;  // as written first,
+    bool beside = how == FIND_BESIDE && relative && dlen;       // then beside the program
     bool link = false;
     const char *at = NULL;
     int err = 0;
@@ -5190,7 +5190,7 @@ FILE *open_read(pray_ctx *c, const char *dir, size_t dlen, const char *name, int
     } else {
         errno = 0;
         fd = fd_open(first, 0);
-        if (fd < 0 && errno == ENOENT && first != p) {
+        if (fd < 0 && errno == ENOENT && beside) {
             fd = fd_open(p, 0);
             if (fd >= 0 || errno != ENOENT) first = p;  // else: named as written
         }
@@ -5210,7 +5210,7 @@ FILE *open_read(pray_ctx *c, const char *dir, size_t dlen, const char *name, int
     if (id) id->valid = 0;
     errno = 0;
     FILE *f = fopen(first, "rb");
-    if (!f && how == FIND_BESIDE && first != p && errno == ENOENT) {
+    if (!f && beside && errno == ENOENT) {
         f = fopen(p, "rb");
         if (f || errno != ENOENT) first = p;
     }

@@ -1014,6 +1014,23 @@ TEST_CASE("textures: missing and unreadable files through the API") {
     pray_release(c, m);
 }
 
+TEST_CASE("textures: a program in another directory finds a texture by an absolute or a relative name") {
+    TempDir d;
+    REQUIRE(std::system(("mkdir " + sq(d / "sub")).c_str()) == 0);
+    std::vector<float> px = {0, 0.5f, 1};
+    pray_image img = {1, 1, px.data()};
+    Ctx c;
+    REQUIRE(pray_write_image(c, &img, (d / "t.tif").c_str(), 8) == PRAY_OK);
+    // the absolute name as written (not joined to the program's directory); "../t.tif" beside it
+    for (const std::string &name : {d / "t.tif", std::string("../t.tif")}) {
+        CAPTURE(name);
+        spit(d / "sub/p.ray", "option \"width\", 2\noption \"height\", 2\noption \"output\", \"" + (d / "o.ppm") +
+                                  "\"\nrendertiff sphere(tiff(color({1}), color({0}), \"" + name + "\"), [0, 0, 0], 9)\n");
+        Ctx k;
+        CHECK_MESSAGE(pray_run_file(k, (d / "sub/p.ray").c_str()) == PRAY_OK, pray_error(k));
+    }
+}
+
 // =============================================================================================
 // Texture coordinates
 // =============================================================================================
