@@ -476,7 +476,7 @@ pray_status pray_texture_register(pray_ctx *ctx, const char *name, pray_texture 
    Everything a context makes belongs to it: objects, models, lights, textures, prepared scenes
    and rendered images. pray_free frees all that is left of them; pray_image_free,
    pray_scene_free and the releases free one earlier. Copy the pixels of an image that must
-   outlive its context. A NULL from a failed call passes through the calls it is given to, so
+   outlive its context, or render into your own buffers (pray_render_into, below). A NULL from a failed call passes through the calls it is given to, so
    one check at the end finds the first failure's message:
        #include <stdio.h>
        #include "pray.hpp"
@@ -496,6 +496,37 @@ pray_status pray_texture_register(pray_ctx *ctx, const char *name, pray_texture 
            return ok ? 0 : 1;
        }
    Running the same scene as a program: pray_run_string(c, "red.ray", text, strlen(text)).
+   A host that keeps the pixels itself renders into its own buffers, here a 4 x 4 rectangle of
+   the image with the primitive seen at each pixel (for picking), and lends a program a texture
+   from memory under a name:
+       #include <stdio.h>
+       #include <string.h>
+       #include "pray.hpp"
+       int main(void) {
+           static float rgb[4 * 4 * 3], checker[2 * 2 * 3] = {1, 1, 1, 0, 0, 0, 0, 0, 0, 1, 1, 1};
+           static int seen[4 * 4];
+           pray_rect r = {30, 30, 4, 4};
+           pray_buffers out = {NULL, NULL, NULL, NULL, 0};
+           pray_rgb white = {1, 1, 1};
+           pray_vec centre = {0, 0, 0};
+           const char *prog = "M = tiff(color({0}), color({1}), \"checker\")\n"
+                              "rendertiff spheremap(M, [0, 0, 0], 0.5, <0, 0, 1>, <1, 0, 0>), none\n";
+           pray_ctx *c = pray_new();
+           pray_object *s = pray_sphere(c, pray_color(c, white), centre, 0.5);
+           pray_texture *t = pray_texture_rgb(c, 2, 2, checker, "checker");
+           int ok;
+           out.rgb = rgb;
+           out.primitive = seen;
+           pray_option(c, "width", 64);
+           pray_option(c, "height", 64);
+           ok = pray_render_into(c, s, NULL, &r, &out) == PRAY_OK && seen[0] == 0;
+           pray_option_string(c, "output", "checker.ppm");
+           ok = ok && pray_texture_register(c, "checker", t) == PRAY_OK &&
+                pray_run_string(c, "checker.ray", prog, strlen(prog)) == PRAY_OK;
+           if (!ok) fprintf(stderr, "%s\n", pray_error(c));
+           pray_free(c);
+           return ok ? 0 : 1;
+       }
    Every indented block of this manual that starts with #include is a whole program, compiled
    as C and as C++ and run by the tests.
 
@@ -506,7 +537,9 @@ pray_status pray_texture_register(pray_ctx *ctx, const char *name, pray_texture 
    (see the conventions before the declarations).
 
    5. Threads and cancelling
-   A context is used by one thread at a time; two contexts may render at once. No global state.
+   A context is used by one thread at a time; two contexts may render at once. No global state
+   (while a PNG is encoded, the encoding thread keeps a pointer to its context in thread-local
+   storage, for the encoder's allocations).
    A render runs on option threads threads, the caller's among them. The progress callback is
    called on any of them, one call at a time; it must not call pray on the context, except
    pray_cancel. pray_cancel may be called from any thread or a signal handler while a program
