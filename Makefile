@@ -75,6 +75,12 @@ $(TESTS): $(TEST_SRC) tests/*.hpp pray.cpp pray.hpp build/png
 $(TESTS_FLOAT): $(TEST_SRC) tests/*.hpp pray.cpp pray.hpp build/png
 	$(CXX) $(TESTFLAGS) -DPRAY_REAL=float $(TEST_SRC) -o $@ $(LDLIBS) -lpthread
 
+# A build without file access (PRAY_NO_STDIO): rendering into buffers and textures the host
+# registers, which such builds use instead of files (tests/test_buffers.cpp).
+TESTS_NOSTDIO = tests/pray_tests_nostdio$(EXE)
+$(TESTS_NOSTDIO): tests/test_main.cpp tests/test_buffers.cpp tests/*.hpp pray.cpp pray.hpp
+	$(CXX) $(TESTFLAGS) -DPRAY_NO_STDIO tests/test_main.cpp tests/test_buffers.cpp pray.cpp -o $@ $(LDLIBS) -lpthread
+
 # The C example: pray.hpp must be usable from C.
 tests/embed$(EXE): examples/embed.c pray.cpp pray.hpp build/png
 	$(CC) -std=c99 -pedantic -Wall -Wextra -Werror -I. -c examples/embed.c -o tests/embed.o
@@ -82,9 +88,11 @@ tests/embed$(EXE): examples/embed.c pray.cpp pray.hpp build/png
 	$(CXX) tests/embed.o tests/pray.o -o $@ $(LDLIBS)
 embed: tests/embed$(EXE)
 
-check: deps $(PRAY) textures $(TESTS) $(TESTS_FLOAT) tests/embed$(EXE)
+check: deps $(PRAY) textures $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embed$(EXE)
 	$(RUN) ./tests/embed$(EXE) tests/embed.ppm
 	CC="$(CC)" CXX="$(CXX)" RUN="$(RUN)" sh tests/manual_examples.sh
+	@echo "== tests of rendering into buffers, without file access (PRAY_NO_STDIO)"
+	$(RUN) ./$(TESTS_NOSTDIO)
 	@echo "== tests, PRAY_REAL=float"
 	$(RUN) ./$(TESTS_FLOAT)
 	@echo "== tests, PRAY_REAL=double"
@@ -175,4 +183,4 @@ ports:
 	sh ports/check
 
 clean:
-	rm -rf $(PRAY) $(TESTS) $(TESTS_FLOAT) tests/embed$(EXE) tests/*.o tests/*.ppm out
+	rm -rf $(PRAY) $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embed$(EXE) tests/*.o tests/*.ppm out
