@@ -1,0 +1,128 @@
+#!/bin/sh
+# bench/suite/run.sh - the benchmark suite (make suite; docs/benchmarks.md, "The suite").
+# Generates the suite's scenes (bench/suite/gen.py) into a temporary directory and renders each
+# with ./pray and with POV-Ray 3.7, one thread, no anti-aliasing; the gallery (examples/*.ray)
+# too, POV-Ray only where bench/pov/ has a twin. Prints a table of CPU times (user + system of
+# the whole process, best of RUNS, default 1) and the ratio POV-Ray / pray, with its geometric
+# mean.
+# Usage: bench/suite/run.sh [--size N] [--quick] [--compare REF] [--only PATTERN]
+#   --size N        image size N x N (default 512)
+#   --quick         size 64, no POV-Ray; checks that every scene renders byte for byte the same
+#                   with pray's default options and with --brute (exits 1 on any difference);
+#                   scenes of over 20000 primitives at half the size, to keep --brute short
+#   --compare REF   also time REF, another pray binary, and check it writes the same images
+#   --only PATTERN  only the scenes whose names match the shell pattern (e.g. 'csg-*')
+# Installs povray with apt-get when it is missing (not for --quick); builds ./pray if needed.
+set -e
+usage() { sed -n 's/^# Usage: //p' "$0" >&2; exit 2; }
+SIZE= QUICK= REF= ONLY='*'
+while [ $# -gt 0 ]; do
+  case $1 in
+    --size) [ $# -ge 2 ] || usage; SIZE=$2; shift 2 ;;
+    --quick) QUICK=1; shift ;;
+    --compare) [ $# -ge 2 ] || usage; REF=$2; shift 2 ;;
+    --only) [ $# -ge 2 ] || usage; ONLY=$2; shift 2 ;;
+    *) usage ;;
+  esac
+done
+if [ -n "$REF" ]; then
+  case $REF in /*) ;; *) REF=$(pwd)/$REF ;; esac
+  [ -x "$REF" ] || { echo "run.sh: $REF is not an executable" >&2; exit 2; }
+fi
+[ -n "$SIZE" ] || { [ -n "$QUICK" ] && SIZE=64 || SIZE=512; }
+case $SIZE in ''|*[!0-9]*|0*) usage ;; esac
+RUNS=${RUNS:-1}
+cd "$(dirname "$0")/../.."
+PY=/usr/bin/python3
+[ -x $PY ] || PY=python3
+
+if [ -z "$QUICK" ] && ! command -v povray >/dev/null 2>&1; then
+  echo "installing: povray" >&2
+  if [ "$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq povray >/dev/null
+fi
+make -s pray textures >/dev/null
+PRAY=$(pwd)/pray
+
+OUT=$(mktemp -d)
+trap 'rm -rf "$OUT"' EXIT
+$PY bench/suite/gen.py "$OUT"
+# POV-Ray reads and writes only where its I/O restrictions allow: it runs inside $OUT
+cp bench/pov/pray.inc "$OUT"
+for f in examples/*.ray; do
+  n=$(basename "$f" .ray)
+  case $n in redsphx|maketex) continue ;; esac
+  echo "gallery-$n -" >> "$OUT/scenes"
+  if [ -f "bench/pov/$n.pov" ]; then cp "bench/pov/$n.pov" "$OUT/gallery-$n.pov"; fi
+done
+mkdir "$OUT/new" "$OUT/ref" "$OUT/brute"
+
+H="$PY $(pwd)/bench/pov/helper.py"
+program() {  # the PRAY program of scene $1 (the gallery's stay where their textures are)
+  case $1 in gallery-*) echo "examples/${1#gallery-}.ray" ;; *) echo "$OUT/$1.ray" ;; esac
+}
+render() {   # render BINARY SCENE DIR [OPTIONS]: time it, "cpu wall" into $OUT/t
+  b=$1; s=$2; d=$3; shift 3
+  $H time $RUNS "$OUT/t" "$b" --quiet --threads 1 -D antialias=1 -s "${N}x$N" \
+    -o "$OUT/$d/$s.ppm" "$@" "$(program $s)"
+}
+same() {     # same SCENE DIR1 DIR2: every frame of the scene identical in both directories
+  for f in "$OUT/$2/$1.ppm" "$OUT/$2/$1"_[0-9]*.ppm; do
+    [ -f "$f" ] || continue
+    cmp -s "$f" "$OUT/$3/${f##*/}" || return 1
+  done
+}
+secs() { cut -d' ' -f1 "$OUT/t"; }
+ratio() { awk -v a="$1" -v b="$2" 'BEGIN { print (a > 0 && b > 0 ? a / b : 0) }'; }
+
+if [ -n "$QUICK" ]; then
+  echo "pray's default against --brute: ${SIZE}x$SIZE (over 20000 primitives: half), one thread; CPU seconds"
+  printf '%-18s %7s %8s %8s' scene prims pray brute
+else
+  echo "pray against POV-Ray $(povray --version 2>&1 | sed -n 's/^POV-Ray \([0-9.]*[0-9]\).*/\1/p'): ${SIZE}x$SIZE, one thread, no anti-aliasing; CPU seconds (user + system), best of $RUNS"
+  printf '%-18s %7s %8s %8s %9s' scene prims pray POV-Ray POV/pray
+fi
+[ -n "$REF" ] && printf ' %8s %9s' REF pray/REF
+echo
+bad=0
+while read -r s prims; do
+  case $s in $ONLY) ;; *) continue ;; esac
+  if [ "$prims" = - ]; then
+    $PRAY --quiet --stats --threads 1 -s 8x8 -o "$OUT/stats.ppm" "$(program $s)" >/dev/null 2>"$OUT/stats"
+    prims=$(awk '/^primitives:/ { print $2; exit }' "$OUT/stats")
+  fi
+  N=$SIZE
+  if [ -n "$QUICK" ] && [ "$prims" -gt 20000 ]; then N=$((SIZE / 2)); fi
+  render "$PRAY" $s new; t=$(secs)
+  line=$(printf '%-18s %7s %8.3f' $s "$prims" "$t")
+  if [ -n "$QUICK" ]; then
+    render "$PRAY" $s brute --brute
+    if same $s new brute; then c=""; else c="  DIFFERENT with --brute"; bad=1; fi
+    line="$line $(printf '%8.3f' "$(secs)")"
+  elif [ -f "$OUT/$s.pov" ]; then
+    (cd "$OUT" && $H time $RUNS "$OUT/t" povray "+I$s.pov" "+O$s-pov.ppm" "+W$SIZE" "+H$SIZE" \
+      -A +WT1 -D +FP File_Gamma=1.0)
+    v=$(secs)
+    line="$line $(printf '%8.3f %9.2f' "$v" "$(ratio "$v" "$t")")"
+    echo "$v $t" >> "$OUT/ratios"
+  else
+    line="$line $(printf '%8s %9s' - -)"
+  fi
+  if [ -n "$REF" ]; then
+    render "$REF" $s ref; r=$(secs)
+    line="$line $(printf '%8.3f %9.2f' "$r" "$(ratio "$t" "$r")")"
+    echo "$t $r" >> "$OUT/refratios"
+    same $s new ref || { c="$c  DIFFERENT from REF"; bad=1; }
+  fi
+  echo "$line$c"
+done < "$OUT/scenes"
+
+geomean() {  # geomean FILE LABEL: the geometric mean of the ratios $1/$2 of the file's lines
+  [ -f "$1" ] && awk -v l="$2" '$1 > 0 && $2 > 0 { s += log($1 / $2); n++ }
+    END { printf "geometric mean of %s over %d scenes: %.2f\n", l, n, exp(s / n) }' "$1"
+}
+echo
+geomean "$OUT/ratios" POV/pray || true
+geomean "$OUT/refratios" pray/REF || true
+if [ $bad != 0 ]; then echo "FAILED: some images differ" >&2; exit 1; fi
