@@ -7,6 +7,7 @@
 #   make matrix     compile pray.cpp under every configuration macro and language level, g++ and clang++
 #   make bench      the acceleration benchmarks (bench/run.sh), results in docs/benchmarks.md
 #   make pov        pray against POV-Ray 3.7 (bench/pov.sh; installs povray)
+#   make suite      the benchmark suite against POV-Ray (bench/suite/run.sh; ARGS=--quick: default == --brute)
 #   make charts     speed against accuracy and the benchmarks, drawn (bench/charts.sh), docs/images/bench-*.png
 #   make ports      build, run and compare every port (ports/check; installs cross compilers, qemu, wine)
 #   make check-bad  the catalogue of bad inputs (tests/bad/run.sh); the last step of check
@@ -34,7 +35,7 @@ TESTS = tests/pray_tests$(EXE)
 TESTS_FLOAT = tests/pray_tests_float$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
-.PHONY: FORCE all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff fuzz-long textures gallery ports pov charts
+.PHONY: FORCE all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff fuzz-long textures gallery ports pov suite charts
 
 all: $(PRAY)
 
@@ -168,6 +169,10 @@ bench: $(PRAY)
 
 pov: $(PRAY)
 	bench/pov.sh
+
+# The suite's scenes against POV-Ray (docs/benchmarks.md); ARGS=--quick checks default == --brute.
+suite: $(PRAY) textures
+	bench/suite/run.sh $(ARGS)
 
 # Time against error (undersampling, antialias, grid, float), threads, Table 3.6.1 and scaling, drawn.
 charts: $(PRAY) textures
