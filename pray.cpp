@@ -486,9 +486,9 @@ struct pray_ctx {
     pray_progress_fn progress_fn;
     void *progress_ud;
     pray_frame_fn frame_fn;
+    void *frame_ud;
     pray_write_fn warn_fn;  // pray_set_warning
     void *warn_ud;
-    void *frame_ud;
     Setup cur;       // in force now
     Setup base;      // what the host set; every run starts from it and ends back at it
     int running;     // a program is running: its settings change `cur` only
@@ -560,6 +560,18 @@ void apply_memory_cap(pray_ctx *c) {
     c->limit = cap;
 }
 
+// A block into a list of blocks (after its sentinel), and out of the list it is in.
+void block_link(Block *list, Block *b) {
+    b->prev = list;
+    b->next = list->next;
+    list->next->prev = b;
+    list->next = b;
+}
+void block_unlink(Block *b) {
+    b->prev->next = b->next;
+    b->next->prev = b->prev;
+}
+
 void *mem_alloc(pray_ctx *c, size_t n) {
     if (n > (size_t)-1 / 2) {
         fail_nomem(c);
@@ -578,10 +590,7 @@ void *mem_alloc(pray_ctx *c, size_t n) {
     }
     b->size = n;
     b->owner = c;
-    b->prev = &c->blocks;
-    b->next = c->blocks.next;
-    c->blocks.next->prev = b;
-    c->blocks.next = b;
+    block_link(&c->blocks, b);
     c->used += n + sizeof(Block);
     return b + 1;
 }
@@ -598,8 +607,7 @@ inline const pray_ctx *owner_of(const void *p) { return ((const Block *)p - 1)->
 void mem_free(pray_ctx *c, void *p) {
     if (!p) return;
     Block *b = (Block *)p - 1;
-    b->prev->next = b->next;
-    b->next->prev = b->prev;
+    block_unlink(b);
     c->used -= b->size + sizeof(Block);
     c->alloc(c->alloc_ud, b, sizeof(Block) + b->size, 0);
 }
@@ -6600,12 +6608,8 @@ __thread PngEncoding *png_now;
 
 void png_hold(PngEncoding *e, void *p) {
     Block *b = (Block *)p - 1;  // from the context's list to the encoding's
-    b->prev->next = b->next;
-    b->next->prev = b->prev;
-    b->prev = &e->held;
-    b->next = e->held.next;
-    e->held.next->prev = b;
-    e->held.next = b;
+    block_unlink(b);
+    block_link(&e->held, b);
 }
 
 pray_status write_png(pray_ctx *c, const pray_image *img, Sink &out) {
