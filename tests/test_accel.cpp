@@ -6,9 +6,11 @@
 //     scenes with fixed seeds, each probed with adversarial rays (accel_scenes.hpp: voxel faces,
 //     edges and corners, box corners, tangents, rays in faces, starting inside the grid, on box
 //     boundaries and inside solids, with tmax limits);
-//   - the same images, float for float, on example programs and on random scenes, for every
-//     grid x freeze x merge x bounds, and with each of lightbuffer, eyebuffer and shadowcache
-//     off and on;
+//   - the same images, float for float, on example programs and on random scenes: small images
+//     for every grid x freeze x merge x bounds, and images large enough that the light buffers
+//     and the eye's buffer are built for every lightbuffer x eyebuffer x shadowcache x freeze x
+//     merge x bounds (each such case checks that the buffers were built: else it would compare
+//     nothing of them);
 //   - freezing never increases the number of intersection tests;
 //   - the statistics of the grid are plausible.
 // A mismatch is a bug in the renderer: the failure message lists the first ones in full (scene
@@ -76,6 +78,20 @@ std::vector<Opts> all_combinations() {
         for (int f = 0; f < 2; f++)
             for (int m = 0; m < 2; m++)
                 for (int b = 0; b < 2; b++) v.push_back(Opts{0, GRIDS[g], f, m, b});
+    return v;
+}
+
+// lightbuffer x eyebuffer x shadowcache x freeze x merge, and x bounds or with bounds=1, at one
+// grid; the first is the defaults (all on)
+std::vector<Opts> buffer_combinations(int grid, bool with_bounds) {
+    std::vector<Opts> v;
+    for (int lb : {1, 0})
+        for (int eb : {1, 0})
+            for (int sc : {1, 0})
+                for (int f : {1, 0})
+                    for (int m : {1, 0})
+                        for (int b : {1, 0})
+                            if (b || with_bounds) v.push_back(Opts{0, grid, f, m, b, lb, eb, sc});
     return v;
 }
 
@@ -645,7 +661,7 @@ bool read_example(const std::string &name, std::string *text) {
 }
 
 // The example programs that render quickly at 48 x 48 with every grid (not redsphx.ray, which is
-// an error on purpose; room.ray, fractal.ray and cube.ray take longer).
+// an error on purpose; room.ray, fractal.ray and cube.ray are in the buffers' cases below).
 std::vector<std::pair<std::string, std::string>> example_programs() {
     static const char *names[] = {"anim.ray", "csg.ray", "glass.ray", "holes.ray", "loop.ray",
                                   "mirror.ray", "models.ray", "parallel.ray", "redsph.ray"};
@@ -1270,6 +1286,186 @@ TEST_CASE("accel eye buffer: eyebuffer=0 and 1 give the reference's image from e
     Switched par = run_switched("parallel" + field, opts, "eyebuffer");
     CHECK(par.on.stats.eyebuf_voxels == 0);
     CHECK(par.on.stats.rays_eyebuf == 0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The buffers where they are built, with everything switched: example programs and random
+// scenes, each rendered with every combination of lightbuffer x eyebuffer x shadowcache x
+// freeze x merge (x bounds for the random scenes), the same floats as --brute; freezing never
+// adds intersection tests.
+// ---------------------------------------------------------------------------------------------
+namespace {
+
+struct NetTally {
+    long renders = 0, mismatches = 0, freeze_violations = 0;
+    std::vector<std::string> problems;  // the first 30
+    void problem(const std::string &p) {
+        if (problems.size() < 30) problems.push_back(p);
+    }
+};
+
+// Renders `label` with each of `combos` (run(o) returns a Run or a Render) and compares it with
+// the reference's frames; each combination with freeze=1 against the same with freeze=0. Returns
+// the statistics of the first combination (all on, the defaults).
+template <class Fn>
+pray_stats compare_combinations(const std::string &label, const std::vector<testkit::Frame> &ref,
+                                const std::vector<Opts> &combos, Fn run, NetTally &t) {
+    pray_stats first;
+    std::memset(&first, 0, sizeof first);
+    std::map<std::string, double> tests[2];  // per freeze: by the other options
+    for (size_t i = 0; i < combos.size(); i++) {
+        const Opts &o = combos[i];
+        auto r = run(o);
+        t.renders++;
+        CHECK_MESSAGE(r.status == PRAY_OK, label << ", " << o.text() << ": " << r.error);
+        if (i == 0) first = r.stats;
+        std::string d = frame_difference(ref, r.frames);
+        if (!d.empty()) {
+            t.mismatches++;
+            t.problem(label + ", " + o.text() + ": " + d);
+        }
+        Opts k = o;
+        k.freeze = 0;
+        tests[o.freeze][k.text()] = r.stats.intersection_tests;
+    }
+    for (auto &f : tests[1]) {
+        auto u = tests[0].find(f.first);
+        if (u == tests[0].end() || f.second <= u->second) continue;
+        t.freeze_violations++;
+        char buf[120];
+        std::snprintf(buf, sizeof buf, ": %.0f intersection tests with freeze=1, %.0f with freeze=0", f.second, u->second);
+        t.problem(label + ", " + f.first + buf);
+    }
+    return first;
+}
+
+void check_net(const NetTally &t, double secs) {
+    std::string all;
+    for (auto &p : t.problems) all += "\n  - " + p;
+    MESSAGE(t.renders << " renders, " << t.mismatches << " differing images, " << t.freeze_violations
+                      << " freeze violations, " << secs << " s");
+    CHECK_MESSAGE(t.mismatches == 0, t.mismatches << " renders differ from brute=1:" << all);
+    CHECK_MESSAGE(t.freeze_violations == 0, t.freeze_violations << " cases where freezing added intersection tests:" << all);
+}
+
+// A program of the net: its name, text, and which buffers its default render must build.
+struct NetProgram {
+    std::string name, text;
+    bool light, eye;
+};
+
+// Each program at size x size with the combinations of buffer_combinations(grid, with_bounds); in
+// the first (the defaults) the buffers must have been built.
+void program_net(const std::vector<NetProgram> &programs, int size, int grid, bool with_bounds, NetTally &t) {
+    std::vector<std::string> dims = {"width=" + std::to_string(size), "height=" + std::to_string(size)};
+    for (const NetProgram &p : programs) {
+        CAPTURE(p.name);
+        std::vector<std::string> ropts = dims;
+        for (auto &o : reference().fixed()) ropts.push_back(o);
+        Run ref = run_program(p.name, p.text, ropts);
+        REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
+        REQUIRE(!ref.frames.empty());
+        CHECK(ref.frames[0].width == size);
+        pray_stats on = compare_combinations(p.name, ref.frames, buffer_combinations(grid, with_bounds), [&](const Opts &o) {
+            std::vector<std::string> opts = dims;
+            for (auto &x : o.fixed()) opts.push_back(x);
+            return run_program(p.name, p.text, opts);
+        }, t);
+        INFO("defaults: ", stats_text(on));
+        if (p.light) CHECK_MESSAGE(on.lightbuf_voxels > 0, p.name << ": (setup) no light buffer built");
+        if (p.eye) CHECK_MESSAGE(on.eyebuf_voxels > 0, p.name << ": (setup) no eye's buffer built");
+    }
+}
+
+std::vector<NetProgram> examples_of(std::initializer_list<NetProgram> list) {
+    std::vector<NetProgram> v;
+    for (NetProgram p : list)
+        if (read_example(p.name, &p.text)) v.push_back(p);
+    return v;
+}
+
+// A point light in a lamp: a shade of thin fabric (a ball minus a smaller ball minus the
+// half-space under its middle) around a bulb, over the field of spheres, all inside a room (a
+// hollow ball), so that shadow rays come to the light from every side: through the shade, and
+// through its opening. `bulb`: what the bulb lets through.
+std::string lamp_program(const char *bulb) {
+    return std::string("perspective") + FIELD_CAMERA + FIELD +
+           "Shade = transparent({0.6, 0.5, 0.4}, 1) + phong({0.5}, {0.1}, 5)\n"
+           "S = [0.2, 0.1, 0.6]\n"
+           "Lamp = sphere(Shade, S, 0.26) - sphere(Shade, S, 0.245) - plane(Shade, S, <0, 0, 1>)"
+           " | sphere(color({1}) + transparent(" + bulb + ", 1), S, 0.05)\n"
+           "Room = -sphere(phong({0.6, 0.6, 0.5}, {0}, 1), [0, 0, 0.5], 5)\n"
+           "rendertiff All | Lamp | Room, pointlight({0.8}, S)\n";
+}
+
+} // namespace
+
+// (bounds=1 only: the random scenes' case below switches it)
+TEST_CASE("accel buffers: examples at 160 x 160 on a grid of 8, where the buffers are built, every lightbuffer x "
+          "eyebuffer x shadowcache x freeze x merge: the same floats as --brute; freezing never adds tests") {
+    auto t0 = std::chrono::steady_clock::now();
+    // (room.ray: its eye is amid the grid, whose buffer would have too many voxels for this
+    // image; parallel.ray: a parallel camera has no eye's buffer; anim.ray: three frames)
+    std::vector<NetProgram> programs = examples_of({{"room.ray", "", true, false},
+                                                    {"fractal.ray", "", true, true},
+                                                    {"glass.ray", "", true, true},
+                                                    {"cube.ray", "", true, true},
+                                                    {"csg.ray", "", true, true},
+                                                    {"holes.ray", "", true, true},
+                                                    {"mirror.ray", "", true, true},
+                                                    {"models.ray", "", true, true},
+                                                    {"anim.ray", "", true, true},
+                                                    {"parallel.ray", "", true, false}});
+    programs.push_back({"lamp (clear bulb)", lamp_program("{1}"), true, true});
+    programs.push_back({"lamp (dim bulb)", lamp_program("{0.97}"), true, true});
+    programs.push_back({"field", std::string("perspective") + FIELD_CAMERA + FIELD +
+                                     "rendertiff All, dirlight({0.7}, <1, 2, -3>), pointlight({0.5}, [0.5, 0.5, 3])\n",
+                        true, true});
+    NetTally t;
+    program_net(programs, 160, 8, false, t);
+    check_net(t, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+}
+
+// (the automatic grid is finer for larger images: these sizes are the smallest where it builds
+// both buffers of these programs)
+TEST_CASE("accel buffers: examples at 384 and 512 pixels square with the automatic grid, where the buffers are "
+          "built, every lightbuffer x eyebuffer x shadowcache x freeze x merge: the same floats as --brute") {
+    auto t0 = std::chrono::steady_clock::now();
+    NetTally t;
+    program_net(examples_of({{"cube.ray", "", true, true}}), 384, -1, false, t);
+    program_net(examples_of({{"fractal.ray", "", true, true}, {"csg.ray", "", true, true}}), 512, -1, false, t);
+    check_net(t, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+}
+
+TEST_CASE("accel buffers: random scenes at 128 x 128 under the sun and lamps outside, inside the grid's box and amid "
+          "the objects, every lightbuffer x eyebuffer x shadowcache x freeze x merge x bounds: the same floats as --brute") {
+    const Pick picks[] = {{K_RANDOM, 5},  {K_RANDOM, 42}, {K_RANDOM, 77}, {K_MANY, 2},  {K_MANY, 7},   {K_LATTICE, 4},
+                          {K_BLOCKS, 7},  {K_BLOCKS, 12}, {K_FLOOR, 3},   {K_FLOOR, 9}, {K_SCALED, 2}, {K_SCALED, 6}};
+    auto t0 = std::chrono::steady_clock::now();
+    NetTally t;
+    pray_rgb w = {0.6, 0.6, 0.6}, w2 = {0.5, 0.4, 0.3};
+    each_pick(picks, [&](pray_ctx *c, const Scene &s) {
+        pray_vec lo = s.lo, hi = s.hi, mid = mul(add(lo, hi), 0.5), ext = sub(hi, lo);
+        double big = std::max(ext.x, std::max(ext.y, ext.z));
+        pray_light *lights = pray_light_add(
+            c, pray_light_add(c, pray_dirlight(c, w, V(1, 2, -3)), pray_pointlight(c, w2, add(hi, ext))),
+            pray_light_add(c, pray_pointlight(c, w2, add(lo, mul(ext, 0.3))), pray_pointlight(c, w2, mid)));
+        REQUIRE(lights);
+        // the eye outside the grid's box, looking at its centre
+        pray_vec eye = add(mid, V(0.3 * big, -2.5 * big, 0.8 * big)), look = sub(mid, eye);
+        pray_vec x = mul(unit(cross(look, V(0, 0, 1))), 0.6 * big);
+        pray_vec y = mul(unit(cross(look, x)), 0.6 * big);
+        REQUIRE(pray_perspective(c, x, y, eye, mid) == PRAY_OK);
+        Render ref = render(c, s.root, lights, reference(), 128);
+        REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
+        pray_stats on = compare_combinations(s.label, ref.frames, buffer_combinations(5, true), [&](const Opts &o) {
+            return render(c, s.root, lights, o, 128);
+        }, t);
+        INFO("defaults: ", stats_text(on));
+        CHECK_MESSAGE(on.lightbuf_voxels > 0, "(setup) no light buffer built");
+        CHECK_MESSAGE(on.eyebuf_voxels > 0, "(setup) no eye's buffer built");
+    });
+    check_net(t, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 }
 
 TEST_CASE("accel hits: degenerate roots (nothing, one, complements, a lone primitive) with every combination") {
