@@ -27,7 +27,7 @@ OPT      ?= -O3 -fno-math-errno
 WARN     := -Wall -Wextra -pedantic
 override CXXFLAGS := $(OPT) $(WARN) -fno-exceptions -fno-rtti $(CXXFLAGS)
 LDLIBS   ?= -lm
-TESTFLAGS = -std=c++17 -O1 -g -Wall -Wextra
+TESTFLAGS = -std=c++17 -O1 -g -Wall -Wextra -DPRAY_CHECKS
 PACKAGES  = doctest-dev libstb-dev python3 python3-pil libtiff-tools
 
 PRAY  = pray$(EXE)

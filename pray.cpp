@@ -11,6 +11,9 @@
    [SECTION] 8  Ray/primitive intersection
    [SECTION] 9  CSG status-tree sweep (the brute-force reference, thesis 3.4)
    [SECTION] 9b Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
+                [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas and
+                jumps, [9b.4] light and eye buffers, [9b.5] accel_build; per ray: [9b.6] list
+                evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver
    [SECTION] 9c Reading files (programs, textures, fonts), TIFF reader and textures, the built-in font
    [SECTION] 10 Whitted shading, textured surfaces, the render driver (threads, undersampling)
    [SECTION] 11 Image writers: TIFF, PPM, PNG; writing files safely; public functions
@@ -55,7 +58,7 @@
 #include <string.h>
 #include <time.h>
 
-#if PRAY_VERSION_MAJOR != 0 || PRAY_VERSION_MINOR != 1
+#if PRAY_VERSION_MAJOR != 0 || PRAY_VERSION_MINOR != 2
 #error "pray.cpp and pray.hpp are from different versions"
 #endif
 
@@ -67,6 +70,17 @@
 #endif
 #ifndef PRAY_TEMP_SUFFIX
 #define PRAY_TEMP_SUFFIX ".tmp"
+#endif
+
+// Invariants that only end-to-end tests would otherwise catch are stated with PRAY_ASSERT. They
+// are checked when PRAY_CHECKS is defined (the tests' builds) and cost nothing otherwise; a host
+// may define PRAY_ASSERT(x) itself to report a failure its own way.
+#ifndef PRAY_ASSERT
+#ifdef PRAY_CHECKS
+#define PRAY_ASSERT(x) ((x) ? (void)0 : pray_assert_failed(__FILE__, __LINE__, #x))
+#else
+#define PRAY_ASSERT(x) ((void)0)
+#endif
 #endif
 
 #ifdef PRAY_NO_INTERP
@@ -164,6 +178,18 @@ typedef PRAY_REAL real;
 #endif
 #define PRAY_STRINGIFY2(x) #x
 #define PRAY_STRINGIFY(x) PRAY_STRINGIFY2(x)
+
+#ifdef PRAY_CHECKS
+// A broken invariant (PRAY_ASSERT): say where, and stop.
+void pray_assert_failed(const char *file, int line, const char *what) {
+#if PRAY_HAS_STDIO
+    fprintf(stderr, "%s:%d: invariant broken: %s\n", file, line, what);
+#else
+    (void)file, (void)line, (void)what;
+#endif
+    abort();
+}
+#endif
 
 // Wall-clock seconds, for statistics only.
 double clock_seconds() {
@@ -1512,6 +1538,13 @@ inline R3 unit(R3 a) {
 // Element codes of the flattened tree: primitive i is 2i, node j is 2j+1; two constants stand
 // for a subtree that folded to all of space or to nothing.
 const real REAL_BIG = (real)HUGE_VAL;
+
+// The relative rounding of `real` (one unit in the last place of 1).
+const double REAL_EPS = sizeof(real) == sizeof(float) ? FLT_EPSILON : DBL_EPSILON;
+// The snapping tolerance: values this many units in the last place apart (of the largest
+// magnitude involved) differ by rounding, not by design. Coincident surfaces within it are made
+// identical (snap_coincident), and a box is widened by as much to hold its solid after rounding.
+const double SNAP_ULPS = 8;
 const int E_ALL = -1;
 const int E_NONE = -2;
 inline bool e_is_node(int e) { return (e & 1) != 0; }
@@ -1643,10 +1676,9 @@ real comp(R3 v, int i) { return i == 0 ? v.x : i == 1 ? v.y : v.z; }
 // A box must contain its solid also after rounding in `real`: widen finite sides by a few units
 // in the last place of the largest coordinate involved.
 void box_pad(Box *b, double scale) {
-    const double eps = sizeof(real) == sizeof(float) ? FLT_EPSILON : DBL_EPSILON;
     for (int i = 0; i < 3; i++) {
         double m = fabs((double)b->lo[i]) > fabs((double)b->hi[i]) ? fabs((double)b->lo[i]) : fabs((double)b->hi[i]);
-        double pad = 8 * eps * (m + scale);
+        double pad = SNAP_ULPS * REAL_EPS * (m + scale);
         if (b->lo[i] > -REAL_BIG) b->lo[i] = (real)((double)b->lo[i] - pad);
         if (b->hi[i] < REAL_BIG) b->hi[i] = (real)((double)b->hi[i] + pad);
     }
@@ -1738,7 +1770,7 @@ void polyhedron_box(const Scene *s, const int *kids, int n, Box *b) {
                 }
             }
     if (!found) return;  // numerically empty: keep the plain box, never fold on this evidence
-    const double rel = sizeof(real) == sizeof(float) ? 64 * FLT_EPSILON : 1e-9;
+    const double rel = sizeof(real) == sizeof(float) ? 64 * REAL_EPS : 1e-9;
     for (int l = 0; l < 3; l++) {
         double pad = rel * (fabs(lo[l]) + fabs(hi[l]) + 1);
         // (a float build keeps a side that float cannot hold)
@@ -1940,7 +1972,6 @@ void snap_key(const Prim &q, SnapKey *k) {
 
 // Within a few units in the last place of the largest coordinate involved: rounding, not design.
 bool snap_close(const Prim &a, const Prim &b, int sa, int sb) {
-    const double eps = sizeof(real) == sizeof(float) ? FLT_EPSILON : DBL_EPSILON;
     double m = 0;
     const Prim *both[2] = {&a, &b};
     for (int k = 0; k < 2; k++) {
@@ -1949,14 +1980,14 @@ bool snap_close(const Prim &a, const Prim &b, int sa, int sb) {
         for (int i = 0; i < 5; i++)
             if (fabs(v[i]) > m) m = fabs(v[i]);
     }
-    double tol = 8 * eps * m;
+    double tol = SNAP_ULPS * REAL_EPS * m;
     R3 na = a.n * (real)sa, nb = b.n * (real)sb;
     R3 dp = a.p - b.p;
     if (a.kind == O_SPHERE)
         return fabs((double)dp.x) <= tol && fabs((double)dp.y) <= tol && fabs((double)dp.z) <= tol &&
                fabs((double)(a.r - b.r)) <= tol;
     R3 dn = na - nb;
-    const double ntol = 8 * eps;
+    const double ntol = SNAP_ULPS * REAL_EPS;
     if (fabs((double)dn.x) > ntol || fabs((double)dn.y) > ntol || fabs((double)dn.z) > ntol) return false;
     if (a.kind == O_PLANE) return fabs((double)(a.d * (real)sa - b.d * (real)sb)) <= tol;
     R3 perp = dp - na * dot(dp, na);  // axes: the same line within tolerance
@@ -2008,7 +2039,6 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
         mem_free(c, scale);
         return c->status;
     }
-    const double eps = sizeof(real) == sizeof(float) ? FLT_EPSILON : DBL_EPSILON;
     for (int i = 0; i < n; i++) {
         k[i].prim = i;
         snap_key(s->prims[i], &k[i]);
@@ -2029,7 +2059,7 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
                 // normals and axes are unit vectors: absolute; positions relative to their scale
                 bool unit = a.kind != (double)O_SPHERE && comp <= 3;
                 double m = scale[a.prim] > scale[o[j].prim] ? scale[a.prim] : scale[o[j].prim];
-                if (o[j].v - a.v > (unit ? 8 * eps : 8 * eps * m)) break;
+                if (o[j].v - a.v > SNAP_ULPS * REAL_EPS * (unit ? 1 : m)) break;
                 k[o[j].prim].v[comp] = a.v;
             }
             i = j;
@@ -2254,7 +2284,6 @@ struct Counters {
     double tests;
     double steps, moves, set_in, set_out, checks, frozen;
     double lbuf;  // shadow rays answered by a light buffer
-    double core;  // shadow rays that ended in a light's core
     double ebuf;  // primary rays answered by the eye's buffer
     double cache; // shadow rays answered by the shadow cache
 };
@@ -2273,6 +2302,7 @@ struct Hull {
     int enter;    // 0: that member is a half-space turned inside out (the ray leaves the half-space)
     int tie;      // two members entered at that same t
     int need, have;  // the flat sweep: its members, and those the ray is in
+    int fixed;    // its node's status is fixed for the ray: 1 outside, 2 inside (plan_fixed)
 };
 
 struct Scratch {
@@ -2510,6 +2540,16 @@ struct ShadowHit {
 // =============================================================================================
 // [SECTION] 9b Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
 // =============================================================================================
+// Building (once per scene) and tracing (per ray) are apart:
+//   [9b.1] The structure: classes, action lists, the grid, light buffers; lookups both use
+//   [9b.2] Building: action lists, plans, the region-to-list builder
+//   [9b.3] Building: the grid, areas and jumps
+//   [9b.4] Building: light buffers and the eye's buffer
+//   [9b.5] Building: the whole structure (accel_build)
+//   [9b.6] Per ray: list evaluation with freezing (the one list evaluator)
+//   [9b.7] Per ray: stretch sources (grid walk, light buffer voxel, eye buffer cell)
+//   [9b.8] Per ray: the ray driver, the shadow cache, the entry points
+// ---- [9b.1] The structure: classes, action lists, the grid, light buffers; lookups both use ----
 // Classes of a node against a region of space (thesis 3.4).
 enum { CL_OUT = 0, CL_IN = 1, CL_BD = 2 };
 
@@ -2541,15 +2581,6 @@ struct LightBuf {
     // end); then the runs, each a list and the slab where it ends, in order from the eye. A cell
     // whose primary rays walk the grid has one run of list -1.
     int *runs, nruns;
-    // A point light's core: a box of voxels around the light with one small list (light_core).
-    // A shadow ray not answered by a voxel's list walks the grid only to the core, then
-    // evaluates the core's list.
-    real core_lo[3], core_hi[3];
-    int core;  // the core's list; -1: none
-    // The core divided by direction (core_cells): per face and cell, the list of the pyramid from
-    // the light to the core's side.
-    LightFace cf[6];
-    int *cells;
 };
 
 // An action list, stored in Accel::data at off[L]:
@@ -2572,7 +2603,6 @@ struct Accel {
     Array<int> data, off;
     Array<int> plan_at;  // per list: where its plan starts in `plan`, -1 when it has none (list_plan)
     Array<int> plan;
-    Array<unsigned char> clear;  // per list: all its surfaces let all light through (list_passes)
     int outer;         // list of the space outside the grid (everything without a grid)
     int freeze, merge, bounds;
     int cache;              // option shadowcache
@@ -2591,11 +2621,9 @@ void accel_release(pray_ctx *c, Accel *a) {
     a->off.release(c);
     a->plan_at.release(c);
     a->plan.release(c);
-    a->clear.release(c);
     for (int i = 0; a->lbuf && i <= a->nlbuf; i++) {
         mem_free(c, a->lbuf[i].list);
         mem_free(c, a->lbuf[i].runs);
-        mem_free(c, a->lbuf[i].cells);
     }
     mem_free(c, a->lbuf);
     mem_free(c, a);
@@ -2620,6 +2648,36 @@ void voxels_box(const Accel *a, const int *i0, const int *i1, double margin, rea
     }
 }
 
+// The face of a point light's buffer that holds direction m (from the light): its largest
+// component's axis and sign.
+inline int cube_face(R3 m) {
+    real ax = m.x < 0 ? -m.x : m.x, ay = m.y < 0 ? -m.y : m.y, az = m.z < 0 ? -m.z : m.z;
+    int a = ax >= ay && ax >= az ? 0 : ay >= az ? 1 : 2;
+    return 2 * a + (comp(m, a) < 0);
+}
+
+// A point light's zones (and the eye's) are widened by this share of a cell, and a point is
+// looked up in the cells widened by as much: so a point rounded just past a cell's edge (u = 1
+// in one face, -1 in the next) still belongs to the cell it is given.
+const real CELL_SLACK = (real)0.25;
+
+// The cell of face F at (u, v) (a point light's u and v are over w), the face's cells widened
+// by `slack` cells and clamped: 1 and *cell set; 0 when (u, v) is beside the cells; -1 when not
+// a number.
+inline int face_cell(const LightFace &F, real u, real v, real slack, int *cell) {
+    real g[2] = {u, v};
+    int i[2];
+    for (int l = 0; l < 2; l++) {
+        real k = (g[l] - F.lo[l]) * F.inv[l];
+        if (k != k) return -1;
+        if (!(k >= -slack && k < (real)F.n[l] + slack)) return 0;
+        i[l] = k < 0 ? 0 : k < (real)F.n[l] ? (int)k : F.n[l] - 1;
+    }
+    *cell = i[1] * F.n[0] + i[0];
+    return 1;
+}
+
+// ---- [9b.2] Building: action lists, plans, the region-to-list builder ----
 // Class of a primitive against a closed box.
 int classify_prim(const Prim &q, const real *lo, const real *hi) {
     real cen[3], half[3];
@@ -2680,6 +2738,8 @@ struct ListBuilder {
     unsigned char *first_cls, *cls;  // per node: class of the first child; class (by code)
     int *head, *next;      // per node: touched children (a list through `next`, by code)
     Array<int> touched, out, hash;
+    Array<int> rprims;           // lb_region: the region's primitives ...
+    Array<unsigned char> rcls;   // ... and their classes there
 };
 
 int elem_parent(const Scene *s, int e) {
@@ -2718,6 +2778,8 @@ bool lb_init(ListBuilder &b, pray_ctx *c, const Scene *s, Accel *a) {
     b.touched.init();
     b.out.init();
     b.hash.init();
+    b.rprims.init();
+    b.rcls.init();
     if (!b.dflt || !b.cls || !b.next || !b.base_in || !b.mark || !b.acc_in || !b.acc_bd || !b.first_cls || !b.head)
         return false;
     for (int j = 0; j < s->nodes.n; j++) {  // children before parents
@@ -2748,6 +2810,8 @@ void lb_release(ListBuilder &b) {
     b.touched.release(c);
     b.out.release(c);
     b.hash.release(c);
+    b.rprims.release(c);
+    b.rcls.release(c);
 }
 
 int int_cmp(const void *pa, const void *pb) {
@@ -2888,28 +2952,62 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
     return lb_store(b);
 }
 
+// The primitives of a region and their classes there, into b.rprims and b.rcls, for lb_list:
+// each candidate classed by `cl` (a functor, by primitive), those outside left out. Every region
+// that gets a list (a voxel, a light buffer's zone, the space around the grid) is gathered
+// here. False when out of memory.
+template <class Classify>
+bool lb_region(ListBuilder &b, const int *cand, int n, const Classify &cl) {
+    b.rprims.n = b.rcls.n = 0;
+    for (int k = 0; k < n; k++) {
+        int x = cl(cand[k]);
+        if (x != CL_OUT && !(b.rprims.push(b.c, cand[k]) && b.rcls.push(b.c, (unsigned char)x))) return false;
+    }
+    return true;
+}
+
+// Classes in a closed box (a voxel, widened by the margin).
+struct BoxClass {
+    const Scene *s;
+    real lo[3], hi[3];
+    int operator()(int i) const { return classify_prim(s->prims[i], lo, hi); }
+};
+
+// Classes in the space around the grid's box (or everywhere without a grid): a primitive that
+// reaches outside the box's inside is on the boundary there, any other outside.
+struct OuterClass {
+    const Accel *a;
+    const Box *eff;  // where bounds place each primitive
+    int operator()(int i) const {
+        const Box &bx = eff[i];
+        if (box_empty(bx)) return CL_OUT;
+        bool inside = a->n[0] > 0;
+        for (int l = 0; l < 3 && inside; l++) inside = bx.lo[l] > a->org[l] && bx.hi[l] < a->top[l];
+        return inside ? CL_OUT : CL_BD;
+    }
+};
+
 // A list has a plan when its root, in the list's region, is a union of solids, each a primitive
-// or an intersection of members, any of them turned inside out (eval_flat); a member is a
-// primitive or a group: a union of primitives (a wall with a window: the wall's block minus the
-// opening's box, which turned inside out is a union). It is plain when
+// or an intersection of primitives, any of them turned inside out (eval_flat). It is plain when
 // only half-spaces are turned inside out: then a ray enters and leaves each solid once (boxes,
-// slabs, capped cylinders, a wall: the inside of a room's box taken from a solid block); else
-// it is holed (a shell: a ball minus a smaller ball). Each primitive is followed up to the root.
-// A node with one active child passes it on, turned inside out by a complement, or by a
-// difference when the child is not the first (the first child is then inside for the whole
-// region: an active node is on its boundary). A node with more is a union or an intersection (a
-// difference: its first child and the others turned inside out), the one turned into the other
-// by an odd number of inversions above it. An intersection right under the unions starts a
-// solid, which the intersections under it join; a union under it starts a group, which the
-// unions under it join; an intersection may not stand under a group. A solid with a group is
-// holed. Appends to `plan` the number of solids, 1 when holed, the number of groups; per
-// primitive of the list, (solid + 1) * 2 + (1 when turned inside out), solid -1 standing alone;
-// when there are groups, per primitive its group or -1, then per group its solid. Returns where
-// that starts, or -1 (appending nothing) when the list has no plan, -2 when out of memory.
-// `kids`, `solid`: per node scratch, 0 and -1 on entry and left so (a group's node keeps its
-// group in `solid`).
+// slabs, capped cylinders, the inside of a room's box taken from a solid block); else it is
+// holed (a shell: a ball minus a smaller ball). Each primitive is followed up to the root. A node
+// with one active child passes it on, turned inside out by a complement, or by a difference when
+// the child is not the first (the first child is then inside for the whole region: an active
+// node is on its boundary). A node with more is a union or an intersection (a difference: its
+// first child and the others turned inside out), the one turned into the other by an odd number
+// of inversions above it. An intersection right under the unions starts a solid, which the
+// intersections under it join; a union under a solid leaves the list without a plan.
+// Appends to `plan` the number of solids and 1 when holed; per primitive of the list,
+// (solid + 1) * 4 + (2 when decisive) + (1 when turned inside out), solid -1 standing alone (a
+// member is decisive when its being outside for good fixes its solid: fix_solid); per solid, its
+// node and
+// 1 when it is turned inside out above that node (the solid's inside is then the node's outside:
+// a node's status fixed for the ray fixes its solid's, plan_fixed). Returns where that starts,
+// or -1 (appending nothing) when the list has no plan, -2 when out of memory. `kids`, `solid`:
+// per node scratch, 0 and -1 on entry and left so.
 const int PLAN_DEPTH = 64;  // deeper trees are evaluated in full
-const int PLAN_HEAD = 3;    // a plan's numbers before the primitives'
+const int PLAN_HEAD = 2;    // a plan's numbers before the primitives'
 
 int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, Array<int> *plan) {
     int na = d[0], np = d[1];
@@ -2918,12 +3016,11 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
         if (s->nodes[nodes[3 * i]].parent >= 0) kids[s->nodes[nodes[3 * i]].parent]++;
     for (int i = 0; i < np; i++)
         if (s->prims[prims[i]].parent >= 0) kids[s->prims[prims[i]].parent]++;
-    int base = plan->n, ns = 0, ng = 0;
+    int base = plan->n, ns = 0;
     bool holed = false;
-    Array<int> group, gsolid;  // per primitive, per group
-    group.init();
-    gsolid.init();
-    bool mem = np == 0 || (plan->push(c, 0) && plan->push(c, 0) && plan->push(c, 0)), ok = np > 0 && mem;
+    Array<int> solids;  // per solid: its node, inverted above it
+    solids.init();
+    bool mem = np == 0 || (plan->push(c, 0) && plan->push(c, 0)), ok = np > 0 && mem;
     for (int i = 0; ok && i < np; i++) {
         int path[PLAN_DEPTH], n = 0;  // the ancestors, the root last
         for (int p = s->prims[prims[i]].parent; ok && p >= 0; p = s->nodes[p].parent) {
@@ -2931,43 +3028,48 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
             if (ok) path[n++] = p;
         }
         bool inv = false;
-        int k = -1, g = -1;  // the solid, -1 while under unions only; the group
+        int k = -1;  // the solid, -1 while under unions only
         for (int m = n - 1; ok && m >= 0; m--) {
             int j = path[m];
             const Node &nd = s->nodes[j];
             int child = m > 0 ? 2 * path[m - 1] + 1 : 2 * prims[i];
-            bool first = elem_first(s, child);
             if (kids[j] > 1) {
                 bool inter = (nd.op != O_UNION) != inv;
-                ok = !(inter && g >= 0);
+                ok = inter || k < 0;
                 if (inter && k < 0) {
-                    if (solid[j] < 0) solid[j] = ns++;
-                    k = solid[j];
-                } else if (!inter && k >= 0 && g < 0) {
                     if (solid[j] < 0) {
-                        solid[j] = ng++;
-                        mem = gsolid.push(c, k);
+                        solid[j] = ns++;
+                        mem = solids.push(c, j) && solids.push(c, inv);
                         ok = ok && mem;
                     }
-                    g = solid[j];
+                    k = solid[j];
                 }
             }
-            if (nd.op == O_COMPL || (nd.op == O_DIFF && !first)) inv = !inv;
+            if (nd.op == O_COMPL || (nd.op == O_DIFF && !elem_first(s, child))) inv = !inv;
         }
         holed = holed || (inv && s->prims[prims[i]].kind != O_PLANE);
-        mem = !ok || (plan->push(c, (k + 1) * 2 + inv) && group.push(c, g));
+        // decisive: the member outside for good fixes its solid's node for good, as settling
+        // would (not when it stands under a node whose other children, constant in this region,
+        // may change along the ray, such as a union)
+        bool decisive = k >= 0;
+        for (int m = 0, e = 2 * prims[i], v = inv; decisive; m++) {
+            const Node &nd = s->nodes[path[m]];
+            bool first = elem_first(s, e);
+            int fix = nd.op == O_UNION ? (v ? 1 : -1) : nd.op == O_INTER ? (v ? -1 : 0)
+                    : nd.op == O_DIFF ? ((first ? !v : v) ? 0 : -1) : !v;
+            decisive = fix >= 0;
+            if (path[m] == solids[2 * k]) break;
+            v = fix;
+            e = 2 * path[m] + 1;
+        }
+        mem = !ok || plan->push(c, (k + 1) * 4 + decisive * 2 + inv);
         ok = ok && mem;
     }
-    for (int i = 0; ok && ng > 0 && i < np; i++) {
-        mem = plan->push(c, group[i]);
+    for (int i = 0; ok && i < solids.n; i++) {
+        mem = plan->push(c, solids[i]);
         ok = mem;
     }
-    for (int i = 0; ok && i < ng; i++) {
-        mem = plan->push(c, gsolid[i]);
-        ok = mem;
-    }
-    group.release(c);
-    gsolid.release(c);
+    solids.release(c);
     for (int i = 0; i < na; i++) {
         int j = nodes[3 * i];
         solid[j] = -1;
@@ -2978,31 +3080,14 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
         return mem ? -1 : -2;
     }
     plan->p[base] = ns;
-    plan->p[base + 1] = holed || ng > 0;
-    plan->p[base + 2] = ng;
+    plan->p[base + 1] = holed;
     return base;
 }
-
-// Whether every primitive of list d is of one colour and lets all light through: a shadow ray
-// crosses it unchanged, whatever surfaces of it are visible (a lamp's clear bulb).
-bool list_clear(const Scene *s, const int *d) {
-    const int *prims = list_prims(d);
-    for (int i = 0; i < d[1]; i++) {
-        const pray_model *m = s->prims[prims[i]].mat;
-        if (m->kind != M_FLAT || m->transmit.r != 1 || m->transmit.g != 1 || m->transmit.b != 1) return false;
-    }
-    return true;
-}
-
-// Lists a visitor may pass over: none in general; a shadow ray's, those that are clear
-// (list_clear: each factor would be exactly 1).
-template <class Visit>
-inline bool list_passes(const Accel *, int, const Visit &) { return false; }
-inline bool list_passes(const Accel *A, int L, const ShadowHit &) { return A->clear[L] != 0; }
 
 // A plain list: one with a plan and no holes (list_plan).
 inline bool list_plain(const Accel *A, int L) { return A->plan_at[L] >= 0 && !A->plan.p[A->plan_at[L] + 1]; }
 
+// ---- [9b.3] Building: the grid, areas and jumps ----
 // Voxels along the longest axis when the grid option is automatic. Measured on the benchmark
 // scenes (docs/benchmarks.md): about 4 voxels per primitive plus a floor of 4096 voxels is near
 // the best for CSG scenes of 200 to 1000 primitives; the building cost grows with the voxels, so
@@ -3090,7 +3175,8 @@ bool reach_build(pray_ctx *c, Accel *a) {
     return ok;
 }
 
-// ---- light buffers (Haines and Greenberg's light buffer, in the survey [Woo90]) ----
+// ---- [9b.4] Building: light buffers and the eye's buffer ----
+// (Haines and Greenberg's light buffer, in the survey [Woo90].)
 // A shadow ray runs from a surface point to its light. Around each light the directions are
 // cut into cells (across a directional light: columns), and each cell into slabs by distance
 // from the light; a voxel of this light-space grid keeps the action list of its zone, the part
@@ -3183,77 +3269,25 @@ int classify_zone(const Prim &q, const Box &bx, const Zone &z) {
     return in ? CL_IN : CL_BD;
 }
 
-// The face of a point light's buffer that holds direction m (from the light): its largest
-// component's axis and sign.
-inline int cube_face(R3 m) {
-    real ax = m.x < 0 ? -m.x : m.x, ay = m.y < 0 ? -m.y : m.y, az = m.z < 0 ? -m.z : m.z;
-    int a = ax >= ay && ax >= az ? 0 : ay >= az ? 1 : 2;
-    return 2 * a + (comp(m, a) < 0);
-}
-
-// A point light's zones (and the eye's) are widened by this share of a cell, and a point is
-// looked up in the cells widened by as much: so a point rounded just past a cell's edge (u = 1
-// in one face, -1 in the next) still belongs to the cell it is given.
-const real CELL_SLACK = (real)0.25;
+// Classes in a zone of a light buffer, for primitives whose depths (key: per primitive, the
+// least and the most w of its box) meet the zone's [w0, w1].
+struct ZoneClass {
+    const Scene *s;
+    const Box *eff;  // where bounds place each primitive
+    const real *key;
+    real w0, w1;
+    Zone z;
+    int operator()(int i) const {
+        if (!(key[2 * i] <= w1 && key[2 * i + 1] >= w0)) return CL_OUT;
+        return classify_zone(s->prims[i], eff[i], z);
+    }
+};
 
 // Near a point light, where that widening is less than the rounding of a point, a ball around
 // the light of this radius joins every zone (`eps`: the widening in u and v).
 inline real tip_ball(real margin, real eps) {
     real r = margin * (real)2.6 / eps;
     return r > margin ? r : margin;
-}
-
-// The cell of face F at (u, v) (a point light's u and v are over w), the face's cells widened
-// by `slack` cells and clamped: 1 and *cell set; 0 when (u, v) is beside the cells; -1 when not
-// a number.
-inline int face_cell(const LightFace &F, real u, real v, real slack, int *cell) {
-    real g[2] = {u, v};
-    int i[2];
-    for (int l = 0; l < 2; l++) {
-        real k = (g[l] - F.lo[l]) * F.inv[l];
-        if (k != k) return -1;
-        if (!(k >= -slack && k < (real)F.n[l] + slack)) return 0;
-        i[l] = k < 0 ? 0 : k < (real)F.n[l] ? (int)k : F.n[l] - 1;
-    }
-    *cell = i[1] * F.n[0] + i[0];
-    return 1;
-}
-
-// The list for a shadow ray from x towards the buffer's light, and the part (*ta, *tb] of the
-// ray in that list's zone; before and after it the ray is outside the grid's box, where the
-// outer list holds. `outer` alone when the ray misses the grid's box; -1 when x is in no voxel's
-// reach (then the grid is walked).
-inline int lightbuf_find(const LightBuf &B, int outer, R3 x, real tmax, real *ta, real *tb) {
-    if (B.faces == 0) return -1;
-    R3 m = x - B.o;
-    const LightFace &F = B.f[B.point ? cube_face(m) : 0];
-    real g[3] = {dot(m, F.e[0]), dot(m, F.e[1]), dot(m, F.e[2])};
-    *ta = 0;
-    *tb = tmax;
-    if (B.point) {
-        if (!(g[2] > 0)) return -1;  // at the light, or not a number
-        if (F.n[2] == 0) return outer;
-        real k = (real)1 / g[2];
-        g[0] *= k;
-        g[1] *= k;
-    }
-    // (a point light's zones are widened: CELL_SLACK)
-    int cell, in = face_cell(F, g[0], g[1], B.point ? CELL_SLACK : 0, &cell);
-    if (in <= 0) return in < 0 ? -1 : outer;  // not a number; beside the grid's box
-    real k = (g[2] - F.lo[2]) * F.inv[2];
-    if (k != k) return -1;
-    int slab;
-    if (!B.point) {  // w grows towards the light
-        if (!(k < (real)F.n[2])) return outer;  // past the box already
-        *tb = B.top - g[2];
-        slab = k < 0 ? 0 : (int)k;
-        if (k < 0) *ta = F.lo[2] - g[2];  // below the box: reaches it there
-    } else {         // w shrinks towards the light
-        if (k < 0) return outer;  // between the light and the box
-        slab = k < (real)F.n[2] ? (int)k : F.n[2] - 1;
-        if (!(k < (real)F.n[2])) *ta = tmax * ((real)1 - (F.lo[2] + (real)F.n[2] * F.h[2]) / g[2]);  // beyond it
-    }
-    return B.list[F.base + slab * F.n[1] * F.n[0] + cell];
 }
 
 // The zone of voxel (iu, iv, k) of face F, widened by the margin (a point light's cells by
@@ -3389,13 +3423,6 @@ bool eye_runs(pray_ctx *c, LightBuf &B, int cells) {
 // were even, and at 1024 x 1024 they save a fifth.
 const int RAYS_PER_VOXEL = 8;
 
-// A point light's core reaches at most LB_CORE voxels beyond the light's on each side, and holds
-// at most LB_CORE_PRIMS primitives, or as many as the light's voxel. (A ray evaluates only its
-// cell's part of the core's list, so the whole list may be longer than a voxel's: in the Room,
-// 12 instead of 8 lets the lamps' cores reach 4 and 3 voxels instead of 2, and saves a tenth of
-// the voxel steps.)
-const int LB_CORE = 8, LB_CORE_PRIMS = 12;
-
 // Face fi of a point light's cube of directions: e[2] along axis fi / 2, away from the light
 // (towards -1 for odd fi), e[0] and e[1] the next two axes.
 void point_face(int fi, LightFace *F) {
@@ -3407,121 +3434,8 @@ void point_face(int fi, LightFace *F) {
     F->e[1] = unitv[(ax + 2) % 3];
 }
 
-// A point light's core is divided by direction like a light buffer's faces, into CORE_CELLS x
-// CORE_CELLS cells per face, one slab deep: the pyramid of each cell from the light to the
-// core's side gets its own list, which holds only what that pyramid meets. A lamp's shadow ray
-// from below then leaves out the shade above the light.
-const int CORE_CELLS = 16;
-
-// The lists of the cells of B's core (LightBuf::cells): of the primitives that meet the core's
-// box, those that meet the cell's pyramid. `cand`, `prims`, `cls`: scratch.
-bool core_cells(ListBuilder &b, const Box *eff, real margin, LightBuf &B, Array<int> &cand, Array<int> &prims,
-                Array<unsigned char> &cls) {
-    const Scene *s = b.s;
-    const int per = CORE_CELLS * CORE_CELLS;
-    B.cells = (int *)mem_alloc(b.c, sizeof(int) * 6 * per);
-    if (!B.cells) return false;
-    Box core;
-    for (int l = 0; l < 3; l++) core.lo[l] = B.core_lo[l], core.hi[l] = B.core_hi[l];
-    // the candidates, each followed by its class in the core's box
-    cand.n = 0;
-    for (int i = 0; i < s->prims.n; i++)
-        if (box_overlap(eff[i], core) &&
-            !(cand.push(b.c, i) && cand.push(b.c, classify_prim(s->prims[i], core.lo, core.hi))))
-            return false;
-    // the cells widened, and the ball that takes over near the light
-    real eps = (real)2 / CORE_CELLS * CELL_SLACK, r = tip_ball(margin, eps);
-    for (int fi = 0; fi < 6; fi++) {
-        LightFace &F = B.cf[fi];
-        point_face(fi, &F);
-        int ax = fi / 2;
-        for (int l = 0; l < 2; l++) {
-            F.lo[l] = -1;
-            F.h[l] = (real)2 / CORE_CELLS;
-            F.inv[l] = (real)CORE_CELLS / 2;
-            F.n[l] = CORE_CELLS;
-        }
-        F.lo[2] = 0;
-        F.h[2] = fi & 1 ? comp(B.o, ax) - B.core_lo[ax] : B.core_hi[ax] - comp(B.o, ax);
-        F.inv[2] = 0;
-        F.n[2] = 1;
-        F.base = fi * per;
-        F.cbase = 0;
-        for (int cel = 0; cel < per; cel++) {
-            Zone z;
-            lightbuf_zone(B, F, cel % CORE_CELLS, cel / CORE_CELLS, 0, margin, eps, r, &z);
-            prims.n = 0;
-            cls.n = 0;
-            for (int j = 0; j < cand.n; j += 2) {
-                // the part of the pyramid inside the core's box: outside it where either says
-                // so, inside where either says so
-                int i = cand[j], in_box = cand[j + 1];
-                int cl = in_box == CL_OUT ? CL_OUT : classify_zone(s->prims[i], eff[i], z);
-                if (cl == CL_BD && in_box == CL_IN) cl = CL_IN;
-                if (cl != CL_OUT && !(prims.push(b.c, i) && cls.push(b.c, (unsigned char)cl))) return false;
-            }
-            int L = lb_list(b, prims.p, cls.p, prims.n);
-            if (L < 0) return false;
-            B.cells[F.base + cel] = L;
-        }
-    }
-    return true;
-}
-
-// The list for the part inside B's core of a shadow ray from x to the light: its cell's; the
-// whole core's when x is at the light.
-inline int core_list(const LightBuf &B, R3 x) {
-    R3 m = x - B.o;
-    const LightFace &F = B.cf[cube_face(m)];
-    real g = dot(m, F.e[2]);
-    if (!(g > 0)) return B.core;
-    real k = (real)1 / g;
-    int cell;
-    if (face_cell(F, dot(m, F.e[0]) * k, dot(m, F.e[1]) * k, CELL_SLACK, &cell) <= 0) return B.core;
-    return B.cells[F.base + cell];
-}
-
-// The core of point light B (LightBuf::core): the largest cube of voxels centred on the light's
-// voxel, clipped to the grid, whose list is small (LB_CORE_PRIMS). A lamp in its shade gets the
-// shade's box, and a light in empty space the empty space around it. Its list is built as a
-// voxel's (`margin`: the grid's; `eff`: where bounds place each primitive).
-bool light_core(ListBuilder &b, const Box *eff, real margin, LightBuf &B, Array<int> &prims,
-                Array<unsigned char> &cls) {
-    const Accel *a = b.a;
-    const Scene *s = b.s;
-    int ix[3];
-    if (!voxel_of(a, B.o, ix)) return true;
-    int most = a->data[a->off[a->voxel[voxel_index(a, ix)]] + 1];
-    most = most > LB_CORE_PRIMS ? most : LB_CORE_PRIMS;
-    bool whole = false;
-    for (int k = 1; k <= LB_CORE && !whole; k++) {
-        Box bx;
-        int i0[3], i1[3];
-        whole = true;
-        for (int l = 0; l < 3; l++) {
-            i0[l] = ix[l] - k > 0 ? ix[l] - k : 0;
-            i1[l] = ix[l] + k + 1 < a->n[l] ? ix[l] + k + 1 : a->n[l];
-            whole = whole && i0[l] == 0 && i1[l] == a->n[l];
-        }
-        voxels_box(a, i0, i1, margin, bx.lo, bx.hi);
-        prims.n = 0;
-        cls.n = 0;
-        for (int i = 0; i < s->prims.n; i++) {
-            if (!box_overlap(eff[i], bx)) continue;
-            if (!prims.push(b.c, i) || !cls.push(b.c, (unsigned char)classify_prim(s->prims[i], bx.lo, bx.hi)))
-                return false;
-        }
-        int L = lb_list(b, prims.p, cls.p, prims.n);
-        if (L < 0) return false;
-        if (a->data[a->off[L] + 1] > most) break;
-        B.core = L;
-        for (int l = 0; l < 3; l++) B.core_lo[l] = bx.lo[l], B.core_hi[l] = bx.hi[l];
-    }
-    return true;
-}
-
 // Build the light buffers: cells and slabs about `cell` wide where the grid's box is, and lists
-// for the space between each voxel and its light, and the point lights' cores. `eff`: where
+// for the space between each voxel and its light. `eff`: where
 // bounds place each primitive; `margin`: how far rounding may move a point (the grid's).
 // `lights`, `eye`: which buffers to build; `rays`: the primary rays of the image.
 bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool lights, bool eye, double rays) {
@@ -3532,15 +3446,12 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
     a->lbuf = (LightBuf *)mem_zalloc(c, sizeof(LightBuf) * (size_t)(nl + 1));
     if (!a->lbuf) return false;
     a->nlbuf = nl;
-    for (int li = 0; li <= nl; li++) a->lbuf[li].core = -1;
-    Array<int> start, cand, prims, seen;
-    Array<unsigned char> cls, seen_cls;
+    Array<int> start, cand, seen;
+    Array<unsigned char> seen_cls;
     Array<real> key;
     Array<int> foot;  // per primitive: u0, u1, v0, v1 (u0 > u1: not on this face)
     start.init();
     cand.init();
-    prims.init();
-    cls.init();
     seen.init();
     seen_cls.init();
     key.init();
@@ -3553,12 +3464,6 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
         B.point = B.pieces || s->lights[li].point;
         B.faces = B.point ? 6 : 1;
         B.o = B.pieces ? s->eye : B.point ? s->lights[li].v : r3(0, 0, 0);
-        if (!B.pieces && B.point &&
-            !(light_core(b, eff, margin, B, prims, cls) &&
-              (B.core < 0 || core_cells(b, eff, margin, B, cand, prims, cls)))) {
-            ok = false;
-            break;
-        }
         long total = 0, cells = 0;
         real eps = 0, r = 0;
         for (int fi = 0; fi < B.faces; fi++) {
@@ -3714,16 +3619,16 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
                     if (out == -1) continue;
                     real w0, w1;
                     zone_depths(B, F, k, margin, &w0, &w1);
-                    Zone z;
-                    lightbuf_zone(B, F, cel % F.n[0], cel / F.n[0], k, margin, eps, r, &z);
-                    prims.n = 0;
-                    cls.n = 0;
-                    for (int j = start[cel]; ok && j < start[cel + 1]; j++) {
-                        int i = cand[j];
-                        if (!(key[2 * i] <= w1 && key[2 * i + 1] >= w0)) continue;
-                        int cl = classify_zone(s->prims[i], eff[i], z);
-                        if (cl != CL_OUT) ok = prims.push(c, i) && cls.push(c, (unsigned char)cl);
-                    }
+                    ZoneClass in;
+                    in.s = s;
+                    in.eff = eff;
+                    in.key = key.p;
+                    in.w0 = w0;
+                    in.w1 = w1;
+                    lightbuf_zone(B, F, cel % F.n[0], cel / F.n[0], k, margin, eps, r, &in.z);
+                    ok = lb_region(b, cand.p + start[cel], start[cel + 1] - start[cel], in);
+                    const Array<int> &prims = b.rprims;
+                    const Array<unsigned char> &cls = b.rcls;
                     // the next slab's zone often meets the same: then it has the same list
                     // (no memcmp/memcpy of an empty list: its pointer may still be null)
                     if (last >= 0 && prims.n == seen.n &&
@@ -3748,8 +3653,6 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
     }
     start.release(c);
     cand.release(c);
-    prims.release(c);
-    cls.release(c);
     seen.release(c);
     seen_cls.release(c);
     key.release(c);
@@ -3757,6 +3660,7 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
     return ok;
 }
 
+// ---- [9b.5] Building: the whole structure ----
 // Build the acceleration structure: the lists of the grid's voxels and of the space around it,
 // and the buffers of the lights and, for a render (`render`), of the eye.
 pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
@@ -3767,7 +3671,6 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     a->off.init();
     a->plan_at.init();
     a->plan.init();
-    a->clear.init();
     a->freeze = opt_int(c, OPT_FREEZE);
     a->merge = opt_int(c, OPT_MERGE);
     // (the shadow cache's answer is the reference's when no surface lets more light through
@@ -3835,7 +3738,6 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         double m = fabs((double)region.lo[l]) > fabs((double)region.hi[l]) ? fabs((double)region.lo[l]) : fabs((double)region.hi[l]);
         if (m > mag) mag = m;
     }
-    const double eps = sizeof(real) == sizeof(float) ? FLT_EPSILON : DBL_EPSILON;
     // With bounds, a primitive matters only where all its ancestors' boxes reach: outside a
     // node's box the node is outside, and so is what its primitives alone would make of it
     // (a box smaller than all of space implies that). So each primitive is placed in the grid
@@ -3856,10 +3758,8 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         mem_free(c, neff);
     }
     Array<int> cand, start;
-    Array<unsigned char> cls;
     cand.init();
     start.init();
-    cls.init();
     // The layout: cubic voxels, a margin that keeps classification safe from rounding in the
     // traversal, the grid centred on the region. The voxel table and the references to the
     // primitives must fit the budget (option gridmem): otherwise the grid is made coarser.
@@ -3868,7 +3768,7 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     while (want > 0 && st == PRAY_OK) {
         a->h = (real)(ext / want);
         a->inv_h = (real)1 / a->h;
-        margin = (double)a->h * 1e-6 + 64 * eps * (mag + ext) * (want + 4);
+        margin = (double)a->h * 1e-6 + 64 * REAL_EPS * (mag + ext) * (want + 4);
         // far from the origin in low precision the voxels would be smaller than the rounding of
         // the positions: then no grid
         if (margin > (double)a->h / 4) {
@@ -3957,15 +3857,10 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
                     int ix[3] = {x, y, z}, ix1[3] = {x + 1, y + 1, z + 1};
                     long v = voxel_index(a, ix);
                     int k0 = start[(int)v], k1 = start[(int)v + 1];
-                    real lo[3], hi[3];
-                    voxels_box(a, ix, ix1, margin, lo, hi);
-                    cls.n = 0;
-                    if (!cls.reserve(c, k1 - k0 + 1)) {
-                        st = c->status;
-                        break;
-                    }
-                    for (int k = k0; k < k1; k++) cls.p[cls.n++] = (unsigned char)classify_prim(s->prims[cand[k]], lo, hi);
-                    int L = lb_list(b, cand.p + k0, cls.p, k1 - k0);
+                    BoxClass in;
+                    in.s = s;
+                    voxels_box(a, ix, ix1, margin, in.lo, in.hi);
+                    int L = lb_region(b, cand.p + k0, k1 - k0, in) ? lb_list(b, b.rprims.p, b.rcls.p, b.rprims.n) : -1;
                     if (L < 0) st = c->status;
                     else a->voxel[v] = L;
                 }
@@ -4003,21 +3898,14 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     }
     // the space outside the grid (or everything): primitives not inside the grid's box are active
     if (st == PRAY_OK) {
+        OuterClass out;
+        out.a = a;
+        out.eff = eff;
         cand.n = 0;
-        cls.n = 0;
-        for (int i = 0; i < np && st == PRAY_OK; i++) {
-            const Box &bx = eff[i];
-            if (box_empty(bx)) continue;
-            bool inside = a->n[0] > 0;
-            for (int l = 0; l < 3 && inside; l++)
-                inside = bx.lo[l] > a->org[l] && bx.hi[l] < a->top[l];
-            if (inside) continue;
-            if (!cand.push(c, i) || !cls.push(c, CL_BD)) st = c->status;
-        }
-        if (st == PRAY_OK) {
-            a->outer = lb_list(b, cand.p, cls.p, cand.n);
-            if (a->outer < 0) st = c->status;
-        }
+        for (int i = 0; i < np && st == PRAY_OK; i++)
+            if (!cand.push(c, i)) st = c->status;
+        a->outer = st == PRAY_OK && lb_region(b, cand.p, cand.n, out) ? lb_list(b, b.rprims.p, b.rcls.p, b.rprims.n) : -1;
+        if (a->outer < 0) st = c->status;
     }
     bool lights = opt_int(c, OPT_SHADOWS) && opt_int(c, OPT_LIGHTBUFFER) && s->lights.n > 0;
     bool eye = render && opt_int(c, OPT_EYEBUFFER) && !s->parallel;
@@ -4025,7 +3913,6 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         st = c->status;
     cand.release(c);
     start.release(c);
-    cls.release(c);
     mem_free(c, eff);
     lb_release(b);
     if (st == PRAY_OK) {
@@ -4040,19 +3927,18 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
                 break;
             }
             int where = list_plan(c, s, a->data.p + a->off[L], kids, solid, &a->plan);
-            if (where == -2 || !a->plan_at.push(c, where) || !a->clear.push(c, list_clear(s, a->data.p + a->off[L])))
+            if (where == -2 || !a->plan_at.push(c, where))
                 st = c->status;
         }
         mem_free(c, kids);
         mem_free(c, solid);
     }
-    long lbv = 0, ebv = 0, eruns = 0, cores = 0;  // the light buffers' voxels, the eye's, its runs' numbers
+    long lbv = 0, ebv = 0, eruns = 0;  // the light buffers' voxels, the eye's, its runs' numbers
     for (int i = 0; st == PRAY_OK && a->lbuf && i <= a->nlbuf; i++) {
         LightBuf &B = a->lbuf[i];
         long nv = 0;
         for (int f = 0; f < B.faces; f++) nv += (long)B.f[f].n[0] * B.f[f].n[1] * B.f[f].n[2];
         (B.pieces ? ebv : lbv) += nv;
-        cores += B.core >= 0;
         if (B.pieces) {
             eruns += B.nruns;
             continue;
@@ -4070,10 +3956,9 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     nv = (long)a->n[0] * a->n[1] * a->n[2];
     a->memory = (double)sizeof(Accel) + (double)nv * (sizeof(int) + 1) + (double)a->data.cap * sizeof(int) +
                 (double)a->off.cap * sizeof(int) + (double)(a->plan_at.cap + a->plan.cap) * sizeof(int) +
-                (double)a->clear.cap + (double)(a->lbuf ? a->nlbuf + 1 : 0) * sizeof(LightBuf) +
-                (double)(lbv + eruns + cores * 6 * CORE_CELLS * CORE_CELLS) * sizeof(int);
+                (double)(a->lbuf ? a->nlbuf + 1 : 0) * sizeof(LightBuf) +
+                (double)(lbv + eruns) * sizeof(int);
     c->stats.lightbuf_voxels = lbv;
-    c->stats.lightbuf_cores = cores;
     c->stats.eyebuf_voxels = ebv;
     c->stats.grid[0] = a->n[0];
     c->stats.grid[1] = a->n[1];
@@ -4085,7 +3970,7 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     return st;
 }
 
-// ---- evaluation along a ray ----
+// ---- [9b.6] Per ray: list evaluation with freezing (the one list evaluator) ----
 // The primitive's interval along the current ray, computed at most once per ray.
 inline const Span &span_get(const Scene *s, Scratch *w, const Ray &ray, int p, int self) {
     Span &sp = w->span[p];
@@ -4135,6 +4020,13 @@ void settle(const Scene *s, Scratch *w, int e, bool st) {
     }
 }
 
+// Primitive p, with status `in` at a and the span (kind, t0, t1), keeps that status for the rest
+// of the ray: settle it when that decides its parent (Prim::settles).
+inline void settle_prim(const Scene *s, Scratch *w, int p, bool in, int kind, real t0, real t1, real a) {
+    if ((s->prims[p].settles & (in ? 2 : 1)) && (kind != SPAN || t1 <= a || (t0 <= a && t1 >= REAL_INF)))
+        settle(s, w, 2 * p, in);
+}
+
 // Like propagate (section 9), but a node whose status is fixed for the ray stops the change.
 bool propagate_live(const Scene *s, Scratch *w, int e, bool st) {
     for (;;) {
@@ -4160,27 +4052,64 @@ inline void bump(const Scene *s, Scratch *w, int e) {
     else w->cnt[p]++;
 }
 
+// The solids of a plan (list_plan) whose node's status is fixed for this ray: Hull::fixed 1 when
+// the solid is outside for good, 2 inside; 0 not fixed. Their members are frozen.
+inline void plan_fixed(Scratch *w, const int *solids, int k) {
+    int j = solids[2 * k];
+    w->hull[k].fixed = w->nfixed[j] != w->ray ? 0 : 1 + ((w->nfixval[j] != 0) != (solids[2 * k + 1] != 0));
+}
+
+// A primitive of a plan: its solid, -1 standing alone, and whether it is turned inside out.
+inline int plan_solid(const int *code, int i) { return (code[i] >> 2) - 1; }
+
+// Solid k of a plan is outside for the rest of the ray (one of its members is): its node's
+// status is fixed for the ray (3.5), which freezes its members here and in every later list.
+// (A solid is an intersection of its members, so one member decides, at whatever depth of the
+// tree it stands.)
+inline void fix_solid(const Scene *s, Scratch *w, const int *solids, int k) {
+    int j = solids[2 * k];
+    w->nfixed[j] = w->ray;
+    w->nfixval[j] = (unsigned char)solids[2 * k + 1];
+    w->hull[k].fixed = 1;
+    if (2 * j + 1 == s->root) w->root_fixed = 1;
+}
+
 // The flat sweep of a list with a plan (list_plan), holed or not, on the part (a, b] of the ray
-// (and t < tmax): each group is inside where the ray is in one of its primitives, each solid
-// where it is in all of its members, the root where it is in one solid or more. The crossings
-// are taken in order, and each changes one primitive, perhaps its group, perhaps its solid,
-// perhaps the root. Returns true when `visit` stopped.
+// (and t < tmax): each solid is inside where the ray is in all of its members, the root where it
+// is in one solid or more. The crossings are taken in order, and each changes one primitive,
+// perhaps its solid, perhaps the root. A solid whose node is fixed for the ray keeps its status
+// and its members are frozen (3.5). Returns true when `visit` stopped or nothing further can be
+// seen.
 template <class Visit>
-bool eval_flat(const Scene *s, Scratch *w, const Ray &ray, const int *prims, int np, const int *plan, real a, real b,
-               real tmax, int self, Visit &visit) {
-    int ns = plan[0], ng = plan[2];
-    plan += PLAN_HEAD;
-    // (the groups' counts after the solids': a group is in when one of its members is)
-    const int *group = ng ? plan + np : NULL, *gsolid = plan + 2 * np;
-    Hull *gh = w->hull + ns;
-    for (int k = 0; k < ns + ng; k++) w->hull[k].need = w->hull[k].have = 0;
+bool eval_flat(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const int *prims, int np, const int *plan,
+               real a, real b, real tmax, int self, Visit &visit) {
+    int ns = plan[0];
+    const int *code = plan + PLAN_HEAD, *solids = code + np;
+    for (int k = 0; k < ns; k++) {
+        w->hull[k].need = w->hull[k].have = 0;
+        plan_fixed(w, solids, k);
+    }
     int in = 0, nc = 0;  // solids (and primitives standing alone) the ray is in
     for (int i = 0; i < np; i++) {
-        const Span &sp = span_get(s, w, ray, prims[i], self);
-        bool st = (sp.kind == SPAN_ALL || (sp.kind == SPAN && sp.t0 <= a && a < sp.t1)) != (plan[i] & 1);
-        int k = (plan[i] >> 1) - 1;
-        if (group && group[i] >= 0) gh[group[i]].have += st;
-        else if (k < 0) in += st;
+        int p = prims[i], k = plan_solid(code, i);
+        if (k >= 0 && w->hull[k].fixed) {
+            w->k.frozen += 1;
+            continue;
+        }
+        const Span &sp = span_get(s, w, ray, p, self);
+        bool tin = sp.kind == SPAN_ALL || (sp.kind == SPAN && sp.t0 <= a && a < sp.t1);
+        bool st = tin != (code[i] & 1);
+        if (A->freeze) {
+            // a member outside for the rest of the ray: its solid too; one standing alone
+            // settles as in the full evaluation
+            if (k < 0) settle_prim(s, w, p, tin, sp.kind, sp.t0, sp.t1, a);
+            else if (!st && (code[i] & 2) && (sp.kind != SPAN || (code[i] & 1 ? sp.t0 <= a && sp.t1 >= REAL_INF : sp.t1 <= a))) {
+                fix_solid(s, w, solids, k);
+                continue;
+            }
+            if (w->root_fixed) return true;  // the root keeps its status from a on
+        }
+        if (k < 0) in += st;
         else w->hull[k].need++, w->hull[k].have += st;
         if (sp.kind != SPAN) continue;
         for (int e = 1; e >= 0; e--) {
@@ -4192,10 +4121,11 @@ bool eval_flat(const Scene *s, Scratch *w, const Ray &ray, const int *prims, int
             nc++;
         }
     }
-    w->k.checks += np;
     if (nc == 0) return false;
-    for (int g = 0; g < ng; g++) w->hull[gsolid[g]].need++, w->hull[gsolid[g]].have += gh[g].have > 0;
-    for (int k = 0; k < ns; k++) in += w->hull[k].need == w->hull[k].have;
+    for (int k = 0; k < ns; k++) {
+        const Hull &u = w->hull[k];
+        in += u.fixed ? u.fixed == 2 : u.need == u.have;
+    }
     // (the list's primitives are in the order of their numbers, so the crossings sort as the
     // full evaluation's do)
     if (nc > 1) sort_crossings(w->cross, nc);
@@ -4206,124 +4136,138 @@ bool eval_flat(const Scene *s, Scratch *w, const Ray &ray, const int *prims, int
         int last = -1;  // crossings at the same t together, as in the full evaluation
         for (; j < nc && w->cross[j].t == t; j++) {
             const Cross &x = w->cross[j];
-            int i = x.prim, k = (plan[i] >> 1) - 1, st = (x.enter != 0) != (plan[i] & 1) ? 1 : -1;
-            if (group && group[i] >= 0) {  // the group's member: the group changes, or nothing
-                Hull &G = gh[group[i]];
-                bool was = G.have > 0;
-                G.have += st;
-                if (was == (G.have > 0)) continue;
-                st = was ? -1 : 1;
-            }
+            int i = x.prim, k = plan_solid(code, i), st = (x.enter != 0) != (code[i] & 1) ? 1 : -1;
             if (k < 0) in += st;
             else {
                 Hull &u = w->hull[k];
+                if (u.fixed) continue;
                 bool was = u.have == u.need;
                 u.have += st;
                 if (was != (u.have == u.need)) in += was ? -1 : 1;
             }
             if ((in > 0) != root) root = !root, last = j;
+            if (!A->freeze) continue;
+            int p = prims[i];
+            if (k < 0) {
+                if ((s->prims[p].settles & (x.enter ? 2 : 1)) && (!x.enter || w->span[p].t1 >= REAL_INF))
+                    settle(s, w, 2 * p, x.enter != 0);
+            } else if (st < 0 && (code[i] & 2) && (!(code[i] & 1) || w->span[p].t1 >= REAL_INF)) {
+                fix_solid(s, w, solids, k);  // (left for good: it is entered once at most)
+            }
         }
-        if (root == before || last < 0) continue;
-        Hit h;
-        h.t = t;
-        h.prim = prims[w->cross[last].prim];
-        h.prim_enter = w->cross[last].enter;
-        h.root_enter = root;
-        if (!visit(h)) return true;
+        if (root != before && last >= 0) {
+            Hit h;
+            h.t = t;
+            h.prim = prims[w->cross[last].prim];
+            h.prim_enter = w->cross[last].enter;
+            h.root_enter = root;
+            if (!visit(h)) return true;
+        }
+        if (w->root_fixed) return true;
     }
     return false;
 }
 
-// Evaluate list L on the part (a, b] of the ray (and t < tmax). A list with a plan takes its
-// shortcuts: the nearest entry when it is plain, else (or when the visitor goes on from there)
-// the flat sweep. Any other is evaluated in full: initialise the active part of the status tree
-// at a, then sweep the crossings inside, freezing what settles. Returns true when `visit`
-// stopped.
+// The nearest entry of a plain list (list_plan): a union of solids, none inside for the whole
+// region. While the ray is outside them all, the first visible surface is the nearest entry.
+// An intersection is entered at the latest entry of its members and left at the earliest exit;
+// a half-space turned inside out is entered where the ray leaves the half-space. A solid whose
+// node is fixed for the ray is outside for good, or the flat sweep decides; its members are
+// frozen (3.5). Returns 1 when `visit` stopped or nothing further can be seen, 0 when nothing
+// is entered in (a, b], -1 when the flat sweep must decide from *a on (a solid inside at a,
+// entries at the same t, a grazing touch, or the visitor going on through the solid entered).
+// (A primitive standing alone that is inside at a sends the list to the flat sweep, which
+// settles it.)
 template <class Visit>
-bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L, real a, real b, real tmax,
-               int self, Visit &visit) {
-    if (L == 0 || list_passes(A, L, visit)) return false;
-    const int *d = A->data.p + A->off[L];
-    int na = d[0], np = d[1];
-    const int *nodes = d + LIST_HEAD, *prims = list_prims(d);
-    w->k.set_in += d[2];
-    w->k.set_out += d[3];
-    if (list_plain(A, L)) {
-        // A union of solids (plain lists, list_plan: the common lists of a scene of many
-        // objects), none inside for the whole region: while the ray is outside them all, the
-        // first visible surface is the nearest entry. An intersection is entered at the latest
-        // entry of its members and left at the earliest exit; a half-space turned inside out is
-        // entered where the ray leaves the half-space. Anything less plain (a solid inside at a,
-        // entries at the same t, a grazing touch) is left to the flat sweep.
-        const int *plan = A->plan.p + A->plan_at[L] + PLAN_HEAD;
-        int ns = plan[-PLAN_HEAD];
-        for (int k = 0; k < ns; k++) {
-            Hull &u = w->hull[k];
-            u.t0 = -REAL_INF;
-            u.t1 = REAL_INF;
-            u.prim = -1;
-            u.enter = 1;
-            u.tie = 0;
-        }
-        int first = -1, first_enter = 1;
-        real tf = 0;
-        bool plain = true;
-        for (int i = 0; i < np + ns && plain; i++) {
-            int p, kind, enter;
-            real t0, t1;
-            bool tie = false;
-            if (i < np) {  // the primitives: the members of intersections are gathered first
-                // (computed afresh, not through span_get: cheaper than its book-keeping here)
-                p = prims[i];
-                w->k.tests += 1;
-                kind = prim_span(s->prims[p], ray, twin(s, p, self), &t0, &t1);
-                enter = !(plan[i] & 1);
-                if (!enter) {  // a half-space (one end of its span infinite) turned inside out
-                    if (kind != SPAN) kind = kind == SPAN_ALL ? SPAN_NONE : SPAN_ALL;
-                    else if (t0 == -REAL_INF) t0 = t1, t1 = REAL_INF;
-                    else t1 = t0, t0 = -REAL_INF;
-                }
-                int k = (plan[i] >> 1) - 1;
-                if (k >= 0) {
-                    Hull &u = w->hull[k];
-                    if (kind == SPAN_NONE) u.t1 = -REAL_INF;
-                    if (kind != SPAN) continue;
-                    if (t0 == u.t0) u.tie = 1;
-                    if (t0 > u.t0) u.t0 = t0, u.prim = p, u.enter = enter, u.tie = 0;
-                    if (t1 < u.t1) u.t1 = t1;
+int eval_plain(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const int *prims, int np, const int *plan,
+               real *pa, real b, real tmax, int self, Visit &visit) {
+    int ns = plan[0];
+    const int *code = plan + PLAN_HEAD, *solids = code + np;
+    real a = *pa;
+    for (int k = 0; k < ns; k++) {
+        Hull &u = w->hull[k];
+        u.t0 = -REAL_INF;
+        u.t1 = REAL_INF;
+        u.prim = -1;
+        u.enter = 1;
+        u.tie = 0;
+        plan_fixed(w, solids, k);
+        if (u.fixed == 2) return -1;
+        if (u.fixed) u.t1 = -REAL_INF;
+    }
+    int first = -1, first_enter = 1;
+    real tf = 0;
+    for (int i = 0; i < np + ns; i++) {
+        int p, kind, enter;
+        real t0 = 0, t1 = 0;
+        bool tie = false;
+        if (i < np) {  // the primitives: the members of intersections are gathered first
+            int k = plan_solid(code, i);
+            if (k >= 0 && w->hull[k].fixed) {
+                w->k.frozen += 1;
+                continue;
+            }
+            // (computed afresh, not through span_get: cheaper than its book-keeping here)
+            p = prims[i];
+            w->k.tests += 1;
+            kind = prim_span(s->prims[p], ray, twin(s, p, self), &t0, &t1);
+            enter = !(code[i] & 1);
+            if (!enter) {  // a half-space (one end of its span infinite) turned inside out
+                if (kind != SPAN) kind = kind == SPAN_ALL ? SPAN_NONE : SPAN_ALL;
+                else if (t0 == -REAL_INF) t0 = t1, t1 = REAL_INF;
+                else t1 = t0, t0 = -REAL_INF;
+            }
+            if (k >= 0) {
+                Hull &u = w->hull[k];
+                if (A->freeze && (code[i] & 2) && (kind == SPAN_NONE || (kind == SPAN && t1 <= a))) {
+                    fix_solid(s, w, solids, k);  // a member outside for the rest of the ray
+                    if (w->root_fixed) return 1;
+                    u.t1 = -REAL_INF;
                     continue;
                 }
-            } else {  // then the intersections, as solids
-                const Hull &u = w->hull[i - np];
-                p = u.prim;
-                enter = u.enter;
-                t0 = u.t0;
-                t1 = u.t1;
-                tie = u.tie != 0;
-                kind = t0 <= t1 ? SPAN : SPAN_NONE;  // inside from -infinity when no member is entered
+                if (kind == SPAN_NONE) u.t1 = -REAL_INF;
+                if (kind != SPAN) continue;
+                if (t0 == u.t0) u.tie = 1;
+                if (t0 > u.t0) u.t0 = t0, u.prim = p, u.enter = enter, u.tie = 0;
+                if (t1 < u.t1) u.t1 = t1;
+                continue;
             }
-            if (kind == SPAN_NONE || (kind == SPAN && t1 <= a)) continue;
-            plain = plain && kind == SPAN && t0 > a;
-            if (!plain || t0 > b || !(t0 < tmax) || (first >= 0 && t0 > tf)) continue;
-            plain = t1 > t0 && !tie && !(first >= 0 && t0 == tf);
-            first = p;
-            first_enter = enter;
-            tf = t0;
+        } else {  // then the intersections, as solids
+            const Hull &u = w->hull[i - np];
+            p = u.prim;
+            enter = u.enter;
+            t0 = u.t0;
+            t1 = u.t1;
+            tie = u.tie != 0;
+            kind = t0 <= t1 ? SPAN : SPAN_NONE;  // inside from -infinity when no member is entered
         }
-        if (plain) {
-            w->k.checks += np;
-            if (first < 0) return false;
-            Hit h;
-            h.t = tf;
-            h.prim = first;
-            h.prim_enter = first_enter;
-            h.root_enter = 1;
-            if (!visit(h)) return true;
-            a = tf;  // the visitor goes on through the solid: the rest by the flat sweep
-        }
+        if (kind == SPAN_NONE || (kind == SPAN && t1 <= a)) continue;
+        if (kind != SPAN || !(t0 > a)) return -1;  // inside at a
+        if (t0 > b || !(t0 < tmax) || (first >= 0 && t0 > tf)) continue;
+        if (!(t1 > t0) || tie || (first >= 0 && t0 == tf)) return -1;
+        first = p;
+        first_enter = enter;
+        tf = t0;
     }
-    if (A->plan_at[L] >= 0)
-        return eval_flat(s, w, ray, prims, np, A->plan.p + A->plan_at[L], a, b, tmax, self, visit);
+    if (first < 0) return 0;
+    Hit h;
+    h.t = tf;
+    h.prim = first;
+    h.prim_enter = first_enter;
+    h.root_enter = 1;
+    if (!visit(h)) return 1;
+    *pa = tf;  // the visitor goes on through the solid: the rest by the flat sweep
+    return -1;
+}
+
+// The full evaluation of a list (3.4, 3.5): initialise the active part of the status tree at a,
+// then sweep the crossings in (a, b] (and t < tmax), freezing what settles. Returns true when
+// `visit` stopped or nothing further can be seen.
+template <class Visit>
+bool eval_full(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const int *d, real a, real b, real tmax,
+               int self, Visit &visit) {
+    int na = d[0], np = d[1];
+    const int *nodes = d + LIST_HEAD, *prims = list_prims(d);
     for (int i = na - 1; i >= 0; i--) {  // parents first: pass freezing down
         int j = nodes[3 * i];
         w->cnt[j] = nodes[3 * i + 1];
@@ -4333,7 +4277,6 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
     // check actions: the primitive's status at a and its crossings in (a, b]; a primitive that
     // keeps its status for the rest of the ray is settled (3.5), which may freeze others
     int nc = 0;
-    w->k.checks += np;
     for (int i = 0; i < np; i++) {
         int p = prims[i];
         if (frozen(w, s->prims[p].parent)) {
@@ -4359,8 +4302,7 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
                 nc++;
             }
         }
-        if (A->freeze && (s->prims[p].settles & (in ? 2 : 1)) && (kind != SPAN || t1 <= a || (t0 <= a && t1 >= REAL_INF)))
-            settle(s, w, 2 * p, in);
+        if (A->freeze) settle_prim(s, w, p, in, kind, t0, t1, a);
         if (in) bump(s, w, 2 * p);
     }
     if (w->root_fixed) return true;  // the root keeps its status from a on
@@ -4404,6 +4346,29 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
     return false;
 }
 
+// Evaluate list L on the part (a, b] of the ray (and t < tmax): the one list evaluator. A list
+// with a plan takes its shortcuts, the nearest entry when it is plain, else (or when the visitor
+// goes on from there) the flat sweep; any other is evaluated in full. All three freeze what
+// settles (3.5). Returns true when `visit` stopped or nothing further can be seen on the ray.
+template <class Visit>
+bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L, real a, real b, real tmax,
+               int self, Visit &visit) {
+    if (L == 0) return false;
+    const int *d = A->data.p + A->off[L];
+    w->k.checks += d[1];
+    w->k.set_in += d[2];
+    w->k.set_out += d[3];
+    int at = A->plan_at[L];
+    if (at < 0) return eval_full(s, A, w, ray, d, a, b, tmax, self, visit);
+    const int *plan = A->plan.p + at;
+    if (!plan[1]) {
+        int r = eval_plain(s, A, w, ray, list_prims(d), d[1], plan, &a, b, tmax, self, visit);
+        if (r >= 0) return r != 0;
+    }
+    return eval_flat(s, A, w, ray, list_prims(d), d[1], plan, a, b, tmax, self, visit);
+}
+
+// ---- [9b.7] Per ray: stretch sources (grid walk, light buffer voxel, eye buffer cell) ----
 // Where the ray meets the box: [*t0, *t1]; false when it misses. `inv` holds the reciprocals
 // of the direction's components, 0 for a ray parallel to that axis.
 bool ray_box(const Ray &r, const real *inv, const real *lo, const real *hi, real *t0, real *t1) {
@@ -4460,56 +4425,34 @@ inline real nearest(const real *v, int *axis) {
     return near;
 }
 
-// A new ray: a new stamp for what is kept per ray (3.5: no explicit unfreezing).
-void ray_begin(const Scene *s, Scratch *w) {
-    w->ray++;
-    if (w->ray == 0) {  // the stamps wrapped around: clear them
-        for (int i = 0; i < s->prims.n; i++) w->span[i].stamp = 0;
-        memset(w->nfrozen, 0, sizeof(unsigned) * (size_t)s->nodes.n);
-        memset(w->nfixed, 0, sizeof(unsigned) * (size_t)s->nodes.n);
-        w->ray = 1;
-    }
-    w->root_fixed = 0;
-}
+// A source covers a part (ta, tb] of the ray inside the grid's box, and cuts it into stretches
+// with their lists: span() finds the part (false when the ray misses it), walk() gives the
+// stretches from ta to tb to `out`, and returns true when `out` stopped.
 
-// The accelerated counterpart of `sweep`: the same hits, in the same order, up to tstop (tmax, or
-// where a shadow ray reaches its light's core); `inv`: the direction's reciprocals (ray_inverse).
-// Returns true when the visitor stopped or nothing further can be hit.
-template <class Visit>
-bool trace_accel(const Scene *s, Scratch *w, const Ray &ray, const real *inv, real tmax, real tstop, int self,
-                 Visit &visit) {
-    const Accel *A = s->accel;
-    if (s->root < 0) return true;
-    ray_begin(s, w);
-    if (A->bounds && A->n[0] == 0) {
-        // without a grid, a bounded node whose box the ray misses is outside for the whole ray
-        for (int j = s->nodes.n - 1; j >= 0; j--) {
-            const Node &nd = s->nodes[j];
-            if (frozen(w, nd.parent)) {
-                w->nfrozen[j] = w->ray;
-                continue;
-            }
-            if (w->nfixed[j] == w->ray || !box_finite(nd.box)) continue;
-            real t0, t1;
-            if (ray_box(ray, inv, nd.box.lo, nd.box.hi, &t0, &t1) && t1 > 0 && t0 < tmax) continue;
-            w->nfixed[j] = w->ray;
-            w->nfixval[j] = 0;
-            if (A->freeze) settle(s, w, 2 * j + 1, false);
-        }
+// The grid (3.3, 3.6): leading-axis traversal through the voxels, an area of equal lists (and
+// the voxels a jump crosses) being one stretch.
+struct GridSource {
+    const Accel *A;
+    const Ray &ray;
+    real inv[3];  // the direction's reciprocals (ray_inverse)
+    GridSource(const Accel *A_, const Ray &ray_) : A(A_), ray(ray_) { ray_inverse(ray, inv); }
+    bool span(real *ta, real *tb) const {
+        *ta = 0;
+        if (in_box(ray.o, A->org, A->top)) *tb = box_exit(ray, inv, A->org, A->top);
+        else if (!ray_box(ray, inv, A->org, A->top, ta, tb)) return false;
+        return *tb > 0;
     }
-    if (A->n[0] == 0) return eval_list(s, A, w, ray, A->outer, 0, tstop, tmax, self, visit);
-    real tin = 0, tout;
-    if (in_box(ray.o, A->org, A->top)) tout = box_exit(ray, inv, A->org, A->top);
-    else if (!ray_box(ray, inv, A->org, A->top, &tin, &tout)) tout = 0;
-    if (tout <= 0 || tin >= tstop)
-        return eval_list(s, A, w, ray, A->outer, 0, tstop, tmax, self, visit);
-    real t = tin > 0 ? tin : 0;
-    if (t > 0 && eval_list(s, A, w, ray, A->outer, 0, t, tmax, self, visit)) return true;
-    real tend = tout < tstop ? tout : tstop;
-    // Leading-axis traversal (3.3): the boundaries of the three axes come at regular intervals
-    // along the ray; the next voxel is across the nearest one. Distances are kept as ray
-    // parameters (the leading-axis distance over the leading component of the direction), so a
-    // step is two comparisons and one addition.
+    template <class Out>
+    bool walk(Out &out, real t, real tend) const;
+};
+
+// The boundaries of the three axes come at regular intervals along the ray; the next voxel is
+// across the nearest one. Distances are kept as ray parameters (the leading-axis distance over
+// the leading component of the direction), so a step is two comparisons and one addition. With
+// merging, a voxel with the list of the one before is a move, not a new stretch; and a voxel
+// whose reach is r (reach_build) lets the ray jump to where it leaves the cube of voxels within r.
+template <class Out>
+bool GridSource::walk(Out &out, real t, real tend) const {
     R3 p = ray.o + ray.d * t;
     int ix[3], step[3], left[3];       // left: voxels ahead along each axis inside the grid
     real next[3], delta[3], slope[3];  // slope: voxels per unit of t along each axis
@@ -4526,7 +4469,7 @@ bool trace_accel(const Scene *s, Scratch *w, const Ray &ray, const real *inv, re
     int run = -1;  // the list of the area being crossed
     real run_a = t;
     long at = voxel_index(A, ix);  // the voxel the ray is in
-    long stride[3];  // a step along each axis, in cells
+    long stride[3];  // a step along each axis, in voxels
     stride[0] = step[0];
     stride[1] = (long)step[1] * A->n[0];
     stride[2] = (long)step[2] * A->n[0] * A->n[1];
@@ -4534,12 +4477,13 @@ bool trace_accel(const Scene *s, Scratch *w, const Ray &ray, const real *inv, re
     long steps = 0, moves = 0;  // counted here, added to the counters once per ray
     bool stopped = false;
     for (;;) {
+        PRAY_ASSERT(at >= 0 && at < (long)A->n[0] * A->n[1] * A->n[2]);
         int L = A->voxel[at];
         steps++;
         if (L == run && merge) {
             moves++;  // same list: a move, no evaluation
         } else {
-            if (run > 0 && eval_list(s, A, w, ray, run, run_a, t, tmax, self, visit)) {
+            if (run >= 0 && out(run, run_a, t)) {
                 stopped = true;
                 break;
             }
@@ -4585,23 +4529,173 @@ bool trace_accel(const Scene *s, Scratch *w, const Ray &ray, const real *inv, re
         }
         if (left[ax] < 0) break;
     }
-    w->k.steps += (double)steps;
-    w->k.moves += (double)moves;
-    if (stopped) return true;
+    out.w->k.steps += (double)steps;
+    out.w->k.moves += (double)moves;
     // the last stretch ends where the ray leaves the grid's box, whatever rounding the stepping
     // gathered, so that it meets the stretch after the grid without a gap
-    if (run > 0 && eval_list(s, A, w, ray, run, run_a, tend, tmax, self, visit)) return true;
-    return tend < tstop && eval_list(s, A, w, ray, A->outer, tend, tstop, tmax, self, visit);
+    return stopped || out(run, run_a, tend);
+}
+
+// The list for a shadow ray from x towards the buffer's light, and the part (*ta, *tb] of the
+// ray in that list's zone; before and after it the ray is outside the grid's box, where the
+// outer list holds. `outer` alone when the ray misses the grid's box; -1 when x is in no voxel's
+// reach (then the grid is walked).
+inline int lightbuf_find(const LightBuf &B, int outer, R3 x, real tmax, real *ta, real *tb) {
+    if (B.faces == 0) return -1;
+    R3 m = x - B.o;
+    const LightFace &F = B.f[B.point ? cube_face(m) : 0];
+    real g[3] = {dot(m, F.e[0]), dot(m, F.e[1]), dot(m, F.e[2])};
+    *ta = 0;
+    *tb = tmax;
+    if (B.point) {
+        if (!(g[2] > 0)) return -1;  // at the light, or not a number
+        if (F.n[2] == 0) return outer;
+        real k = (real)1 / g[2];
+        g[0] *= k;
+        g[1] *= k;
+    }
+    // (a point light's zones are widened: CELL_SLACK)
+    int cell, in = face_cell(F, g[0], g[1], B.point ? CELL_SLACK : 0, &cell);
+    if (in <= 0) return in < 0 ? -1 : outer;  // not a number; beside the grid's box
+    real k = (g[2] - F.lo[2]) * F.inv[2];
+    if (k != k) return -1;
+    int slab;
+    if (!B.point) {  // w grows towards the light
+        if (!(k < (real)F.n[2])) return outer;  // past the box already
+        *tb = B.top - g[2];
+        slab = k < 0 ? 0 : (int)k;
+        if (k < 0) *ta = F.lo[2] - g[2];  // below the box: reaches it there
+    } else {         // w shrinks towards the light
+        if (k < 0) return outer;  // between the light and the box
+        slab = k < (real)F.n[2] ? (int)k : F.n[2] - 1;
+        if (!(k < (real)F.n[2])) *ta = tmax * ((real)1 - (F.lo[2] + (real)F.n[2] * F.h[2]) / g[2]);  // beyond it
+    }
+    return B.list[F.base + slab * F.n[1] * F.n[0] + cell];
+}
+
+// A light buffer's voxel (lightbuf_find): one list for the whole part of a shadow ray in the
+// voxel's zone, found before the ray starts.
+struct ZoneSource {
+    int L;
+    real ta, tb;
+    bool span(real *a, real *b) const {
+        *a = ta;
+        *b = tb;
+        return true;
+    }
+    template <class Out>
+    bool walk(Out &out, real a, real b) const { return out(L, a, b); }
+};
+
+// A cell of the eye's buffer: a primary ray stays in the cell and crosses its runs, slab by slab
+// outwards; all of the grid's box lies between the first slab and the last.
+struct EyeSource {
+    const LightFace *F;
+    const int *run, *end;  // the cell's runs
+    real inv;              // 1 / the ray's depth per unit of t
+    bool span(real *a, real *b) const {
+        *a = F->lo[2] * inv;
+        *b = (F->lo[2] + (real)end[-1] * F->h[2]) * inv;
+        return true;
+    }
+    template <class Out>
+    bool walk(Out &out, real t, real tb) const {
+        for (const int *r = run; r < end && t < tb; r += 2) {
+            real next = r + 2 < end ? (F->lo[2] + (real)r[1] * F->h[2]) * inv : tb;
+            next = next < tb ? next : tb;
+            if (out(r[0], t, next)) return true;
+            t = next;
+        }
+        return false;
+    }
+};
+
+// ---- [9b.8] Per ray: the ray driver, the shadow cache, the entry points ----
+// A new ray: a new stamp for what is kept per ray (3.5: no explicit unfreezing).
+void ray_begin(const Scene *s, Scratch *w) {
+    w->ray++;
+    if (w->ray == 0) {  // the stamps wrapped around: clear them
+        for (int i = 0; i < s->prims.n; i++) w->span[i].stamp = 0;
+        memset(w->nfrozen, 0, sizeof(unsigned) * (size_t)s->nodes.n);
+        memset(w->nfixed, 0, sizeof(unsigned) * (size_t)s->nodes.n);
+        w->ray = 1;
+    }
+    w->root_fixed = 0;
+}
+
+// Where a ray's stretches go: the one list evaluator, in order along the ray. Each stretch
+// (a, b] starts where the one before ended. operator() returns true when the visitor stopped or
+// nothing further can be seen.
+template <class Visit>
+struct Stretches {
+    const Scene *s;
+    Scratch *w;
+    const Ray &ray;
+    real tmax;
+    int self;
+    Visit &visit;
+    real at;  // where the last stretch ended
+    Stretches(const Scene *s_, Scratch *w_, const Ray &ray_, real tmax_, int self_, Visit &visit_)
+        : s(s_), w(w_), ray(ray_), tmax(tmax_), self(self_), visit(visit_), at(0) {}
+    bool operator()(int L, real a, real b) {
+        PRAY_ASSERT(a == at && a <= b && L >= 0 && L < s->accel->off.n);
+        at = b;
+        return eval_list(s, s->accel, w, ray, L, a, b, tmax, self, visit);
+    }
+};
+
+// The one way a ray reaches the accelerated scene: begin the ray, then give the list evaluator
+// the outer list up to the part the source covers, that part's stretches, and the outer list
+// after it, up to tmax. Without a grid, the outer list holds everything: with bounds, a node
+// whose box the ray misses is outside for the whole ray first. Returns true when the visitor
+// stopped or nothing further can be seen.
+template <class Visit, class Source>
+bool drive(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, const Source *src) {
+    const Accel *A = s->accel;
+    if (s->root < 0) return true;
+    ray_begin(s, w);
+    Stretches<Visit> out(s, w, ray, tmax, self, visit);
+    real ta = 0, tb = 0;
+    if (!src || !src->span(&ta, &tb) || !(tb > 0) || !(ta < tmax)) {
+        if (A->bounds && A->n[0] == 0) {
+            real inv[3];
+            ray_inverse(ray, inv);
+            for (int j = s->nodes.n - 1; j >= 0; j--) {
+                const Node &nd = s->nodes[j];
+                if (frozen(w, nd.parent)) {
+                    w->nfrozen[j] = w->ray;
+                    continue;
+                }
+                if (w->nfixed[j] == w->ray || !box_finite(nd.box)) continue;
+                real t0, t1;
+                if (ray_box(ray, inv, nd.box.lo, nd.box.hi, &t0, &t1) && t1 > 0 && t0 < tmax) continue;
+                w->nfixed[j] = w->ray;
+                w->nfixval[j] = 0;
+                if (A->freeze) settle(s, w, 2 * j + 1, false);
+            }
+        }
+        return out(A->outer, 0, tmax);
+    }
+    ta = ta > 0 ? ta : 0;
+    tb = tb < tmax ? tb : tmax;
+    if (ta > 0 && out(A->outer, 0, ta)) return true;
+    if (src->walk(out, ta, tb)) return true;
+    return tb < tmax && out(A->outer, tb, tmax);
 }
 
 // All hits along the ray in (0, tmax), by the reference or the accelerated path.
 template <class Visit>
 void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
-    if (s->accel) {
-        real inv[3];
-        ray_inverse(ray, inv);
-        trace_accel(s, w, ray, inv, tmax, tmax, self, visit);
-    } else sweep(s, w, ray, tmax, self, visit);
+    if (!s->accel) {
+        sweep(s, w, ray, tmax, self, visit);
+        return;
+    }
+    if (s->accel->n[0] == 0) {
+        drive(s, w, ray, tmax, self, visit, (const GridSource *)NULL);
+        return;
+    }
+    GridSource grid(s->accel, ray);
+    drive(s, w, ray, tmax, self, visit, &grid);
 }
 
 // The shadow cache (option shadowcache): the voxel where the last shadow ray towards the same
@@ -4610,17 +4704,17 @@ void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, 
 // there is zero; else the ray is traced as usual. What the whole ray lets through is a product
 // of the same factors and more, in order. When no factor is more than 1 in magnitude (the
 // cache is off otherwise), rounding is monotonic and the product starts at 1, so the whole
-// ray's product is at most the stretch's at every step: zero too. (Called when the light has a
-// voxel in the cache; `inv`: the direction's reciprocals.)
-bool shadow_probe(const Scene *s, Scratch *w, const Ray &ray, const real *inv, real tmax, int self, int light,
-                  ShadowHit &visit) {
+// ray's product is at most the stretch's at every step: zero too. The probe is a ray of its own
+// (ray_begin): it starts in the middle of the ray, where what was settled before is unknown.
+bool shadow_probe(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, ShadowHit &visit) {
     const Accel *A = s->accel;
     const int *ix = w->blocker + 3 * light;
-    real lo[3], hi[3], ta, tb;
+    real lo[3], hi[3], inv[3], ta, tb;
     for (int l = 0; l < 3; l++) {
         lo[l] = A->org[l] + (real)ix[l] * A->h;
         hi[l] = lo[l] + A->h;
     }
+    ray_inverse(ray, inv);
     if (!ray_box(ray, inv, lo, hi, &ta, &tb)) return false;
     ta = ta > 0 ? ta : 0;
     tb = tb < tmax ? tb : tmax;
@@ -4636,49 +4730,27 @@ bool shadow_probe(const Scene *s, Scratch *w, const Ray &ray, const real *inv, r
 }
 
 // The hits along a shadow ray towards light `light`: the shadow cache's answer when it has one;
-// else from the list of the light buffer's voxel when the ray starts in one; else along the grid
-// to the light's core and from the core's list when the light has one; else as any other ray.
+// else through the light buffer's voxel when the ray starts in one; else as any other ray.
 void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, ShadowHit &visit) {
     const Accel *A = s->accel;
-    if (!A) {
+    if (!A || A->n[0] == 0) {
         find_hits(s, w, ray, tmax, self, visit);
         return;
     }
-    real inv[3], ta = 0, tb = 0;  // (the reciprocals only when needed: not for a light buffer's voxel)
-    bool cache = A->cache && A->n[0] > 0, probe = cache && w->blocker[3 * light] >= 0;
-    if (probe) {
-        ray_inverse(ray, inv);
-        if (shadow_probe(s, w, ray, inv, tmax, self, light, visit)) return;
-    }
-    const LightBuf *B = A->lbuf ? &A->lbuf[light] : NULL;
-    int L = B ? lightbuf_find(*B, A->outer, ray.o, tmax, &ta, &tb) : -1;
-    if (L < 0 && !probe) ray_inverse(ray, inv);
-    // (a ray that misses the core's box, by rounding, walks the grid)
-    bool core = L < 0 && B && B->core >= 0 && ray_box(ray, inv, B->core_lo, B->core_hi, &ta, &tb) && ta < tmax;
-    if (L >= 0) {
-        w->k.lbuf += 1;
-        ray_begin(s, w);
-        if (!(ta > 0 && eval_list(s, A, w, ray, A->outer, 0, ta, tmax, self, visit)) &&
-            !eval_list(s, A, w, ray, L, ta, tb, tmax, self, visit) && tb < tmax)
-            eval_list(s, A, w, ray, A->outer, tb, tmax, tmax, self, visit);
-    } else if (core) {  // the grid to the core, then the core's list to the light
-        w->k.core += 1;
-        if (ta > 0) {
-            if (!trace_accel(s, w, ray, inv, tmax, ta, self, visit))
-                eval_list(s, A, w, ray, core_list(*B, ray.o), ta, tmax, tmax, self, visit);
-        } else {
-            ray_begin(s, w);
-            eval_list(s, A, w, ray, core_list(*B, ray.o), 0, tmax, tmax, self, visit);
-        }
-    } else trace_accel(s, w, ray, inv, tmax, tmax, self, visit);
     int *ix = w->blocker + 3 * light;
-    if (cache && !(czero(visit.f) && voxel_of(A, ray.o + ray.d * visit.t, ix))) ix[0] = -1;
+    if (A->cache && ix[0] >= 0 && shadow_probe(s, w, ray, tmax, self, light, visit)) return;
+    ZoneSource zone;
+    zone.L = A->lbuf ? lightbuf_find(A->lbuf[light], A->outer, ray.o, tmax, &zone.ta, &zone.tb) : -1;
+    if (zone.L >= 0) {  // (the outer list alone when the ray misses the grid's box)
+        w->k.lbuf += 1;
+        drive(s, w, ray, tmax, self, visit, &zone);
+    } else find_hits(s, w, ray, tmax, self, visit);
+    if (A->cache && !(czero(visit.f) && voxel_of(A, ray.o + ray.d * visit.t, ix))) ix[0] = -1;
 }
 
-// The hits along a primary ray, which starts at the eye: when the eye has a buffer, the ray
-// stays in one of its cells and walks that cell's pieces slab by slab, outwards, with the outer
-// list before and after them (all of the grid's box lies between the first slab and the last);
-// else as any other ray.
+// The hits along a primary ray, which starts at the eye: through the cell of the eye's buffer
+// that holds its direction, when the eye has a buffer and the cell has runs; else as any other
+// ray.
 template <class Visit>
 void primary_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, Visit &visit) {
     const Accel *A = s->accel;
@@ -4689,33 +4761,23 @@ void primary_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, Visit &
         find_hits(s, w, ray, tmax, -1, visit);
         return;
     }
-    const int *run = NULL, *end = NULL;  // the cell's runs; NULL: the ray misses the box
+    EyeSource eye;
+    eye.F = F;
+    eye.run = eye.end = NULL;  // no runs: the ray misses the grid's box
+    eye.inv = (real)1 / g2;
     if (F->n[2] > 0) {
         int cell, in = face_cell(*F, dot(ray.d, F->e[0]) / g2, dot(ray.d, F->e[1]) / g2, CELL_SLACK, &cell);
         if (in > 0) {
-            run = B->runs + B->runs[F->cbase + cell];
-            end = B->runs + B->runs[F->cbase + cell + 1];
+            eye.run = B->runs + B->runs[F->cbase + cell];
+            eye.end = B->runs + B->runs[F->cbase + cell + 1];
         }
-        if (in < 0 || (run && run[0] < 0)) {
+        if (in < 0 || (eye.run && eye.run[0] < 0)) {
             find_hits(s, w, ray, tmax, -1, visit);
             return;
         }
     }
     w->k.ebuf += 1;
-    ray_begin(s, w);
-    if (!run) {
-        eval_list(s, A, w, ray, A->outer, 0, tmax, tmax, -1, visit);
-        return;
-    }
-    real inv = (real)1 / g2, t = F->lo[2] * inv;
-    if (t > 0 && eval_list(s, A, w, ray, A->outer, 0, t, tmax, -1, visit)) return;
-    t = t > 0 ? t : 0;
-    for (; run < end && t < tmax; run += 2) {
-        real next = (F->lo[2] + (real)run[1] * F->h[2]) * inv;
-        if (run[0] > 0 && eval_list(s, A, w, ray, run[0], t, next, tmax, -1, visit)) return;
-        t = next;
-    }
-    if (t < tmax) eval_list(s, A, w, ray, A->outer, t, tmax, tmax, -1, visit);
+    drive(s, w, ray, tmax, -1, visit, eye.run ? &eye : NULL);
 }
 
 // =============================================================================================
@@ -6448,7 +6510,6 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         c->stats.checks += k.checks;
         c->stats.frozen_skips += k.frozen;
         c->stats.rays_lightbuf += k.lbuf;
-        c->stats.rays_lightcore += k.core;
         c->stats.rays_eyebuf += k.ebuf;
         c->stats.rays_shadowcache += k.cache;
         scratch_release(c, &worker_at(wbuf, stride, i).w);
@@ -10087,7 +10148,7 @@ void print_stats(pray_ctx *c) {
             "primitives: %ld declared, %ld kept; nodes %ld\n"
             "grid: %d x %d x %d = %ld voxels, %ld distinct lists, %ld areas, %.0f bytes\n"
             "rays: primary %.0f (of %.0f without undersampling), shadow %.0f, reflected %.0f, refracted %.0f\n"
-            "light buffers: %ld voxels, %ld cores; shadow rays from them %.0f, through a core %.0f\n"
+            "light buffers: %ld voxels; shadow rays from them %.0f\n"
             "eye buffer: %ld voxels; primary rays from it %.0f\n"
             "shadow cache: shadow rays it stopped %.0f\n"
             "traversal: %.0f voxel steps, %.0f area moves\n"
@@ -10095,7 +10156,7 @@ void print_stats(pray_ctx *c) {
             "intersection tests %.0f\n"
             "time: parse %.3f s, prepare %.3f s, render %.3f s on %d thread%s\n",
             s.primitives_declared, s.primitives, s.nodes, s.grid[0], s.grid[1], s.grid[2], s.voxels, s.lists,
-            s.areas, s.memory, s.rays_primary, s.rays_primary_full, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.lightbuf_voxels, s.lightbuf_cores, s.rays_lightbuf, s.rays_lightcore, s.eyebuf_voxels, s.rays_eyebuf, s.rays_shadowcache, s.voxel_steps,
+            s.areas, s.memory, s.rays_primary, s.rays_primary_full, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.lightbuf_voxels, s.rays_lightbuf, s.eyebuf_voxels, s.rays_eyebuf, s.rays_shadowcache, s.voxel_steps,
             s.area_moves, s.set_inside, s.set_outside, s.checks, s.frozen_skips, s.intersection_tests,
             s.time_parse, s.time_prepare, s.time_render, s.threads, s.threads == 1 ? "" : "s");
 }

@@ -9,9 +9,9 @@
 #define PRAY_HPP
 
 #define PRAY_VERSION_MAJOR 0
-#define PRAY_VERSION_MINOR 1
+#define PRAY_VERSION_MINOR 2
 #define PRAY_VERSION_PATCH 0
-#define PRAY_VERSION_STRING "0.1.0"
+#define PRAY_VERSION_STRING "0.2.0"
 
 /* ---------------------------------------------------------------------------------------------
    Configuration. Every macro is optional; define it on the command line or in a header named by
@@ -54,7 +54,7 @@ typedef enum pray_status {
 
 /* The text of a status code ("ok", "out of memory", ...). Never NULL. */
 const char *pray_status_text(pray_status s);
-/* "0.1.0". */
+/* "0.2.0". */
 const char *pray_version(void);
 /* The configuration compiled in, e.g. "interp stdio png threads real=double". */
 const char *pray_features(void);
@@ -327,8 +327,6 @@ typedef struct pray_stats {
     double rays_primary_full;        /* primary rays without undersampling (option adaptive) */
     long lightbuf_voxels;            /* voxels of the light buffers (option lightbuffer) */
     double rays_lightbuf;            /* shadow rays answered by a light buffer's list */
-    long lightbuf_cores;             /* point lights' cores: boxes around the lights with one list */
-    double rays_lightcore;           /* shadow rays that walked the grid only to a light's core */
     long eyebuf_voxels;              /* voxels of the eye's buffer (option eyebuffer) */
     double rays_eyebuf;              /* primary rays traced through the eye's buffer */
     double rays_shadowcache;         /* shadow rays stopped by the shadow cache (option shadowcache) */
