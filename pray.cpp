@@ -3040,7 +3040,7 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
                     if (solid[j] < 0) {
                         solid[j] = ns++;
                         mem = solids.push(c, j) && solids.push(c, inv);
-                        ok = ok && mem;
+                        ok = mem;
                     }
                     k = solid[j];
                 }
@@ -3051,7 +3051,7 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
         // decisive: the member outside for good fixes its solid's node for good, as settling
         // would (not when it stands under a node whose other children, constant in this region,
         // may change along the ray, such as a union)
-        bool decisive = k >= 0;
+        bool decisive = ok && k >= 0;
         for (int m = 0, e = 2 * prims[i], v = inv; decisive; m++) {
             const Node &nd = s->nodes[path[m]];
             bool first = elem_first(s, e);
@@ -3062,8 +3062,7 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
             v = fix;
             e = 2 * path[m] + 1;
         }
-        mem = !ok || plan->push(c, (k + 1) * 4 + decisive * 2 + inv);
-        ok = ok && mem;
+        if (ok) mem = ok = plan->push(c, (k + 1) * 4 + decisive * 2 + inv);
     }
     for (int i = 0; ok && i < solids.n; i++) {
         mem = plan->push(c, solids[i]);
@@ -4483,7 +4482,8 @@ bool GridSource::walk(Out &out, real t, real tend) const {
         if (L == run && merge) {
             moves++;  // same list: a move, no evaluation
         } else {
-            if (run >= 0 && out(run, run_a, t)) {
+            if (run == 0) out.pass(run_a, t);
+            else if (run > 0 && out(run, run_a, t)) {
                 stopped = true;
                 break;
             }
@@ -4533,7 +4533,10 @@ bool GridSource::walk(Out &out, real t, real tend) const {
     out.w->k.moves += (double)moves;
     // the last stretch ends where the ray leaves the grid's box, whatever rounding the stepping
     // gathered, so that it meets the stretch after the grid without a gap
-    return stopped || out(run, run_a, tend);
+    if (stopped) return true;
+    if (run > 0) return out(run, run_a, tend);
+    out.pass(run_a, tend);
+    return false;
 }
 
 // The list for a shadow ray from x towards the buffer's light, and the part (*ta, *tb] of the
@@ -4641,6 +4644,12 @@ struct Stretches {
         PRAY_ASSERT(a == at && a <= b && L >= 0 && L < s->accel->off.n);
         at = b;
         return eval_list(s, s->accel, w, ray, L, a, b, tmax, self, visit);
+    }
+    // a stretch of the empty list 0, where nothing can be hit
+    void pass(real a, real b) {
+        PRAY_ASSERT(a == at && a <= b);
+        at = b;
+        (void)a;
     }
 };
 

@@ -766,6 +766,52 @@ TEST_CASE("accel images: nine examples at 48 x 48, every grid x freeze x merge x
     CHECK_MESSAGE(freeze_violations == 0, freeze_violations << " cases where freezing added intersection tests:" << all);
 }
 
+TEST_CASE("accel freezing: each evaluation path freezes: fewer intersection tests than freeze=0, the same image") {
+    // Three scenes whose lists take each path of the list evaluator: a block minus cylinders
+    // (holed plans: the flat sweep), a field of boxes of half-spaces (plain plans: the nearest
+    // entry), and a block minus boxes (a union under the block: no plan, the full evaluation).
+    // A ray that leaves a solid for good fixes its node, and its other members are skipped.
+    const std::string head = "perspective <1.6, 0, 0>, <0, 0, -1.6>, [0.3, -5, 1.2], [0, 0, 0]\n"
+                             "M = phong({0.7}, {0.2}, {0.1}, 10)\n";
+    // Bx = the box of half side R around [X, Y, Z]
+    const std::string box = "Bx = plane(M, [X + R, Y, Z], <1, 0, 0>) & plane(M, [X - R, Y, Z], <-1, 0, 0>) & "
+                            "plane(M, [X, Y + R, Z], <0, 1, 0>) & plane(M, [X, Y - R, Z], <0, -1, 0>) & "
+                            "plane(M, [X, Y, Z + R], <0, 0, 1>) & plane(M, [X, Y, Z - R], <0, 0, -1>)\n";
+    const std::string tail = "rendertiff S | plane(M, [0, 0, -1.5], <0, 0, 1>), dirlight({0.8}, <-0.5, 1, -1.5>)\n";
+    const std::string block = "X = 0\nY = 0\nZ = 0\nR = 1\n" + box + "S = Bx\n";
+    struct Case {
+        std::string name, body;
+    } cases[] = {
+        {"block minus cylinders",
+         block + "I = 0\nwhile I < 5\n  A = -0.8 + 0.4*I\n  J = 0\n  while J < 5\n"
+                 "    B = -0.8 + 0.4*J\n    S = S - cylinder(M, [A, 0, B], <0, 1, 0>, 0.1) - cylinder(M, [0, A, B], <1, 0, 0>, 0.1)\n"
+                 "    J = J + 1\n  endwhile\n  I = I + 1\nendwhile\n"},
+        {"field of boxes",
+         "S = nothing\nR = 0.12\nI = 0\nwhile I < 8\n  J = 0\n  while J < 8\n"
+         "    X = -1.4 + 0.4*I\n    Y = 0.2*((I + J) % 3)\n    Z = -1.4 + 0.4*J\n  " + box +
+         "    S = S | Bx\n    J = J + 1\n  endwhile\n  I = I + 1\nendwhile\n"},
+        {"block minus boxes",
+         block + "R = 0.15\nI = 0\nwhile I < 4\n  J = 0\n  while J < 4\n"
+                 "    X = -0.75 + 0.5*I\n    Z = -0.75 + 0.5*J\n    Y = -1\n  " + box + "    S = S - Bx\n"
+                 "    Y = 1\n  " + box + "    S = S - Bx\n    J = J + 1\n  endwhile\n  I = I + 1\nendwhile\n"},
+    };
+    for (const Case &k : cases) {
+        CAPTURE(k.name);
+        std::string prog = head + k.body + tail;
+        std::vector<std::string> size = {"width=64", "height=64"};
+        Run on = run_program(k.name, prog, size);
+        std::vector<std::string> off_opts = size;
+        off_opts.push_back("freeze=0");
+        Run off = run_program(k.name, prog, off_opts);
+        REQUIRE_MESSAGE(on.status == PRAY_OK, on.error);
+        REQUIRE_MESSAGE(off.status == PRAY_OK, off.error);
+        CHECK(frame_difference(off.frames, on.frames) == "");
+        CHECK(on.stats.frozen_skips > 0);
+        CHECK(off.stats.frozen_skips == 0);
+        CHECK(on.stats.intersection_tests < off.stats.intersection_tests);
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // Random scenes rendered through pray_render: the same images, fewer tests with freezing.
 // ---------------------------------------------------------------------------------------------
