@@ -2997,17 +2997,20 @@ struct OuterClass {
 // node is on its boundary). A node with more is a union or an intersection (a difference: its
 // first child and the others turned inside out), the one turned into the other by an odd number
 // of inversions above it. An intersection right under the unions starts a solid, which the
-// intersections under it join; a union under a solid leaves the list without a plan.
-// Appends to `plan` the number of solids and 1 when holed; per primitive of the list,
-// (solid + 1) * 4 + (2 when decisive) + (1 when turned inside out), solid -1 standing alone (a
-// member is decisive when its being outside for good fixes its solid: fix_solid); per solid, its
-// node and
+// intersections under it join; a union under a solid starts a group (a wall with a window: the
+// wall's block minus the opening's box, which turned inside out is a union), which the unions
+// under it join; an intersection under a group leaves the list without a plan. A solid with a
+// group is holed. Appends to `plan` the number of solids, 1 when holed, the number of groups;
+// per primitive of the list, (solid + 1) * 4 + (2 when decisive) + (1 when turned inside out),
+// solid -1 standing alone (a member is decisive when its being outside for good fixes its solid:
+// fix_solid); when there are groups, per primitive its group or -1, then per group its solid;
+// per solid, its node and
 // 1 when it is turned inside out above that node (the solid's inside is then the node's outside:
 // a node's status fixed for the ray fixes its solid's, plan_fixed). Returns where that starts,
 // or -1 (appending nothing) when the list has no plan, -2 when out of memory. `kids`, `solid`:
 // per node scratch, 0 and -1 on entry and left so.
 const int PLAN_DEPTH = 64;  // deeper trees are evaluated in full
-const int PLAN_HEAD = 2;    // a plan's numbers before the primitives'
+const int PLAN_HEAD = 3;    // a plan's numbers before the primitives'
 
 int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, Array<int> *plan) {
     int na = d[0], np = d[1];
@@ -3016,11 +3019,13 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
         if (s->nodes[nodes[3 * i]].parent >= 0) kids[s->nodes[nodes[3 * i]].parent]++;
     for (int i = 0; i < np; i++)
         if (s->prims[prims[i]].parent >= 0) kids[s->prims[prims[i]].parent]++;
-    int base = plan->n, ns = 0;
+    int base = plan->n, ns = 0, ng = 0;
     bool holed = false;
-    Array<int> solids;  // per solid: its node, inverted above it
+    Array<int> solids, group, gsolid;  // per solid: its node, inverted above it; per primitive; per group
     solids.init();
-    bool mem = np == 0 || (plan->push(c, 0) && plan->push(c, 0)), ok = np > 0 && mem;
+    group.init();
+    gsolid.init();
+    bool mem = np == 0 || (plan->push(c, 0) && plan->push(c, 0) && plan->push(c, 0)), ok = np > 0 && mem;
     for (int i = 0; ok && i < np; i++) {
         int path[PLAN_DEPTH], n = 0;  // the ancestors, the root last
         for (int p = s->prims[prims[i]].parent; ok && p >= 0; p = s->nodes[p].parent) {
@@ -3028,14 +3033,14 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
             if (ok) path[n++] = p;
         }
         bool inv = false;
-        int k = -1;  // the solid, -1 while under unions only
+        int k = -1, g = -1;  // the solid, -1 while under unions only; the group
         for (int m = n - 1; ok && m >= 0; m--) {
             int j = path[m];
             const Node &nd = s->nodes[j];
             int child = m > 0 ? 2 * path[m - 1] + 1 : 2 * prims[i];
             if (kids[j] > 1) {
                 bool inter = (nd.op != O_UNION) != inv;
-                ok = inter || k < 0;
+                ok = !(inter && g >= 0);
                 if (inter && k < 0) {
                     if (solid[j] < 0) {
                         solid[j] = ns++;
@@ -3043,6 +3048,13 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
                         ok = mem;
                     }
                     k = solid[j];
+                } else if (!inter && k >= 0 && g < 0) {
+                    if (solid[j] < 0) {
+                        solid[j] = ng++;
+                        mem = gsolid.push(c, k);
+                        ok = mem;
+                    }
+                    g = solid[j];
                 }
             }
             if (nd.op == O_COMPL || (nd.op == O_DIFF && !elem_first(s, child))) inv = !inv;
@@ -3062,13 +3074,14 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
             v = fix;
             e = 2 * path[m] + 1;
         }
-        if (ok) mem = ok = plan->push(c, (k + 1) * 4 + decisive * 2 + inv);
+        if (ok) mem = ok = plan->push(c, (k + 1) * 4 + decisive * 2 + inv) && group.push(c, g);
     }
-    for (int i = 0; ok && i < solids.n; i++) {
-        mem = plan->push(c, solids[i]);
-        ok = mem;
-    }
+    for (int i = 0; ok && ng > 0 && i < np; i++) mem = ok = plan->push(c, group[i]);
+    for (int i = 0; ok && i < ng; i++) mem = ok = plan->push(c, gsolid[i]);
+    for (int i = 0; ok && i < solids.n; i++) mem = ok = plan->push(c, solids[i]);
     solids.release(c);
+    group.release(c);
+    gsolid.release(c);
     for (int i = 0; i < na; i++) {
         int j = nodes[3 * i];
         solid[j] = -1;
@@ -3079,7 +3092,8 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
         return mem ? -1 : -2;
     }
     plan->p[base] = ns;
-    plan->p[base + 1] = holed;
+    plan->p[base + 1] = holed || ng > 0;
+    plan->p[base + 2] = ng;
     return base;
 }
 
@@ -4074,42 +4088,48 @@ inline void fix_solid(const Scene *s, Scratch *w, const int *solids, int k) {
 }
 
 // The flat sweep of a list with a plan (list_plan), holed or not, on the part (a, b] of the ray
-// (and t < tmax): each solid is inside where the ray is in all of its members, the root where it
-// is in one solid or more. The crossings are taken in order, and each changes one primitive,
-// perhaps its solid, perhaps the root. A solid whose node is fixed for the ray keeps its status
-// and its members are frozen (3.5). Returns true when `visit` stopped or nothing further can be
-// seen.
+// (and t < tmax): each group is inside where the ray is in one of its members, each solid where
+// it is in all of its members, the root where it is in one solid or more. The crossings are taken
+// in order, and each changes one primitive, perhaps its group, perhaps its solid, perhaps the
+// root. A solid whose node is fixed for the ray keeps its status and its members are frozen
+// (3.5); primitives standing alone are not settled here (they have nothing under them to
+// freeze). Returns true when `visit` stopped or nothing further can be seen.
 template <class Visit>
 bool eval_flat(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const int *prims, int np, const int *plan,
                real a, real b, real tmax, int self, Visit &visit) {
-    int ns = plan[0];
-    const int *code = plan + PLAN_HEAD, *solids = code + np;
+    int ns = plan[0], ng = plan[2];
+    const int *code = plan + PLAN_HEAD, *group = ng ? code + np : NULL, *gsolid = code + 2 * np,
+              *solids = code + (ng ? 2 * np + ng : np);
+    const bool freeze = A->freeze != 0;
+    Hull *hull = w->hull, *gh = hull + ns;  // (the groups' counts after the solids')
+    bool fixed = false;  // some solid is fixed (then its members are skipped)
     for (int k = 0; k < ns; k++) {
-        w->hull[k].need = w->hull[k].have = 0;
+        hull[k].need = hull[k].have = 0;
         plan_fixed(w, solids, k);
+        fixed = fixed || hull[k].fixed;
     }
+    for (int g = 0; g < ng; g++) gh[g].have = 0;
     int in = 0, nc = 0;  // solids (and primitives standing alone) the ray is in
     for (int i = 0; i < np; i++) {
-        int p = prims[i], k = plan_solid(code, i);
-        if (k >= 0 && w->hull[k].fixed) {
+        int p = prims[i], c = code[i], k = (c >> 2) - 1;
+        if (fixed && k >= 0 && hull[k].fixed) {
             w->k.frozen += 1;
             continue;
         }
         const Span &sp = span_get(s, w, ray, p, self);
-        bool tin = sp.kind == SPAN_ALL || (sp.kind == SPAN && sp.t0 <= a && a < sp.t1);
-        bool st = tin != (code[i] & 1);
-        if (A->freeze) {
-            // a member outside for the rest of the ray: its solid too; one standing alone
-            // settles as in the full evaluation
-            if (k < 0) settle_prim(s, w, p, tin, sp.kind, sp.t0, sp.t1, a);
-            else if (!st && (code[i] & 2) && (sp.kind != SPAN || (code[i] & 1 ? sp.t0 <= a && sp.t1 >= REAL_INF : sp.t1 <= a))) {
+        bool st = (sp.kind == SPAN_ALL || (sp.kind == SPAN && sp.t0 <= a && a < sp.t1)) != (c & 1);
+        if (k < 0) in += st;
+        else if (group && group[i] >= 0) gh[group[i]].have += st;  // a group is in when a member is
+        else {
+            // a decisive member outside for the rest of the ray: its solid too
+            if (!st && (c & 2) && freeze && (sp.kind != SPAN || (c & 1 ? sp.t0 <= a && sp.t1 >= REAL_INF : sp.t1 <= a))) {
                 fix_solid(s, w, solids, k);
+                if (w->root_fixed) return true;  // the root keeps its status from a on
+                fixed = true;
                 continue;
             }
-            if (w->root_fixed) return true;  // the root keeps its status from a on
+            hull[k].need++, hull[k].have += st;
         }
-        if (k < 0) in += st;
-        else w->hull[k].need++, w->hull[k].have += st;
         if (sp.kind != SPAN) continue;
         for (int e = 1; e >= 0; e--) {
             real t = e ? sp.t0 : sp.t1;
@@ -4121,10 +4141,8 @@ bool eval_flat(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
         }
     }
     if (nc == 0) return false;
-    for (int k = 0; k < ns; k++) {
-        const Hull &u = w->hull[k];
-        in += u.fixed ? u.fixed == 2 : u.need == u.have;
-    }
+    for (int g = 0; g < ng; g++) hull[gsolid[g]].need++, hull[gsolid[g]].have += gh[g].have > 0;
+    for (int k = 0; k < ns; k++) in += hull[k].fixed ? hull[k].fixed == 2 : hull[k].need == hull[k].have;
     // (the list's primitives are in the order of their numbers, so the crossings sort as the
     // full evaluation's do)
     if (nc > 1) sort_crossings(w->cross, nc);
@@ -4135,23 +4153,25 @@ bool eval_flat(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
         int last = -1;  // crossings at the same t together, as in the full evaluation
         for (; j < nc && w->cross[j].t == t; j++) {
             const Cross &x = w->cross[j];
-            int i = x.prim, k = plan_solid(code, i), st = (x.enter != 0) != (code[i] & 1) ? 1 : -1;
+            int i = x.prim, c = code[i], k = (c >> 2) - 1, st = (x.enter != 0) != (c & 1) ? 1 : -1;
             if (k < 0) in += st;
             else {
-                Hull &u = w->hull[k];
-                if (u.fixed) continue;
+                Hull &u = hull[k];
+                if (fixed && u.fixed) continue;
+                if (group && group[i] >= 0) {  // the group's member: the group changes, or nothing
+                    Hull &G = gh[group[i]];
+                    bool gwas = G.have > 0;
+                    G.have += st;
+                    if (gwas == (G.have > 0)) continue;
+                }
                 bool was = u.have == u.need;
                 u.have += st;
                 if (was != (u.have == u.need)) in += was ? -1 : 1;
             }
             if ((in > 0) != root) root = !root, last = j;
-            if (!A->freeze) continue;
-            int p = prims[i];
-            if (k < 0) {
-                if ((s->prims[p].settles & (x.enter ? 2 : 1)) && (!x.enter || w->span[p].t1 >= REAL_INF))
-                    settle(s, w, 2 * p, x.enter != 0);
-            } else if (st < 0 && (code[i] & 2) && (!(code[i] & 1) || w->span[p].t1 >= REAL_INF)) {
+            if (st < 0 && (c & 2) && freeze && (!(c & 1) || w->span[prims[i]].t1 >= REAL_INF)) {
                 fix_solid(s, w, solids, k);  // (left for good: it is entered once at most)
+                fixed = true;
             }
         }
         if (root != before && last >= 0) {
@@ -4181,10 +4201,13 @@ template <class Visit>
 int eval_plain(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const int *prims, int np, const int *plan,
                real *pa, real b, real tmax, int self, Visit &visit) {
     int ns = plan[0];
-    const int *code = plan + PLAN_HEAD, *solids = code + np;
+    const int *code = plan + PLAN_HEAD, *solids = code + np;  // (a plain plan has no groups)
     real a = *pa;
+    const bool freeze = A->freeze != 0;
+    Hull *hull = w->hull;
+    bool fixed = false;  // some solid is fixed (then its members are skipped)
     for (int k = 0; k < ns; k++) {
-        Hull &u = w->hull[k];
+        Hull &u = hull[k];
         u.t0 = -REAL_INF;
         u.t1 = REAL_INF;
         u.prim = -1;
@@ -4192,7 +4215,7 @@ int eval_plain(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
         u.tie = 0;
         plan_fixed(w, solids, k);
         if (u.fixed == 2) return -1;
-        if (u.fixed) u.t1 = -REAL_INF;
+        if (u.fixed) u.t1 = -REAL_INF, fixed = true;
     }
     int first = -1, first_enter = 1;
     real tf = 0;
@@ -4202,7 +4225,7 @@ int eval_plain(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
         bool tie = false;
         if (i < np) {  // the primitives: the members of intersections are gathered first
             int k = plan_solid(code, i);
-            if (k >= 0 && w->hull[k].fixed) {
+            if (fixed && k >= 0 && hull[k].fixed) {
                 w->k.frozen += 1;
                 continue;
             }
@@ -4217,11 +4240,12 @@ int eval_plain(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
                 else t1 = t0, t0 = -REAL_INF;
             }
             if (k >= 0) {
-                Hull &u = w->hull[k];
-                if (A->freeze && (code[i] & 2) && (kind == SPAN_NONE || (kind == SPAN && t1 <= a))) {
+                Hull &u = hull[k];
+                if (freeze && (code[i] & 2) && (kind == SPAN_NONE || (kind == SPAN && t1 <= a))) {
                     fix_solid(s, w, solids, k);  // a member outside for the rest of the ray
                     if (w->root_fixed) return 1;
                     u.t1 = -REAL_INF;
+                    fixed = true;
                     continue;
                 }
                 if (kind == SPAN_NONE) u.t1 = -REAL_INF;
@@ -4232,7 +4256,7 @@ int eval_plain(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
                 continue;
             }
         } else {  // then the intersections, as solids
-            const Hull &u = w->hull[i - np];
+            const Hull &u = hull[i - np];
             p = u.prim;
             enter = u.enter;
             t0 = u.t0;
@@ -4669,12 +4693,10 @@ bool drive(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visi
         if (A->bounds && A->n[0] == 0) {
             real inv[3];
             ray_inverse(ray, inv);
-            for (int j = s->nodes.n - 1; j >= 0; j--) {
+            for (int j = s->nodes.n - 1; j >= 0; j--) {  // (parents first)
                 const Node &nd = s->nodes[j];
-                if (frozen(w, nd.parent)) {
-                    w->nfrozen[j] = w->ray;
-                    continue;
-                }
+                // a frozen node is still fixed by its own box, which a list with a plan reads
+                if (frozen(w, nd.parent)) w->nfrozen[j] = w->ray;
                 if (w->nfixed[j] == w->ray || !box_finite(nd.box)) continue;
                 real t0, t1;
                 if (ray_box(ray, inv, nd.box.lo, nd.box.hi, &t0, &t1) && t1 > 0 && t0 < tmax) continue;

@@ -5,23 +5,27 @@
 # too, POV-Ray only where bench/pov/ has a twin. Prints a table of CPU times (user + system of
 # the whole process, best of RUNS, default 1) and the ratio POV-Ray / pray, with its geometric
 # mean.
-# Usage: bench/suite/run.sh [--size N] [--quick] [--compare REF] [--only PATTERN]
+# Usage: bench/suite/run.sh [--size N] [--quick] [--compare REF] [--only PATTERN] [--instructions]
 #   --size N        image size N x N (default 512)
 #   --quick         size 64, no POV-Ray; checks that every scene renders byte for byte the same
 #                   with pray's default options and with --brute (exits 1 on any difference);
 #                   scenes of over 20000 primitives at half the size, to keep --brute short
 #   --compare REF   also time REF, another pray binary, and check it writes the same images
 #   --only PATTERN  only the scenes whose names match the shell pattern (e.g. 'csg-*')
+#   --instructions  count pray's instructions (millions, under valgrind's callgrind) instead of
+#                   timing it, and leave POV-Ray out: exact figures for deciding small
+#                   differences with --compare on a machine whose timings are noisy
 # Installs povray with apt-get when it is missing (not for --quick); builds ./pray if needed.
 set -e
 usage() { sed -n 's/^# Usage: //p' "$0" >&2; exit 2; }
-SIZE= QUICK= REF= ONLY='*'
+SIZE= QUICK= REF= ONLY='*' INSTR=
 while [ $# -gt 0 ]; do
   case $1 in
     --size) [ $# -ge 2 ] || usage; SIZE=$2; shift 2 ;;
     --quick) QUICK=1; shift ;;
     --compare) [ $# -ge 2 ] || usage; REF=$2; shift 2 ;;
     --only) [ $# -ge 2 ] || usage; ONLY=$2; shift 2 ;;
+    --instructions) INSTR=1; shift ;;
     *) usage ;;
   esac
 done
@@ -36,7 +40,10 @@ cd "$(dirname "$0")/../.."
 PY=/usr/bin/python3
 [ -x $PY ] || PY=python3
 
-if [ -z "$QUICK" ] && ! command -v povray >/dev/null 2>&1; then
+if [ -n "$INSTR" ] && ! command -v valgrind >/dev/null 2>&1; then
+  echo "run.sh: --instructions needs valgrind (apt-get install valgrind)" >&2; exit 2
+fi
+if [ -z "$QUICK" ] && [ -z "$INSTR" ] && ! command -v povray >/dev/null 2>&1; then
   echo "installing: povray" >&2
   if [ "$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi
   $SUDO apt-get update -qq
@@ -62,8 +69,15 @@ H="$PY $(pwd)/bench/pov/helper.py"
 program() {  # the PRAY program of scene $1 (the gallery's stay where their textures are)
   case $1 in gallery-*) echo "examples/${1#gallery-}.ray" ;; *) echo "$OUT/$1.ray" ;; esac
 }
-render() {   # render BINARY SCENE DIR [OPTIONS]: time it, "cpu wall" into $OUT/t
+render() {   # render BINARY SCENE DIR [OPTIONS]: time it, "cpu wall" into $OUT/t (--instructions:
+             # millions of instructions)
   b=$1; s=$2; d=$3; shift 3
+  if [ -n "$INSTR" ]; then
+    valgrind --tool=callgrind --callgrind-out-file="$OUT/cg" "$b" --quiet --threads 1 -D antialias=1 \
+      -s "${N}x$N" -o "$OUT/$d/$s.ppm" "$@" "$(program $s)" >/dev/null 2>&1
+    awk '/^summary:/ { printf "%.1f 0\n", $2 / 1e6 }' "$OUT/cg" > "$OUT/t"
+    return
+  fi
   $H time $RUNS "$OUT/t" "$b" --quiet --threads 1 -D antialias=1 -s "${N}x$N" \
     -o "$OUT/$d/$s.ppm" "$@" "$(program $s)"
 }
@@ -76,7 +90,10 @@ same() {     # same SCENE DIR1 DIR2: every frame of the scene identical in both 
 secs() { cut -d' ' -f1 "$OUT/t"; }
 ratio() { awk -v a="$1" -v b="$2" 'BEGIN { print (a > 0 && b > 0 ? a / b : 0) }'; }
 
-if [ -n "$QUICK" ]; then
+if [ -n "$INSTR" ]; then
+  echo "pray's instructions (millions, callgrind): ${SIZE}x$SIZE, one thread, no anti-aliasing"
+  printf '%-18s %7s %8s' scene prims pray
+elif [ -n "$QUICK" ]; then
   echo "pray's default against --brute: ${SIZE}x$SIZE (over 20000 primitives: half), one thread; CPU seconds"
   printf '%-18s %7s %8s %8s' scene prims pray brute
 else
@@ -100,6 +117,8 @@ while read -r s prims; do
     render "$PRAY" $s brute --brute
     if same $s new brute; then c=""; else c="  DIFFERENT with --brute"; bad=1; fi
     line="$line $(printf '%8.3f' "$(secs)")"
+  elif [ -n "$INSTR" ]; then
+    :
   elif [ -f "$OUT/$s.pov" ]; then
     (cd "$OUT" && $H time $RUNS "$OUT/t" povray "+I$s.pov" "+O$s-pov.ppm" "+W$SIZE" "+H$SIZE" \
       -A +WT1 -D +FP File_Gamma=1.0)
