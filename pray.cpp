@@ -4111,7 +4111,7 @@ bool eval_flat(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
     for (int g = 0; g < ng; g++) gh[g].have = 0;
     int in = 0, nc = 0;  // solids (and primitives standing alone) the ray is in
     for (int i = 0; i < np; i++) {
-        int p = prims[i], c = code[i], k = (c >> 2) - 1;
+        int p = prims[i], c = code[i], k = plan_solid(code, i);
         if (fixed && k >= 0 && hull[k].fixed) {
             w->k.frozen += 1;
             continue;
@@ -4153,7 +4153,7 @@ bool eval_flat(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
         int last = -1;  // crossings at the same t together, as in the full evaluation
         for (; j < nc && w->cross[j].t == t; j++) {
             const Cross &x = w->cross[j];
-            int i = x.prim, c = code[i], k = (c >> 2) - 1, st = (x.enter != 0) != (c & 1) ? 1 : -1;
+            int i = x.prim, c = code[i], k = plan_solid(code, i), st = (x.enter != 0) != (c & 1) ? 1 : -1;
             if (k < 0) in += st;
             else {
                 Hull &u = hull[k];
@@ -4195,8 +4195,7 @@ bool eval_flat(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
 // frozen (3.5). Returns 1 when `visit` stopped or nothing further can be seen, 0 when nothing
 // is entered in (a, b], -1 when the flat sweep must decide from *a on (a solid inside at a,
 // entries at the same t, a grazing touch, or the visitor going on through the solid entered).
-// (A primitive standing alone that is inside at a sends the list to the flat sweep, which
-// settles it.)
+// (Primitives standing alone are not settled: they have nothing under them to freeze.)
 template <class Visit>
 int eval_plain(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const int *prims, int np, const int *plan,
                real *pa, real b, real tmax, int self, Visit &visit) {
