@@ -479,7 +479,7 @@ struct TexName {
 enum {
     OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_CUTOFF, OPT_DEPTH, OPT_EYEBUFFER, OPT_FREEZE,
     OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_LIGHTBUFFER, OPT_MAXFRAMES, OPT_MAXLINE, OPT_MAXMEM, OPT_MAXNEST,
-    OPT_MAXOUTPUT, OPT_MAXPIXELS, OPT_MAXPRIMS, OPT_MAXRAYS, OPT_MAXSTEPS, OPT_MAXSTRING, OPT_MERGE, OPT_OUTPUT,
+    OPT_MAXOUTPUT, OPT_MAXPIXELS, OPT_MAXPRIMS, OPT_MAXRAYS, OPT_MAXSTEPS, OPT_MAXSTRING, OPT_MERGE, OPT_NEST, OPT_OUTPUT,
     OPT_SHADOWCACHE, OPT_SHADOWS, OPT_TEXMEM, OPT_THREADS,
     OPT_WIDTH, OPT_COUNT
 };
@@ -1401,6 +1401,7 @@ const OptDef OPTS[OPT_COUNT] = {
     {"maxsteps", 1e7, 0, 1e15, 1, 1e6},
     {"maxstring", 65536, 1, 16777216, 1, 4096},
     {"merge", 1, 0, 1, 1, 0},
+    {"nest", 2, 0, 4, 1, 0},
     {"output", 0, 0, 0, 0, 0},
     {"shadowcache", 1, 0, 1, 1, 0},
     {"shadows", 1, 0, 1, 1, 0},
@@ -1780,6 +1781,42 @@ void polyhedron_box(const Scene *s, const int *kids, int n, Box *b) {
     }
 }
 
+// An intersection of a cylinder with half-spaces that cut its axis on both sides (a rod, a
+// capped tube in any direction) lies in the piece of the cylinder between the farthest points
+// of the axis that the cylinder's sections in those planes reach: shrink box `b` to that piece's
+// box. (A half-space cuts the axis at t = (d - n.p) / (n.a); its section reaches r |n x a| / |n.a|
+// further along the axis; planes within about 6 degrees of the axis are left out.)
+void capped_cylinder_box(const Scene *s, const int *kids, int n, Box *b) {
+    for (int k = 0; k < n; k++) {
+        if (e_is_node(kids[k]) || s->prims[e_index(kids[k])].kind != O_CYLINDER) continue;
+        const Prim &cy = s->prims[e_index(kids[k])];
+        double r = (double)cy.r, t0 = -HUGE_VAL, t1 = HUGE_VAL, slack = 0;
+        for (int j = 0; j < n; j++) {
+            if (e_is_node(kids[j]) || s->prims[e_index(kids[j])].kind != O_PLANE) continue;
+            const Prim &q = s->prims[e_index(kids[j])];
+            double c = (double)q.n.x * cy.n.x + (double)q.n.y * cy.n.y + (double)q.n.z * cy.n.z;
+            if (fabs(c) < 0.1) continue;
+            double h = (double)q.n.x * cy.p.x + (double)q.n.y * cy.p.y + (double)q.n.z * cy.p.z;
+            double t = ((double)q.d - h + r * sqrt(1 - c * c > 0 ? 1 - c * c : 0)) / c;
+            slack += 64 * REAL_EPS * (fabs((double)q.d) + fabs(h) + r) / fabs(c);
+            if (c > 0 && t < t1) t1 = t;
+            if (c < 0 && t > t0) t0 = t;
+        }
+        if (!(t0 > -HUGE_VAL && t1 < HUGE_VAL && t0 <= t1)) continue;
+        t0 -= slack;
+        t1 += slack;
+        Box cb;
+        for (int l = 0; l < 3; l++) {
+            double a = (double)comp(cy.n, l), p = (double)comp(cy.p, l);
+            double e = r * sqrt(1 - a * a > 0 ? 1 - a * a : 0) + slack, x0 = p + a * t0, x1 = p + a * t1;
+            cb.lo[l] = (real)((x0 < x1 ? x0 : x1) - e);
+            cb.hi[l] = (real)((x0 < x1 ? x1 : x0) + e);
+        }
+        box_pad(&cb, r + fabs(t0) + fabs(t1) + fabs((double)cy.p.x) + fabs((double)cy.p.y) + fabs((double)cy.p.z));
+        box_clip(b, cb);
+    }
+}
+
 const Box &elem_box(const Scene *s, int e) {
     return e_is_node(e) ? s->nodes[e_index(e)].box : s->prims[e_index(e)].box;
 }
@@ -1796,6 +1833,7 @@ int add_node(pray_ctx *c, Scene *s, int op, const int *kids, int n) {
         nd.box = box_all();
         for (int i = 0; i < n; i++) box_clip(&nd.box, elem_box(s, kids[i]));
         polyhedron_box(s, kids, n, &nd.box);
+        capped_cylinder_box(s, kids, n, &nd.box);
     } else if (op == O_UNION) {
         for (int l = 0; l < 3; l++) {
             nd.box.lo[l] = REAL_BIG;
@@ -2593,13 +2631,21 @@ const int LIST_HEAD = 4;  // the numbers before the nodes
 inline const int *list_prims(const int *d) { return d + LIST_HEAD + 3 * d[0]; }
 inline int list_len(const int *d) { return LIST_HEAD + 3 * d[0] + d[1]; }
 
-struct Accel {
+// A uniform grid of cubic voxels. A voxel that holds many primitives to check has a grid of its
+// own, nested in it (Accel::nested), whose voxels are classed in turn: fine where the scene is
+// crowded, coarse where it is empty.
+struct Grid {
     int n[3];          // voxels per axis; all 0 without a grid
     real org[3], h;    // low corner of the grid and side of a voxel
     real top[3];       // high corner of the grid
     real inv_h;        // 1 / h
-    int *voxel;        // list of each voxel, x fastest
+    int *voxel;        // per voxel, x fastest: its list; -1 - g: the nested grid g
     unsigned char *reach;  // per voxel: how far around it every voxel has its list (see reach_build)
+};
+
+struct Accel {
+    Grid g;            // the grid over the scene
+    Array<Grid> nested;
     Array<int> data, off;
     Array<int> plan_at;  // per list: where its plan starts in `plan`, -1 when it has none (list_plan)
     Array<int> plan;
@@ -2615,8 +2661,11 @@ struct Accel {
 
 void accel_release(pray_ctx *c, Accel *a) {
     if (!a) return;
-    mem_free(c, a->voxel);
-    mem_free(c, a->reach);
+    for (int i = -1; i < a->nested.n; i++) {
+        mem_free(c, (i < 0 ? a->g : a->nested[i]).voxel);
+        mem_free(c, (i < 0 ? a->g : a->nested[i]).reach);
+    }
+    a->nested.release(c);
     a->data.release(c);
     a->off.release(c);
     a->plan_at.release(c);
@@ -2630,21 +2679,21 @@ void accel_release(pray_ctx *c, Accel *a) {
 }
 
 // The voxel that holds the point: its coordinates in ix; false when it is outside the grid.
-bool voxel_of(const Accel *A, R3 p, int *ix) {
+bool voxel_of(const Grid &G, R3 p, int *ix) {
     for (int l = 0; l < 3; l++) {
-        real g = (comp(p, l) - A->org[l]) * A->inv_h;
-        if (!(g >= 0 && g < (real)A->n[l])) return false;
+        real g = (comp(p, l) - G.org[l]) * G.inv_h;
+        if (!(g >= 0 && g < (real)G.n[l])) return false;
         ix[l] = (int)g;
     }
     return true;
 }
-inline long voxel_index(const Accel *A, const int *ix) { return ((long)ix[2] * A->n[1] + ix[1]) * A->n[0] + ix[0]; }
+inline long voxel_index(const Grid &G, const int *ix) { return ((long)ix[2] * G.n[1] + ix[1]) * G.n[0] + ix[0]; }
 
 // The box of the voxels from i0 to i1 - 1 along each axis, widened by the margin.
-void voxels_box(const Accel *a, const int *i0, const int *i1, double margin, real *lo, real *hi) {
+void voxels_box(const Grid &G, const int *i0, const int *i1, double margin, real *lo, real *hi) {
     for (int l = 0; l < 3; l++) {
-        lo[l] = (real)((double)a->org[l] + i0[l] * (double)a->h - margin);
-        hi[l] = (real)((double)a->org[l] + i1[l] * (double)a->h + margin);
+        lo[l] = (real)((double)G.org[l] + i0[l] * (double)G.h - margin);
+        hi[l] = (real)((double)G.org[l] + i1[l] * (double)G.h + margin);
     }
 }
 
@@ -2981,8 +3030,8 @@ struct OuterClass {
     int operator()(int i) const {
         const Box &bx = eff[i];
         if (box_empty(bx)) return CL_OUT;
-        bool inside = a->n[0] > 0;
-        for (int l = 0; l < 3 && inside; l++) inside = bx.lo[l] > a->org[l] && bx.hi[l] < a->top[l];
+        bool inside = a->g.n[0] > 0;
+        for (int l = 0; l < 3 && inside; l++) inside = bx.lo[l] > a->g.org[l] && bx.hi[l] < a->g.top[l];
         return inside ? CL_OUT : CL_BD;
     }
 };
@@ -3144,7 +3193,7 @@ long bordered(long v, int nx, int ny) {
 // is the chessboard distance from voxel v to the nearest voxel with a neighbour of another list
 // (at most 255; the grid's edge does not count): every voxel within that distance of v has v's
 // list, so a ray in v goes on to where it leaves that cube of voxels without looking at them.
-bool reach_build(pray_ctx *c, Accel *a) {
+bool reach_build(pray_ctx *c, Grid *a) {
     const int nx = a->n[0], ny = a->n[1], nz = a->n[2];
     const long nv = (long)nx * ny * nz;
     const long px = nx + 2, py = ny + 2, np = px * py * (nz + 2);  // with a border of one voxel
@@ -3185,6 +3234,174 @@ bool reach_build(pray_ctx *c, Accel *a) {
     mem_free(c, mn);
     mem_free(c, mx);
     mem_free(c, r);
+    return ok;
+}
+
+// The voxels of G that box bx, widened by the margin, meets: lo[l] to hi[l] along each axis
+// (false when none).
+bool voxel_range(const Grid &G, const Box &bx, double margin, int *lo, int *hi) {
+    for (int l = 0; l < 3; l++) {
+        double gl = ((double)bx.lo[l] - margin - (double)G.org[l]) / (double)G.h;
+        double gh = ((double)bx.hi[l] + margin - (double)G.org[l]) / (double)G.h;
+        lo[l] = gl < 0 ? 0 : gl >= G.n[l] ? G.n[l] : (int)floor(gl);
+        hi[l] = gh < 0 ? -1 : gh >= G.n[l] ? G.n[l] - 1 : (int)floor(gh);
+        if (lo[l] > hi[l]) return false;
+    }
+    return true;
+}
+
+// The candidates of each voxel of G: of the primitives ids[0 .. n) (0 .. n - 1 when NULL),
+// those whose boxes meet the voxel, as cand[start[v] .. start[v + 1]), in two passes (count,
+// then fill).
+bool grid_bucket(pray_ctx *c, const Grid &G, const Box *eff, const int *ids, int n, double margin, Array<int> &cand,
+                 Array<int> &start) {
+    long nv = (long)G.n[0] * G.n[1] * G.n[2];
+    start.n = cand.n = 0;
+    if (!start.reserve(c, (int)nv + 1)) return false;
+    start.n = (int)nv + 1;
+    memset(start.p, 0, sizeof(int) * (size_t)(nv + 1));
+    for (int pass = 0; pass < 2; pass++) {
+        for (int k = 0; k < n; k++) {
+            if (cancelled(c)) {
+                fail_cancelled(c);
+                return false;
+            }
+            int i = ids ? ids[k] : k, lo[3], hi[3];
+            if (!voxel_range(G, eff[i], margin, lo, hi)) continue;
+            for (int z = lo[2]; z <= hi[2]; z++)
+                for (int y = lo[1]; y <= hi[1]; y++)
+                    for (int x = lo[0]; x <= hi[0]; x++) {
+                        int v = (z * G.n[1] + y) * G.n[0] + x;
+                        if (pass == 0) start[v + 1]++;
+                        else cand[start[v]++] = i;
+                    }
+        }
+        if (pass == 0) {
+            for (long v = 0; v < nv; v++) start[(int)v + 1] += start[(int)v];
+            if (!cand.reserve(c, start[(int)nv] + 1)) return false;
+            cand.n = start[(int)nv];
+        } else {
+            for (long v = nv; v > 0; v--) start[(int)v] = start[(int)v - 1];
+            start[0] = 0;
+        }
+    }
+    return true;
+}
+
+// What the grids of a scene are built with: where bounds place each primitive, the rounding of a
+// position per step of a walk (the margins grow with the steps of the walks above a grid), and
+// how many voxels nested grids may still take.
+struct GridPlan {
+    const Box *eff;
+    double round;
+    double budget;
+};
+
+// A voxel with more primitives to check than this gets a grid of its own (option nest: how many
+// levels deep), with about 4 voxels per primitive to check (as auto_grid), 2 to 32 a side.
+const int NEST_CHECKS = 32;
+
+bool grid_lists(ListBuilder &b, Grid &G, GridPlan &gp, const Array<int> &cand, const Array<int> &start, double margin,
+                int steps, int depth);
+
+// A grid of its own for voxel ix of G, whose candidates are ids[0 .. n) and which has `checks`
+// primitives to check: its index in Accel::nested; -1 when it is not worth it or does not fit
+// the budget; -2 on failure.
+int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const int *ids, int n, int checks, int steps,
+               int depth) {
+    int m = (int)ceil(cbrt_pos(4.0 * checks));
+    m = m < 2 ? 2 : m > 32 ? 32 : m;
+    Grid S;
+    memset(&S, 0, sizeof S);
+    S.h = G.h / (real)m;
+    S.inv_h = (real)1 / S.h;
+    for (int l = 0; l < 3; l++) {
+        S.n[l] = m;
+        S.org[l] = (real)((double)G.org[l] + ix[l] * (double)G.h);
+        S.top[l] = (real)((double)G.org[l] + (ix[l] + 1) * (double)G.h);
+    }
+    steps += m + 4;
+    double margin = (double)S.h * 1e-6 + gp.round * steps, nv = (double)m * m * m;
+    if (margin > (double)S.h / 4 || nv > gp.budget) return -1;  // (b.rprims and b.rcls left as they are)
+    gp.budget -= nv;
+    pray_ctx *c = b.c;
+    Array<int> cand, start;
+    cand.init();
+    start.init();
+    S.voxel = (int *)mem_zalloc(c, sizeof(int) * (size_t)nv);
+    bool ok = S.voxel && grid_bucket(c, S, gp.eff, ids, n, margin, cand, start) &&
+              grid_lists(b, S, gp, cand, start, margin, steps, depth) && b.a->nested.push(c, S);
+    cand.release(c);
+    start.release(c);
+    if (ok) return b.a->nested.n - 1;
+    mem_free(c, S.voxel);
+    mem_free(c, S.reach);
+    return -2;
+}
+
+// The lists of G's voxels from their candidates, classed in the voxels widened by the margin
+// (`steps`: of the walks down to G); a crowded voxel gets a nested grid while `depth` allows.
+bool grid_lists(ListBuilder &b, Grid &G, GridPlan &gp, const Array<int> &cand, const Array<int> &start, double margin,
+                int steps, int depth) {
+    for (int z = 0; z < G.n[2]; z++)
+        for (int y = 0; y < G.n[1]; y++) {
+            if (cancelled(b.c)) {
+                fail_cancelled(b.c);
+                return false;
+            }
+            for (int x = 0; x < G.n[0]; x++) {
+                int ix[3] = {x, y, z}, ix1[3] = {x + 1, y + 1, z + 1};
+                long v = voxel_index(G, ix);
+                int k0 = start[(int)v], k1 = start[(int)v + 1];
+                BoxClass in;
+                in.s = b.s;
+                voxels_box(G, ix, ix1, margin, in.lo, in.hi);
+                if (!lb_region(b, cand.p + k0, k1 - k0, in)) return false;
+                int checks = 0;
+                for (int i = 0; i < b.rcls.n; i++) checks += b.rcls[i] == CL_BD;
+                int g = depth > 0 && checks > NEST_CHECKS ? nest_build(b, G, ix, gp, cand.p + k0, k1 - k0, checks, steps, depth - 1) : -1;
+                if (g == -2) return false;
+                if (g >= 0) {
+                    G.voxel[v] = -1 - g;
+                    continue;
+                }
+                int L = lb_list(b, b.rprims.p, b.rcls.p, b.rprims.n);
+                if (L < 0) return false;
+                G.voxel[v] = L;
+            }
+        }
+    return reach_build(b.c, &G);
+}
+
+// Areas of G (3.6): connected voxels with the same list, counted into *areas (statistics).
+bool grid_areas(pray_ctx *c, const Grid &G, long *areas) {
+    long nv = (long)G.n[0] * G.n[1] * G.n[2];
+    Array<int> q;
+    q.init();
+    unsigned char *seen = (unsigned char *)mem_zalloc(c, (size_t)nv + 1);
+    bool ok = seen != NULL;
+    for (long v0 = 0; ok && v0 < nv; v0++) {
+        if (seen[v0]) continue;
+        ++*areas;
+        seen[v0] = 1;
+        q.n = 0;
+        ok = q.push(c, (int)v0);
+        while (ok && q.n) {
+            long v = q[--q.n];
+            int x = (int)(v % G.n[0]), y = (int)(v / G.n[0] % G.n[1]), z = (int)(v / G.n[0] / G.n[1]);
+            int nb[6][3] = {{x - 1, y, z}, {x + 1, y, z}, {x, y - 1, z}, {x, y + 1, z}, {x, y, z - 1}, {x, y, z + 1}};
+            for (int k = 0; ok && k < 6; k++) {
+                if (nb[k][0] < 0 || nb[k][1] < 0 || nb[k][2] < 0 || nb[k][0] >= G.n[0] || nb[k][1] >= G.n[1] || nb[k][2] >= G.n[2])
+                    continue;
+                long u = voxel_index(G, nb[k]);
+                if (seen[u] || G.voxel[u] != G.voxel[v0]) continue;
+                seen[u] = 1;
+                ok = q.push(c, (int)u);
+            }
+        }
+    }
+    mem_free(c, seen);
+    q.release(c);
     return ok;
 }
 
@@ -3491,7 +3708,7 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
             } else point_face(fi, &F);
             // the grid's box in the face's coordinates
             Box grid;
-            for (int l = 0; l < 3; l++) grid.lo[l] = a->org[l], grid.hi[l] = a->top[l];
+            for (int l = 0; l < 3; l++) grid.lo[l] = a->g.org[l], grid.hi[l] = a->g.top[l];
             real lo[3], hi[3];
             bool behind = face_extent(B, F, grid, lo, hi);
             if (B.point) {
@@ -3684,6 +3901,7 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     a->off.init();
     a->plan_at.init();
     a->plan.init();
+    a->nested.init();
     a->freeze = opt_int(c, OPT_FREEZE);
     a->merge = opt_int(c, OPT_MERGE);
     // (the shadow cache's answer is the reference's when no surface lets more light through
@@ -3779,34 +3997,27 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     double budget = opt_int(c, OPT_GRIDMEM) * 1048576.0, margin = 0;
     long nv = 0;
     while (want > 0 && st == PRAY_OK) {
-        a->h = (real)(ext / want);
-        a->inv_h = (real)1 / a->h;
-        margin = (double)a->h * 1e-6 + 64 * REAL_EPS * (mag + ext) * (want + 4);
+        a->g.h = (real)(ext / want);
+        a->g.inv_h = (real)1 / a->g.h;
+        margin = (double)a->g.h * 1e-6 + 64 * REAL_EPS * (mag + ext) * (want + 4);
         // far from the origin in low precision the voxels would be smaller than the rounding of
         // the positions: then no grid
-        if (margin > (double)a->h / 4) {
+        if (margin > (double)a->g.h / 4) {
             want = 0;
             break;
         }
         double vox = 1;
         for (int l = 0; l < 3; l++) {
             double len = (double)(region.hi[l] - region.lo[l]) + 2 * margin;
-            a->n[l] = (int)ceil(len / (double)a->h);
-            if (a->n[l] < 1) a->n[l] = 1;
-            a->org[l] = (real)((double)(region.lo[l] + region.hi[l]) / 2 - a->n[l] * (double)a->h / 2);
-            vox *= a->n[l];
+            a->g.n[l] = (int)ceil(len / (double)a->g.h);
+            if (a->g.n[l] < 1) a->g.n[l] = 1;
+            a->g.org[l] = (real)((double)(region.lo[l] + region.hi[l]) / 2 - a->g.n[l] * (double)a->g.h / 2);
+            vox *= a->g.n[l];
         }
         double refs = 0;
         for (int i = 0; i < np && vox <= 268435456.0; i++) {
-            double cnt = 1;
-            for (int l = 0; l < 3; l++) {
-                double gl = ((double)eff[i].lo[l] - margin - (double)a->org[l]) / (double)a->h;
-                double gh = ((double)eff[i].hi[l] + margin - (double)a->org[l]) / (double)a->h;
-                double lo = gl < 0 ? 0 : gl >= a->n[l] ? a->n[l] : floor(gl);
-                double hi = gh < 0 ? -1 : gh >= a->n[l] ? a->n[l] - 1 : floor(gh);
-                cnt *= hi >= lo ? hi - lo + 1 : 0;
-            }
-            refs += cnt;
+            int lo[3], hi[3];
+            if (voxel_range(a->g, eff[i], margin, lo, hi)) refs += (double)(hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
         }
         if (vox <= 268435456.0 && refs <= 64.0 * 1048576 && (2 * vox + refs) * sizeof(int) + vox <= budget) {
             nv = (long)vox;
@@ -3814,100 +4025,21 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         }
         want = want > 1 ? (int)(want * 0.8) : 0;
     }
-    if (want <= 0) a->n[0] = a->n[1] = a->n[2] = 0;
+    if (want <= 0) a->g.n[0] = a->g.n[1] = a->g.n[2] = 0;
     if (want > 0) {
-        for (int l = 0; l < 3; l++) a->top[l] = (real)((double)a->org[l] + a->n[l] * (double)a->h);
-        a->voxel = (int *)mem_zalloc(c, sizeof(int) * (size_t)nv);
-        if (!a->voxel) st = c->status;
-        // candidates per voxel, in two passes (count, then fill)
-        if (st == PRAY_OK && !start.reserve(c, (int)nv + 1)) st = c->status;
-        if (st == PRAY_OK) {
-            start.n = (int)nv + 1;
-            memset(start.p, 0, sizeof(int) * (size_t)(nv + 1));
-        }
-        for (int pass = 0; pass < 2 && st == PRAY_OK; pass++) {
-            for (int i = 0; i < np && st == PRAY_OK; i++) {
-                if (cancelled(c)) {
-                    st = fail_cancelled(c);
-                    break;
-                }
-                const Box &bx = eff[i];
-                int lo[3], hi[3];
-                bool any = true;
-                for (int l = 0; l < 3 && any; l++) {
-                    double gl = ((double)bx.lo[l] - margin - (double)a->org[l]) / (double)a->h;
-                    double gh = ((double)bx.hi[l] + margin - (double)a->org[l]) / (double)a->h;
-                    lo[l] = gl < 0 ? 0 : gl >= a->n[l] ? a->n[l] : (int)floor(gl);
-                    hi[l] = gh < 0 ? -1 : gh >= a->n[l] ? a->n[l] - 1 : (int)floor(gh);
-                    any = lo[l] <= hi[l];
-                }
-                if (!any) continue;
-                for (int z = lo[2]; z <= hi[2]; z++)
-                    for (int y = lo[1]; y <= hi[1]; y++)
-                        for (int x = lo[0]; x <= hi[0]; x++) {
-                            long v = ((long)z * a->n[1] + y) * a->n[0] + x;
-                            if (pass == 0) start[(int)v + 1]++;
-                            else cand[start[(int)v]++] = i;
-                        }
-            }
-            if (pass == 0) {
-                for (long v = 0; v < nv; v++) start[(int)v + 1] += start[(int)v];
-                if (!cand.reserve(c, start[(int)nv] + 1)) st = c->status;
-                cand.n = start[(int)nv];
-            } else {
-                for (long v = nv; v > 0; v--) start[(int)v] = start[(int)v - 1];
-                start[0] = 0;
-            }
-        }
-        // one list per voxel
-        for (int z = 0; z < a->n[2] && st == PRAY_OK; z++)
-            for (int y = 0; y < a->n[1] && st == PRAY_OK; y++)
-                for (int x = 0; x < a->n[0] && st == PRAY_OK; x++) {
-                    if (x == 0 && cancelled(c)) {  // (per row of voxels)
-                        st = fail_cancelled(c);
-                        break;
-                    }
-                    int ix[3] = {x, y, z}, ix1[3] = {x + 1, y + 1, z + 1};
-                    long v = voxel_index(a, ix);
-                    int k0 = start[(int)v], k1 = start[(int)v + 1];
-                    BoxClass in;
-                    in.s = s;
-                    voxels_box(a, ix, ix1, margin, in.lo, in.hi);
-                    int L = lb_region(b, cand.p + k0, k1 - k0, in) ? lb_list(b, b.rprims.p, b.rcls.p, b.rprims.n) : -1;
-                    if (L < 0) st = c->status;
-                    else a->voxel[v] = L;
-                }
-        if (st == PRAY_OK && !reach_build(c, a)) st = c->status;
-        // areas: connected voxels with the same list (for the statistics)
-        if (st == PRAY_OK) {
-            Array<int> q;
-            q.init();
-            unsigned char *seen = (unsigned char *)mem_zalloc(c, (size_t)nv);
-            if (!seen) st = c->status;
-            for (long v0 = 0; st == PRAY_OK && v0 < nv; v0++) {
-                if (seen[v0]) continue;
-                a->areas++;
-                seen[v0] = 1;
-                q.n = 0;
-                if (!q.push(c, (int)v0)) st = c->status;
-                while (st == PRAY_OK && q.n) {
-                    long v = q[--q.n];
-                    int x = (int)(v % a->n[0]), y = (int)(v / a->n[0] % a->n[1]), z = (int)(v / a->n[0] / a->n[1]);
-                    int nb[6][3] = {{x - 1, y, z}, {x + 1, y, z}, {x, y - 1, z}, {x, y + 1, z}, {x, y, z - 1}, {x, y, z + 1}};
-                    for (int k = 0; k < 6; k++) {
-                        if (nb[k][0] < 0 || nb[k][1] < 0 || nb[k][2] < 0 || nb[k][0] >= a->n[0] ||
-                            nb[k][1] >= a->n[1] || nb[k][2] >= a->n[2])
-                            continue;
-                        long u = voxel_index(a, nb[k]);
-                        if (seen[u] || a->voxel[u] != a->voxel[v0]) continue;
-                        seen[u] = 1;
-                        if (!q.push(c, (int)u)) st = c->status;
-                    }
-                }
-            }
-            mem_free(c, seen);
-            q.release(c);
-        }
+        for (int l = 0; l < 3; l++) a->g.top[l] = (real)((double)a->g.org[l] + a->g.n[l] * (double)a->g.h);
+        a->g.voxel = (int *)mem_zalloc(c, sizeof(int) * (size_t)nv);
+        // nested grids take what the budget leaves, and no more voxels than the image has rays
+        GridPlan gp;
+        gp.eff = eff;
+        gp.round = 64 * REAL_EPS * (mag + ext);
+        gp.budget = (budget - (double)nv * (2 * sizeof(int) + 1)) / 16;
+        gp.budget = gp.budget < rays / 2 ? gp.budget : rays / 2;
+        if (!a->g.voxel || !grid_bucket(c, a->g, eff, NULL, np, margin, cand, start) ||
+            !grid_lists(b, a->g, gp, cand, start, margin, want + 4, opt_int(c, OPT_NEST)))
+            st = c->status;
+        for (int i = -1; st == PRAY_OK && i < a->nested.n; i++)
+            if (!grid_areas(c, i < 0 ? a->g : a->nested[i], &a->areas)) st = c->status;
     }
     // the space outside the grid (or everything): primitives not inside the grid's box are active
     if (st == PRAY_OK) {
@@ -3922,7 +4054,7 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     }
     bool lights = opt_int(c, OPT_SHADOWS) && opt_int(c, OPT_LIGHTBUFFER) && s->lights.n > 0;
     bool eye = render && opt_int(c, OPT_EYEBUFFER) && !s->parallel;
-    if (st == PRAY_OK && a->n[0] > 0 && (lights || eye) && !lightbuf_build(b, eff, a->h, (real)margin, lights, eye, rays))
+    if (st == PRAY_OK && a->g.n[0] > 0 && (lights || eye) && !lightbuf_build(b, eff, a->g.h, (real)margin, lights, eye, rays))
         st = c->status;
     cand.release(c);
     start.release(c);
@@ -3966,17 +4098,22 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         if (!any) B.faces = 0;
     }
     a->eye = a->lbuf && a->lbuf[a->nlbuf].faces ? &a->lbuf[a->nlbuf] : NULL;
-    nv = (long)a->n[0] * a->n[1] * a->n[2];
-    a->memory = (double)sizeof(Accel) + (double)nv * (sizeof(int) + 1) + (double)a->data.cap * sizeof(int) +
+    nv = (long)a->g.n[0] * a->g.n[1] * a->g.n[2];
+    long nested = 0;
+    for (int i = 0; i < a->nested.n; i++) nested += (long)a->nested[i].n[0] * a->nested[i].n[1] * a->nested[i].n[2];
+    a->memory = (double)sizeof(Accel) + (double)(nv + nested) * (sizeof(int) + 1) +
+                (double)a->nested.cap * sizeof(Grid) + (double)a->data.cap * sizeof(int) +
                 (double)a->off.cap * sizeof(int) + (double)(a->plan_at.cap + a->plan.cap) * sizeof(int) +
                 (double)(a->lbuf ? a->nlbuf + 1 : 0) * sizeof(LightBuf) +
                 (double)(lbv + eruns) * sizeof(int);
     c->stats.lightbuf_voxels = lbv;
     c->stats.eyebuf_voxels = ebv;
-    c->stats.grid[0] = a->n[0];
-    c->stats.grid[1] = a->n[1];
-    c->stats.grid[2] = a->n[2];
+    c->stats.grid[0] = a->g.n[0];
+    c->stats.grid[1] = a->g.n[1];
+    c->stats.grid[2] = a->g.n[2];
     c->stats.voxels = nv;
+    c->stats.nested_grids = a->nested.n;
+    c->stats.nested_voxels = nested;
     c->stats.lists = a->off.n - 1;
     c->stats.areas = a->areas;
     c->stats.memory = a->memory;
@@ -4455,13 +4592,17 @@ inline real nearest(const real *v, int *axis) {
 // the voxels a jump crosses) being one stretch.
 struct GridSource {
     const Accel *A;
+    const Grid &G;
     const Ray &ray;
     real inv[3];  // the direction's reciprocals (ray_inverse)
-    GridSource(const Accel *A_, const Ray &ray_) : A(A_), ray(ray_) { ray_inverse(ray, inv); }
+    GridSource(const Accel *A_, const Ray &ray_) : A(A_), G(A_->g), ray(ray_) { ray_inverse(ray, inv); }
+    GridSource(const Accel *A_, const Grid &G_, const Ray &ray_, const real *inv_) : A(A_), G(G_), ray(ray_) {
+        for (int l = 0; l < 3; l++) inv[l] = inv_[l];
+    }
     bool span(real *ta, real *tb) const {
         *ta = 0;
-        if (in_box(ray.o, A->org, A->top)) *tb = box_exit(ray, inv, A->org, A->top);
-        else if (!ray_box(ray, inv, A->org, A->top, ta, tb)) return false;
+        if (in_box(ray.o, G.org, G.top)) *tb = box_exit(ray, inv, G.org, G.top);
+        else if (!ray_box(ray, inv, G.org, G.top, ta, tb)) return false;
         return *tb > 0;
     }
     template <class Out>
@@ -4480,29 +4621,45 @@ bool GridSource::walk(Out &out, real t, real tend) const {
     real next[3], delta[3], slope[3];  // slope: voxels per unit of t along each axis
     for (int l = 0; l < 3; l++) {
         real dd = inv[l] == 0 ? 0 : comp(ray.d, l);
-        real g = (comp(p, l) - A->org[l]) * A->inv_h;  // clamped before the cast
-        ix[l] = !(g > 0) ? 0 : g >= (real)A->n[l] ? A->n[l] - 1 : (int)g;
+        real g = (comp(p, l) - G.org[l]) * G.inv_h;  // clamped before the cast
+        ix[l] = !(g > 0) ? 0 : g >= (real)G.n[l] ? G.n[l] - 1 : (int)g;
         step[l] = dd > 0 ? 1 : dd < 0 ? -1 : 0;
-        left[l] = dd > 0 ? A->n[l] - 1 - ix[l] : dd < 0 ? ix[l] : 0;
-        next[l] = dd == 0 ? REAL_INF : (A->org[l] + (real)(ix[l] + (dd > 0)) * A->h - comp(ray.o, l)) * inv[l];
-        delta[l] = A->h * (inv[l] < 0 ? -inv[l] : inv[l]);
-        slope[l] = (dd < 0 ? -dd : dd) * A->inv_h;
+        left[l] = dd > 0 ? G.n[l] - 1 - ix[l] : dd < 0 ? ix[l] : 0;
+        next[l] = dd == 0 ? REAL_INF : (G.org[l] + (real)(ix[l] + (dd > 0)) * G.h - comp(ray.o, l)) * inv[l];
+        delta[l] = G.h * (inv[l] < 0 ? -inv[l] : inv[l]);
+        slope[l] = (dd < 0 ? -dd : dd) * G.inv_h;
     }
     int run = -1;  // the list of the area being crossed
     real run_a = t;
-    long at = voxel_index(A, ix);  // the voxel the ray is in
+    long at = voxel_index(G, ix);  // the voxel the ray is in
     long stride[3];  // a step along each axis, in voxels
     stride[0] = step[0];
-    stride[1] = (long)step[1] * A->n[0];
-    stride[2] = (long)step[2] * A->n[0] * A->n[1];
+    stride[1] = (long)step[1] * G.n[0];
+    stride[2] = (long)step[2] * G.n[0] * G.n[1];
     bool merge = A->merge != 0;
     long steps = 0, moves = 0;  // counted here, added to the counters once per ray
     bool stopped = false;
     for (;;) {
-        PRAY_ASSERT(at >= 0 && at < (long)A->n[0] * A->n[1] * A->n[2]);
-        int L = A->voxel[at];
+        PRAY_ASSERT(at >= 0 && at < (long)G.n[0] * G.n[1] * G.n[2]);
+        int L = G.voxel[at];
         steps++;
-        if (L == run && merge) {
+        if (L < 0) {  // a grid of its own: its walk up to where the ray leaves this voxel
+            if (run == 0) out.pass(run_a, t);
+            else if (run > 0 && out(run, run_a, t)) {
+                stopped = true;
+                break;
+            }
+            int ax;
+            real near = nearest(next, &ax), exit = near < tend ? near : tend;
+            exit = exit > t ? exit : t;
+            GridSource sub(A, A->nested[-1 - L], ray, inv);
+            if (sub.walk(out, t, exit)) {
+                stopped = true;
+                break;
+            }
+            run = -1;
+            run_a = exit;
+        } else if (L == run && merge) {
             moves++;  // same list: a move, no evaluation
         } else {
             if (run == 0) out.pass(run_a, t);
@@ -4513,7 +4670,7 @@ bool GridSource::walk(Out &out, real t, real tend) const {
             run = L;
             run_a = t;
         }
-        int r = merge ? A->reach[at] : 0;
+        int r = merge ? G.reach[at] : 0;
         int ax;
         if (r < 2) {
             real near = nearest(next, &ax);
@@ -4689,7 +4846,7 @@ bool drive(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visi
     Stretches<Visit> out(s, w, ray, tmax, self, visit);
     real ta = 0, tb = 0;
     if (!src || !src->span(&ta, &tb) || !(tb > 0) || !(ta < tmax)) {
-        if (A->bounds && A->n[0] == 0) {
+        if (A->bounds && A->g.n[0] == 0) {
             real inv[3];
             ray_inverse(ray, inv);
             for (int j = s->nodes.n - 1; j >= 0; j--) {  // (parents first)
@@ -4720,7 +4877,7 @@ void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, 
         sweep(s, w, ray, tmax, self, visit);
         return;
     }
-    if (s->accel->n[0] == 0) {
+    if (s->accel->g.n[0] == 0) {
         drive(s, w, ray, tmax, self, visit, (const GridSource *)NULL);
         return;
     }
@@ -4741,8 +4898,8 @@ bool shadow_probe(const Scene *s, Scratch *w, const Ray &ray, real tmax, int sel
     const int *ix = w->blocker + 3 * light;
     real lo[3], hi[3], inv[3], ta, tb;
     for (int l = 0; l < 3; l++) {
-        lo[l] = A->org[l] + (real)ix[l] * A->h;
-        hi[l] = lo[l] + A->h;
+        lo[l] = A->g.org[l] + (real)ix[l] * A->g.h;
+        hi[l] = lo[l] + A->g.h;
     }
     ray_inverse(ray, inv);
     if (!ray_box(ray, inv, lo, hi, &ta, &tb)) return false;
@@ -4752,7 +4909,7 @@ bool shadow_probe(const Scene *s, Scratch *w, const Ray &ray, real tmax, int sel
     ray_begin(s, w);
     ShadowHit probe = visit;
     probe.f = cmake(1, 1, 1);
-    eval_list(s, A, w, ray, A->voxel[voxel_index(A, ix)], ta, tb, tmax, self, probe);
+    eval_list(s, A, w, ray, A->g.voxel[voxel_index(A->g, ix)], ta, tb, tmax, self, probe);
     if (!czero(probe.f)) return false;
     w->k.cache += 1;
     visit.f = probe.f;
@@ -4763,7 +4920,7 @@ bool shadow_probe(const Scene *s, Scratch *w, const Ray &ray, real tmax, int sel
 // else through the light buffer's voxel when the ray starts in one; else as any other ray.
 void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, ShadowHit &visit) {
     const Accel *A = s->accel;
-    if (!A || A->n[0] == 0) {
+    if (!A || A->g.n[0] == 0) {
         find_hits(s, w, ray, tmax, self, visit);
         return;
     }
@@ -4775,7 +4932,9 @@ void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
         w->k.lbuf += 1;
         drive(s, w, ray, tmax, self, visit, &zone);
     } else find_hits(s, w, ray, tmax, self, visit);
-    if (A->cache && !(czero(visit.f) && voxel_of(A, ray.o + ray.d * visit.t, ix))) ix[0] = -1;
+    // (a voxel with a nested grid has no list to probe)
+    if (A->cache && !(czero(visit.f) && voxel_of(A->g, ray.o + ray.d * visit.t, ix) && A->g.voxel[voxel_index(A->g, ix)] >= 0))
+        ix[0] = -1;
 }
 
 // The hits along a primary ray, which starts at the eye: through the cell of the eye's buffer
@@ -10176,7 +10335,7 @@ void print_stats(pray_ctx *c) {
     pray_stats_get(c, &s);
     fprintf(stderr,
             "primitives: %ld declared, %ld kept; nodes %ld\n"
-            "grid: %d x %d x %d = %ld voxels, %ld distinct lists, %ld areas, %.0f bytes\n"
+            "grid: %d x %d x %d = %ld voxels and %ld in %ld nested grids, %ld distinct lists, %ld areas, %.0f bytes\n"
             "rays: primary %.0f (of %.0f without undersampling), shadow %.0f, reflected %.0f, refracted %.0f\n"
             "light buffers: %ld voxels; shadow rays from them %.0f\n"
             "eye buffer: %ld voxels; primary rays from it %.0f\n"
@@ -10185,7 +10344,7 @@ void print_stats(pray_ctx *c) {
             "actions: set inside %.0f, set outside %.0f, check %.0f (frozen skips %.0f)\n"
             "intersection tests %.0f\n"
             "time: parse %.3f s, prepare %.3f s, render %.3f s on %d thread%s\n",
-            s.primitives_declared, s.primitives, s.nodes, s.grid[0], s.grid[1], s.grid[2], s.voxels, s.lists,
+            s.primitives_declared, s.primitives, s.nodes, s.grid[0], s.grid[1], s.grid[2], s.voxels, s.nested_voxels, s.nested_grids, s.lists,
             s.areas, s.memory, s.rays_primary, s.rays_primary_full, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.lightbuf_voxels, s.rays_lightbuf, s.eyebuf_voxels, s.rays_eyebuf, s.rays_shadowcache, s.voxel_steps,
             s.area_moves, s.set_inside, s.set_outside, s.checks, s.frozen_skips, s.intersection_tests,
             s.time_parse, s.time_prepare, s.time_render, s.threads, s.threads == 1 ? "" : "s");

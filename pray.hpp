@@ -336,6 +336,7 @@ typedef struct pray_stats {
     double intersection_tests;       /* ray/primitive intersections computed */
     double frozen_skips;             /* checks skipped because the node was frozen */
     double time_parse, time_prepare, time_render; /* seconds */
+    long nested_grids, nested_voxels; /* grids nested in crowded voxels, and their voxels */
 } pray_stats;
 
 /* Render `root` lit by `lights` (NULL = no light) with the context's camera, background and

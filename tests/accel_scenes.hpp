@@ -357,11 +357,12 @@ enum Kind {
     K_LATTICE,      // spheres on a lattice, touching their neighbours, minus a box
     K_BLOCKS,       // axis-aligned unit-fraction cubes sharing faces, with differences
     K_FLOOR,        // an unbounded floor with spheres and boxes on it (lists outside the grid)
-    K_SCALED        // a random tree scaled far from 1 and moved far from the origin
+    K_SCALED,       // a random tree scaled far from 1 and moved far from the origin
+    K_CLUSTER       // a dense cluster of small solids and a few far away (nested grids)
 };
 
 inline const char *kind_name(int k) {
-    static const char *names[] = {"random", "many", "lattice", "blocks", "floor", "scaled"};
+    static const char *names[] = {"random", "many", "lattice", "blocks", "floor", "scaled", "cluster"};
     return names[k];
 }
 
@@ -456,6 +457,28 @@ inline Scene make_scene(pray_ctx *c, int kind, uint64_t seed) {
             else s = g.plane(g.point(-1, 1), r.dir());
             if (!root) root = s;
             else root = pray_csg(c, r.chance(0.5) ? PRAY_UNION : r.chance(0.6) ? PRAY_DIFFERENCE : PRAY_INTERSECTION, root, s);
+        }
+        break;
+    }
+    case K_CLUSTER: {
+        // 150 to 400 small leaves (spheres, boxes, rods in any direction, holed balls) packed
+        // in a ball, minus a few solids; one to three spheres 10 to 200 cluster widths away
+        g.spread = 0.12;
+        int n = 150 + r.below(251);
+        for (int i = 0; i < n; i++) {
+            g.focus = V(r.range(-1, 1), r.range(-1, 1), r.range(-1, 1));
+            pray_object *o = r.chance(0.4) ? g.sphere(g.point(-1, 1), g.radius(0.02, 0.1)) : g.leaf();
+            root = root ? pray_csg(c, PRAY_UNION, root, o) : o;
+        }
+        g.focus = V(0, 0, 0);
+        g.spread = 1;
+        for (int i = 0, m = 1 + r.below(3); i < m; i++) {
+            pray_object *k = g.sphere(g.point(-0.6, 0.6), g.radius(0.2, 0.5));
+            root = pray_csg(c, PRAY_DIFFERENCE, root, k);
+        }
+        for (int i = 0, m = 1 + r.below(3); i < m; i++) {
+            pray_object *far = g.sphere(mul(r.dir(), r.range(20, 400)), g.radius(0.2, 2));
+            root = pray_csg(c, PRAY_UNION, root, far);
         }
         break;
     }

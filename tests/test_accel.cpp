@@ -448,6 +448,7 @@ std::string fmt_hits(const Hits &a) {
 // that fail on it (the hits shown are those of the first one); then counts by kind.
 struct Report {
     long scenes = 0, rays = 0, rays_hitting = 0, hits = 0, comparisons = 0, mismatches = 0, failed_prepares = 0;
+    long nested = 0;  // preparations that nested grids (so that the scenes test them)
     struct Case {
         std::string where, want, got, options;
         int count = 0;
@@ -555,6 +556,9 @@ void check_scene(int kind, uint64_t seed, Report &rep) {
             FAIL_CHECK(s.label << ", " << o.text() << ": pray_prepare failed: " << std::string(pray_error(c)));
             continue;
         }
+        pray_stats st;
+        pray_stats_get(c, &st);
+        rep.nested += st.nested_grids > 0;
         for (size_t i = 0; i < rays.size(); i++) {
             Hits got = intersect(c, q, rays[i]);
             rep.comparisons++;
@@ -579,9 +583,10 @@ void run_kind(int kind, int first_seed, int count, Report &total) {
     auto t0 = std::chrono::steady_clock::now();
     for (int i = 0; i < count; i++) check_scene(kind, (uint64_t)(first_seed + i), rep);
     double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    MESSAGE(std::string(kind_name(kind)) << " scenes (" << secs << " s): " << rep.summary());
+    MESSAGE(std::string(kind_name(kind)) << " scenes (" << secs << " s): " << rep.summary() << ", " << rep.nested << " with nested grids");
     CHECK_MESSAGE(rep.mismatches == 0, rep.text());
     CHECK(rep.failed_prepares == 0);
+    if (kind == K_CLUSTER) CHECK_MESSAGE(rep.nested > 0, "no scene nested a grid: the test would not test them");
     total.scenes += rep.scenes;
     total.rays += rep.rays;
     total.rays_hitting += rep.rays_hitting;
@@ -606,6 +611,9 @@ TEST_CASE("accel hits: many small spheres in a union minus a few solids (12 seed
 TEST_CASE("accel hits: lattices of touching spheres (15 seeds)") { run_kind(K_LATTICE, 1, 15, g_total); }
 TEST_CASE("accel hits: blocks sharing faces, on quarter units (20 seeds)") { run_kind(K_BLOCKS, 1, 20, g_total); }
 TEST_CASE("accel hits: an unbounded floor with solids on it (15 seeds)") { run_kind(K_FLOOR, 1, 15, g_total); }
+TEST_CASE("accel hits: dense clusters of small solids with a few far away, where grids nest (5 seeds)") {
+    run_kind(K_CLUSTER, 1, 5, g_total);
+}
 TEST_CASE("accel hits: scenes scaled from 1e-3 to 1e6 and moved far from the origin (20 seeds)") {
     run_kind(K_SCALED, 1, 20, g_total);
     MESSAGE("all scene kinds so far: " << g_total.summary());

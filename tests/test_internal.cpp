@@ -1135,7 +1135,7 @@ TEST_CASE("reach: every voxel's cube of its list, exactly as large as it can be 
     for (uint64_t seed = 1; seed <= 40; seed++) {
         CAPTURE(seed);
         TRng g(seed * 7919ull);
-        Accel a;
+        Grid a;
         memset(&a, 0, sizeof a);
         for (int l = 0; l < 3; l++) a.n[l] = 1 + g.below(seed % 4 == 0 ? 40 : 14);
         long nv = (long)a.n[0] * a.n[1] * a.n[2];
