@@ -58,7 +58,7 @@
 #include <string.h>
 #include <time.h>
 
-#if PRAY_VERSION_MAJOR != 0 || PRAY_VERSION_MINOR != 2
+#if PRAY_VERSION_MAJOR != 0 || PRAY_VERSION_MINOR != 3
 #error "pray.cpp and pray.hpp are from different versions"
 #endif
 
@@ -501,6 +501,7 @@ struct pray_ctx {
     pray_alloc_fn alloc;
     void *alloc_ud;
     size_t used, limit;  // limit: the smaller of the host's cap and option maxmem (0 = none)
+    size_t peak;         // the most `used` has been since the phase began (mem_phase)
     size_t host_limit;   // what pray_set_memory_limit set
     int untrusted;       // pray_set_untrusted: limits have ceilings, files stay beside the program
     Block blocks;  // sentinel of the list of live blocks
@@ -618,6 +619,7 @@ void *mem_alloc(pray_ctx *c, size_t n) {
     b->owner = c;
     block_link(&c->blocks, b);
     c->used += n + sizeof(Block);
+    if (c->used > c->peak) c->peak = c->used;
     return b + 1;
 }
 
@@ -647,6 +649,19 @@ void *mem_realloc(pray_ctx *c, void *p, size_t n) {
     memcpy(q, p, b->size < n ? b->size : n);
     mem_free(c, p);
     return q;
+}
+
+// Where a scene's bytes go (pray_stats): the phase that began at the last call ends now; the
+// most the context held during it goes into *phase (when more than what is there) and into the
+// peak of all phases. The next phase begins with what is held now.
+enum MemPhase { MEM_PARSE, MEM_RUN, MEM_PREPARE, MEM_ACCEL, MEM_RENDER };
+void mem_phase(pray_ctx *c, MemPhase phase) {
+    double *field[] = {&c->stats.memory_parse, &c->stats.memory_run, &c->stats.memory_prepare,
+                       &c->stats.memory_accel, &c->stats.memory_render};
+    double most = (double)c->peak;
+    if (most > *field[phase]) *field[phase] = most;
+    if (most > c->stats.memory_peak) c->stats.memory_peak = most;
+    c->peak = c->used;
 }
 
 char *mem_strdup(pray_ctx *c, const char *s, size_t n) {
@@ -6079,7 +6094,9 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
         if (!s->lights.push(c, L)) return c->status;
     }
     scene_camera(c, s);
+    mem_phase(c, MEM_PREPARE);
     if (!opt_int(c, OPT_BRUTE) && accel_build(c, s, render)) return c->status;  // (the eye's buffer: after the camera)
+    mem_phase(c, MEM_ACCEL);
     s->depth = opt_int(c, OPT_DEPTH);
     s->shadows = opt_int(c, OPT_SHADOWS);
     s->antialias = opt_int(c, OPT_ANTIALIAS);
@@ -7639,6 +7656,7 @@ pray_status image_limits(pray_ctx *c) {
 pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, const pray_rect &r,
                         const pray_buffers &out) {
     double t0 = clock_seconds();
+    mem_phase(c, MEM_RUN);
     Scene s;
     pray_status st = scene_build(c, &s, root, lights, true);
     double t1 = clock_seconds();
@@ -7650,6 +7668,7 @@ pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, cons
     c->stats.time_prepare += t1 - t0;
     c->stats.time_render += clock_seconds() - t1;
     scene_release(c, &s);
+    mem_phase(c, st == PRAY_OK ? MEM_RENDER : MEM_PREPARE);  // (what the scene held is counted)
     return st;
 }
 // What pray_render and pray_render_into check of the scene.
@@ -7893,26 +7912,28 @@ pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *pat
 // =============================================================================================
 namespace {
 
-// Memory for one run's syntax tree and strings, freed all at once.
+// Memory for pieces of a program (a statement's syntax tree, a line's names and strings, the
+// names of variables), freed all at once: at the end of a run, or by reset for the next piece.
 struct Arena {
     Array<char *> chunks;
-    size_t left;
+    size_t left, size0;  // size0: of the first chunk, which reset keeps
     char *next;
     void init() {
         chunks.init();
-        left = 0;
+        left = size0 = 0;
         next = NULL;
     }
     void *get(pray_ctx *c, size_t n) {
         n = (n + 15) & ~(size_t)15;
         if (n > left) {
-            size_t sz = n > 65536 ? n : 65536;
+            size_t sz = n > 16384 ? n : 16384;
             char *p = (char *)mem_alloc(c, sz);
             if (!p) return NULL;
             if (!chunks.push(c, p)) {
                 mem_free(c, p);
                 return NULL;
             }
+            if (chunks.n == 1) size0 = sz;
             next = p;
             left = sz;
         }
@@ -7921,6 +7942,14 @@ struct Arena {
         left -= n;
         memset(r, 0, n);
         return r;
+    }
+    // Everything given out so far is forgotten; the first chunk stays for what comes next.
+    void reset(pray_ctx *c) {
+        if (!chunks.n) return;
+        for (int i = 1; i < chunks.n; i++) mem_free(c, chunks[i]);
+        chunks.n = 1;
+        next = chunks[0];
+        left = size0;
     }
     void release(pray_ctx *c) {
         for (int i = 0; i < chunks.n; i++) mem_free(c, chunks[i]);
@@ -7941,13 +7970,18 @@ struct Tok {
     int dotnum;     // a number written with a leading '.'
 };
 
+// The lexer hands out one line at a time (lex_line): the parser never holds the tokens of more
+// than the line it is reading, so a program of any length is read in little memory.
 struct Lexer {
     pray_ctx *c;
     const char *name;
     const unsigned char *p, *end;
     int line, col;
-    Arena *arena;
-    Array<Tok> toks;
+    Arena *text;       // the names and strings of the tokens in toks
+    Array<Tok> toks;   // the tokens of the current line
+    double maxstring;  // option maxstring as the run started: literals are checked against it
+    int at_end;        // toks ends with T_EOF
+    int failed;        // lex_line found an error
 };
 
 pray_status perr(pray_ctx *c, const char *name, int line, int col, pray_status s, const char *fmt, ...)
@@ -8115,9 +8149,9 @@ pray_status lex_string(Lexer &L) {
         int n;
         st = lex_text_char(L, &n);
         if (st) break;
-        if ((double)t.a.n + n > L.c->cur.opt.v[OPT_MAXSTRING]) {
+        if ((double)t.a.n + n > L.maxstring) {
             st = perr(L.c, L.name, line, col, PRAY_ERR_LIMIT, "string longer than %.0f bytes (option maxstring)",
-                      L.c->cur.opt.v[OPT_MAXSTRING]);
+                      L.maxstring);
             break;
         }
         if (!t.add(L.c, (const char *)L.p, (size_t)n)) {
@@ -8127,7 +8161,7 @@ pray_status lex_string(Lexer &L) {
         lex_adv(L, n);
     }
     if (st == PRAY_OK) {
-        char *s = (char *)L.arena->get(L.c, (size_t)t.a.n + 1);
+        char *s = (char *)L.text->get(L.c, (size_t)t.a.n + 1);
         if (!s || !push_tok(L, T_STR, 0, line, col)) st = L.c->status;
         else {
             memcpy(s, t.str(), (size_t)t.a.n + 1);
@@ -8164,9 +8198,9 @@ pray_status check_line_lengths(Lexer &L) {
     return PRAY_OK;
 }
 
-pray_status lex(Lexer &L) {
-    int last_line = 1;
-    if (check_line_lengths(L)) return L.c->status;
+// The tokens of one line up to its T_NL (a continued line is one line); at the end of the
+// program T_NL and T_EOF.
+pray_status lex_tokens(Lexer &L) {
     while (L.p < L.end) {
         unsigned ch = *L.p;
         if (ch == ' ' || ch == '\t') {
@@ -8176,7 +8210,7 @@ pray_status lex(Lexer &L) {
         if (ch == '\n' || (ch == '\r' && L.p + 1 < L.end && L.p[1] == '\n')) {
             if (!push_tok(L, T_NL, 0, L.line, L.col)) return L.c->status;
             lex_newline(L);
-            continue;
+            return PRAY_OK;
         }
         if (ch == '/' && L.p + 1 < L.end && L.p[1] == '/') {
             pray_status st = lex_comment(L);
@@ -8197,7 +8231,6 @@ pray_status lex(Lexer &L) {
                 return perr(L.c, L.name, line, col, PRAY_ERR_SYNTAX, "line continuation at the end of the file");
             continue;
         }
-        last_line = L.line;
         if (is_digit((int)ch) || (ch == '.' && L.p + 1 < L.end && is_digit(L.p[1]))) {
             pray_status st = lex_number(L);
             if (st) return st;
@@ -8208,7 +8241,7 @@ pray_status lex(Lexer &L) {
             int col = L.col;
             while (L.p < L.end && (is_alpha(*L.p) || is_digit(*L.p))) lex_adv(L, 1);
             int n = (int)(L.p - s);
-            char *name = (char *)L.arena->get(L.c, (size_t)n + 1);
+            char *name = (char *)L.text->get(L.c, (size_t)n + 1);
             if (!name || !push_tok(L, T_NAME, 0, L.line, col)) return L.c->status;
             memcpy(name, s, (size_t)n);
             L.toks[L.toks.n - 1].s = name;
@@ -8257,9 +8290,36 @@ pray_status lex(Lexer &L) {
         snprintf(msg, sizeof msg, "unexpected character '%s' (U+%04lX)", what, cp);
         return lex_err(L, "%s", msg);
     }
-    (void)last_line;
     if (!push_tok(L, T_NL, 0, L.line, L.col) || !push_tok(L, T_EOF, 0, L.line, L.col)) return L.c->status;
+    L.at_end = 1;
     return PRAY_OK;
+}
+
+// The next line's tokens replace the current line's.
+pray_status lex_line(Lexer &L) {
+    L.toks.n = 0;
+    L.text->reset(L.c);
+    if (L.at_end) return push_tok(L, T_EOF, 0, L.line, L.col) ? PRAY_OK : L.c->status;
+    pray_status st = lex_tokens(L);
+    if (st) L.failed = 1;
+    return st;
+}
+
+// Start reading the program from its beginning, the first time with the check of its lines'
+// lengths: the first line's tokens.
+pray_status lex_start(Lexer &L, const char *text, size_t len, bool check) {
+    L.p = (const unsigned char *)text;
+    L.end = L.p + len;
+    L.line = 1;
+    L.col = 1;
+    L.at_end = L.failed = 0;
+    // a UTF-8 byte order mark is allowed at the start
+    if (len >= 3 && L.p[0] == 0xEF && L.p[1] == 0xBB && L.p[2] == 0xBF) L.p += 3;
+    if (check && check_line_lengths(L)) {
+        L.failed = 1;
+        return L.c->status;
+    }
+    return lex_line(L);
 }
 
 } // namespace
@@ -8316,14 +8376,29 @@ struct Var {
 struct Parser {
     pray_ctx *c;
     const char *name;
+    Lexer *L;    // the tokens of the current line: t[0 .. L->toks.n)
     Tok *t;
     int pos;
     int depth;   // nesting of parentheses, literals, calls, unary operators, powers
     int blocks;  // nesting of if and while
-    Arena *arena;
+    double maxnest;  // option maxnest as the run started
+    Arena *arena;    // the syntax tree of the statement being read
+    Arena *names;    // the names of variables, for the whole run
     Array<Var> *vars;
     Array<int> hash;  // open addressing: slot + 1, 0 = empty; size a power of two
 };
+
+// Past the T_NL at the current position: the tokens of the next line, when it takes them.
+// Only here does the parser leave a line, so a token of the line before is never looked at
+// again (the lexer reuses their memory).
+pray_status next_line(Parser &P) {
+    P.pos++;
+    if (P.pos < P.L->toks.n) return PRAY_OK;
+    pray_status st = lex_line(*P.L);
+    P.t = P.L->toks.p;
+    P.pos = 0;
+    return st;
+}
 
 Tok &cur(Parser &P) { return P.t[P.pos]; }
 bool is_op(const Tok &t, int op) { return t.kind == T_OP && t.op == op; }
@@ -8402,7 +8477,11 @@ int var_slot(Parser &P, const char *name) {
     for (; h[(int)k]; k = (k + 1) & (unsigned)(h.n - 1))
         if (strcmp((*P.vars)[h[(int)k] - 1].name, name) == 0) return h[(int)k] - 1;
     Var v;
-    v.name = name;
+    size_t len = strlen(name);
+    char *kept = (char *)P.names->get(P.c, len + 1);
+    if (!kept) return -1;
+    memcpy(kept, name, len + 1);
+    v.name = kept;
     if (!P.vars->push(P.c, v)) return -1;
     h[(int)k] = P.vars->n;
     return P.vars->n - 1;
@@ -8501,10 +8580,11 @@ Expr *parse_primary(Parser &P) {
     if (t.kind == T_STR) {
         P.pos++;
         Expr *e = new_expr(P, EX_STR, t);
-        if (e) {
-            e->s = t.s;
-            e->n = t.n;
-        }
+        char *str = e ? (char *)P.arena->get(P.c, (size_t)t.n + 1) : NULL;
+        if (!str) return NULL;
+        memcpy(str, t.s, (size_t)t.n + 1);
+        e->s = str;
+        e->n = t.n;
         return e;
     }
     if (t.kind == T_NAME) {
@@ -8527,7 +8607,7 @@ Expr *parse_primary(Parser &P) {
             Expr *e = new_expr(P, EX_CALL, t);
             if (!e) return NULL;
             e->n = builtin_index(b);
-            e->s = t.s;
+            e->s = builtin_name(e->n);
             Array<Expr *> args;
             args.init();
             bool ok = true;
@@ -8568,9 +8648,10 @@ Expr *parse_primary(Parser &P) {
         }
         Expr *e = new_expr(P, EX_VAR, t);
         if (!e) return NULL;
-        e->s = t.s;
         e->n = var_slot(P, t.s);
-        return e->n < 0 ? NULL : e;
+        if (e->n < 0) return NULL;
+        e->s = (*P.vars)[e->n].name;
+        return e;
     }
     if (is_op(t, '(')) {
         if (!enter(P)) return NULL;
@@ -8589,9 +8670,9 @@ Expr *parse_primary(Parser &P) {
 
 // One level deeper, at token `at` (default: the current token).
 bool enter(Parser &P, const Tok *at) {
-    if (++P.depth > P.c->cur.opt.v[OPT_MAXNEST]) {
+    if (++P.depth > P.maxnest) {
         char msg[80];
-        double lim = P.c->cur.opt.v[OPT_MAXNEST];
+        double lim = P.maxnest;
         snprintf(msg, sizeof msg, "expression nested deeper than %.0f level%s (option maxnest)", lim, lim == 1 ? "" : "s");
         syn(P, at ? *at : cur(P), "%s", msg);
         return false;
@@ -8708,10 +8789,7 @@ Expr *parse_and(Parser &P) { return parse_chain(P, parse_cmp, is_and); }
 Expr *parse_expr(Parser &P) { return parse_chain(P, parse_and, is_orop); }
 
 pray_status end_of_line(Parser &P) {
-    if (cur(P).kind == T_NL) {
-        P.pos++;
-        return PRAY_OK;
-    }
+    if (cur(P).kind == T_NL) return next_line(P);
     char buf[80];
     return syn(P, cur(P), "expected end of line, found '%s'", tok_text(cur(P), buf, sizeof buf));
 }
@@ -8835,11 +8913,13 @@ Stmt *parse_statement(Parser &P) {
     }
     if (is_word(t, "if") || is_word(t, "while")) {
         bool is_if = is_word(t, "if");
-        s = new_stmt(P, is_if ? ST_IF : ST_WHILE, t);
+        Tok word = t;  // (the block takes the lines after this one's)
+        word.s = is_if ? "if" : "while";
+        s = new_stmt(P, is_if ? ST_IF : ST_WHILE, word);
         if (!s) return NULL;
         P.pos++;
         if (cur(P).kind == T_NL) {
-            syn(P, cur(P), "'%s' needs a condition", t.s);
+            syn(P, cur(P), "'%s' needs a condition", word.s);
             return NULL;
         }
         Expr *cond = parse_expr(P);
@@ -8850,9 +8930,9 @@ Stmt *parse_statement(Parser &P) {
         s->nargs = 1;
         if (is_if && is_word(cur(P), "then")) P.pos++;
         if (end_of_line(P)) return NULL;
-        if (++P.blocks > P.c->cur.opt.v[OPT_MAXNEST]) {
-            double lim = P.c->cur.opt.v[OPT_MAXNEST];
-            syn(P, t, "blocks nested deeper than %.0f level%s (option maxnest)", lim, lim == 1 ? "" : "s");
+        if (++P.blocks > P.maxnest) {
+            double lim = P.maxnest;
+            syn(P, word, "blocks nested deeper than %.0f level%s (option maxnest)", lim, lim == 1 ? "" : "s");
             return NULL;
         }
         Array<Stmt *> body;
@@ -8885,11 +8965,11 @@ Stmt *parse_statement(Parser &P) {
             char msg[200];
             if (stop)
                 snprintf(msg, sizeof msg, "'%s' where '%s' was expected to close the '%s' of line %d",
-                         stop, want, t.s, t.line);
+                         stop, want, word.s, word.line);
             else
-                snprintf(msg, sizeof msg, "'%s' without '%s'", t.s, want);
+                snprintf(msg, sizeof msg, "'%s' without '%s'", word.s, want);
             if (stop) syn(P, cur(P), "%s", msg);
-            else syn(P, t, "%s", msg);
+            else syn(P, word, "%s", msg);
             return NULL;
         }
         P.pos++;
@@ -8923,6 +9003,14 @@ Stmt *parse_statement(Parser &P) {
     return NULL;
 }
 
+// The word that ends a block ('else', 'endif', 'endwhile') at the current token, or NULL.
+const char *block_end(Parser &P) {
+    static const char *const ends[] = {"else", "endif", "endwhile"};
+    for (int i = 0; i < 3; i++)
+        if (is_word(cur(P), ends[i])) return ends[i];
+    return NULL;
+}
+
 // block -> { statement NL }  up to 'else', 'endif', 'endwhile' or the end of the file
 bool parse_block(Parser &P, Array<Stmt *> *out, const char **stop) {
     *stop = NULL;
@@ -8930,13 +9018,10 @@ bool parse_block(Parser &P, Array<Stmt *> *out, const char **stop) {
         Tok &t = cur(P);
         if (t.kind == T_EOF) return true;
         if (t.kind == T_NL) {
-            P.pos++;
+            if (next_line(P)) return false;
             continue;
         }
-        if (is_word(t, "else") || is_word(t, "endif") || is_word(t, "endwhile")) {
-            *stop = t.s;
-            return true;
-        }
+        if ((*stop = block_end(P)) != NULL) return true;
         Stmt *s = parse_statement(P);
         if (!s || !out->push(P.c, s)) return false;
     }
@@ -9922,62 +10007,117 @@ pray_status exec_block(Interp &I, Stmt **body, int n) {
     return PRAY_OK;
 }
 
-pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t len) {
+// Read the program from its start, one statement of the top level at a time; only that
+// statement's tree and its current line's tokens are held. With `I` NULL the program is only
+// checked, so that a malformed program runs none of its statements; else each statement runs as
+// soon as it is read. *parse_time: seconds spent reading.
+pray_status read_statements(Parser &P, const char *text, size_t len, Interp *I, double *parse_time) {
+    pray_ctx *c = P.c;
     double t0 = clock_seconds();
-    Arena arena;
-    arena.init();
+    P.depth = P.blocks = 0;
+    pray_status st = lex_start(*P.L, text, len, I == NULL);
+    P.t = P.L->toks.p;
+    P.pos = 0;
+    while (st == PRAY_OK) {
+        if (cur(P).kind == T_EOF) break;
+        if (cur(P).kind == T_NL) {
+            st = next_line(P);
+            continue;
+        }
+        const char *stop = block_end(P);
+        if (stop) {
+            st = syn(P, cur(P), "'%s' without a matching '%s'", stop, strcmp(stop, "endwhile") == 0 ? "while" : "if");
+            break;
+        }
+        Stmt *s = parse_statement(P);
+        if (!s) {
+            st = c->status;
+            break;
+        }
+        if (I) {
+            if (I->vars.n > I->vals.n) {  // (the check found every name already)
+                if (!I->vals.reserve(c, I->vars.n)) {
+                    st = c->status;
+                    break;
+                }
+                memset(I->vals.p + I->vals.n, 0, sizeof(Value) * (size_t)(I->vars.n - I->vals.n));
+                I->vals.n = I->vars.n;
+            }
+            double t1 = clock_seconds();
+            *parse_time += t1 - t0;
+            st = exec(*I, s);
+            t0 = clock_seconds();
+            if (I->quit) break;
+        }
+        P.arena->reset(c);
+    }
+    *parse_time += clock_seconds() - t0;
+    if (st && !I && !P.L->failed) {
+        // the program is wrong: an error of its characters, anywhere, is the one to report
+        // (as when the whole text is lexed first); else this one
+        pray_status first = st;
+        char msg[sizeof c->msg];
+        memcpy(msg, c->msg, sizeof msg);
+        while (!P.L->at_end && lex_line(*P.L) == PRAY_OK) {
+        }
+        if (P.L->failed) return c->status;
+        c->status = first;
+        memcpy(c->msg, msg, sizeof msg);
+    }
+    return st;
+}
+
+pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t len) {
+    Arena tree, words, names;  // a statement's syntax tree; a line's names and strings; variables' names
+    tree.init();
+    words.init();
+    names.init();
     Lexer L;
+    memset(&L, 0, sizeof L);
     L.c = c;
     L.name = name;
-    L.p = (const unsigned char *)text;
-    L.end = L.p + len;
-    L.line = 1;
-    L.col = 1;
-    L.arena = &arena;
+    L.text = &words;
     L.toks.init();
-    // a UTF-8 byte order mark is allowed at the start
-    if (len >= 3 && L.p[0] == 0xEF && L.p[1] == 0xBB && L.p[2] == 0xBF) L.p += 3;
+    L.maxstring = c->cur.opt.v[OPT_MAXSTRING];
     Interp I;
     memset(&I, 0, sizeof I);
     I.c = c;
     I.name = name;
     I.vars.init();
     I.vals.init();
-    Array<Stmt *> prog;
-    prog.init();
-    pray_status st = lex(L);
-    if (st == PRAY_OK) {
-        Parser P;
-        P.c = c;
-        P.name = name;
-        P.t = L.toks.p;
-        P.pos = 0;
-        P.depth = 0;
-        P.blocks = 0;
-        P.arena = &arena;
-        P.vars = &I.vars;
-        P.hash.init();
-        const char *stop = NULL;
-        if (!parse_block(P, &prog, &stop)) st = c->status;
-        else if (stop)
-            st = syn(P, cur(P), "'%s' without a matching '%s'", stop, strcmp(stop, "endwhile") == 0 ? "while" : "if");
-        P.hash.release(c);
-    }
+    Parser P;
+    memset(&P, 0, sizeof P);
+    P.c = c;
+    P.name = name;
+    P.L = &L;
+    P.maxnest = c->cur.opt.v[OPT_MAXNEST];
+    P.arena = &tree;
+    P.names = &names;
+    P.vars = &I.vars;
+    P.hash.init();
+    // first the whole program is checked, then it is read again and run statement by statement
+    double parse_time = 0;
+    pray_status st = read_statements(P, text, len, NULL, &parse_time);
     if (st == PRAY_OK && I.vars.n && !I.vals.reserve(c, I.vars.n)) st = c->status;
-    c->stats.time_parse += clock_seconds() - t0;
+    mem_phase(c, MEM_PARSE);
     if (st == PRAY_OK) {
         if (I.vars.n) memset(I.vals.p, 0, sizeof(Value) * (size_t)I.vars.n);
         I.vals.n = I.vars.n;
-        st = exec_block(I, prog.p, prog.n);
+        tree.reset(c);
+        st = read_statements(P, text, len, &I, &parse_time);
     }
+    c->stats.time_parse += parse_time;
+    mem_phase(c, MEM_RUN);
     for (int i = 0; i < I.vals.n; i++) vrelease(I, I.vals[i]);
     I.vals.release(c);
     for (int i = 0; i < I.names.n; i++) mem_free(c, I.names[i].name);
     I.names.release(c);
     I.vars.release(c);
-    prog.release(c);
+    P.hash.release(c);
     L.toks.release(c);
-    arena.release(c);
+    tree.release(c);
+    words.release(c);
+    names.release(c);
     return st;
 }
 
@@ -9993,6 +10133,7 @@ void reset_run(pray_ctx *c) {
     c->cur = c->base;
     texture_cache_clear(c);  // files are read again by the next run
     memset(&c->stats, 0, sizeof c->stats);
+    c->peak = c->used;
     c->frames = 0;
     c->written = 0;
     c->status = PRAY_OK;
@@ -10184,11 +10325,13 @@ void print_stats(pray_ctx *c) {
             "traversal: %.0f voxel steps, %.0f area moves\n"
             "actions: set inside %.0f, set outside %.0f, check %.0f (frozen skips %.0f)\n"
             "intersection tests %.0f\n"
-            "time: parse %.3f s, prepare %.3f s, render %.3f s on %d thread%s\n",
+            "time: parse %.3f s, prepare %.3f s, render %.3f s on %d thread%s\n"
+            "memory: peak %.0f bytes; by phase: parse %.0f, run %.0f, prepare %.0f, acceleration %.0f, render %.0f\n",
             s.primitives_declared, s.primitives, s.nodes, s.grid[0], s.grid[1], s.grid[2], s.voxels, s.lists,
             s.areas, s.memory, s.rays_primary, s.rays_primary_full, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.lightbuf_voxels, s.rays_lightbuf, s.eyebuf_voxels, s.rays_eyebuf, s.rays_shadowcache, s.voxel_steps,
             s.area_moves, s.set_inside, s.set_outside, s.checks, s.frozen_skips, s.intersection_tests,
-            s.time_parse, s.time_prepare, s.time_render, s.threads, s.threads == 1 ? "" : "s");
+            s.time_parse, s.time_prepare, s.time_render, s.threads, s.threads == 1 ? "" : "s", s.memory_peak,
+            s.memory_parse, s.memory_run, s.memory_prepare, s.memory_accel, s.memory_render);
 }
 
 // SIGINT and SIGTERM while an image is written: remove its temporary file, then die of the
