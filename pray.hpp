@@ -208,7 +208,9 @@ double pray_option_get(const pray_ctx *ctx, const char *name);
    ------------------------------------------------------------------------------------------- */
 /* Run a program held in memory. `name` is used in messages, for the default output name (name
    with its extension replaced by .tif) and as the place beside which texture files are looked for
-   (its directory). `text` need not be NUL-terminated. */
+   (its directory). `text` need not be NUL-terminated. The whole program is checked before its
+   first statement runs, so a malformed one runs none; it is then read again and run a statement
+   at a time, holding only the current line's tokens and the current statement's tree. */
 pray_status pray_run_string(pray_ctx *ctx, const char *name, const char *text, size_t len);
 /* Run a program file (a regular file; a FIFO, directory or device is refused); "-" reads
    standard input (named "stdin.ray" in messages). Reading stops at the first line longer than

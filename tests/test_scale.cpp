@@ -75,8 +75,7 @@ TEST_CASE("memory: the peaks by phase of a scene of spheres are consistent and g
         // every phase holds what the one before kept: the values while the scene is prepared, the
         // prepared scene while its acceleration structure is built and while it is rendered
         CHECK(s.memory_prepare > s.memory_run);
-        CHECK(s.memory_accel > s.memory_run);
-        CHECK(s.memory_render > s.memory_run);
+        CHECK(s.memory_accel > 0);
         CHECK(s.memory_peak == max_phase(s));
         // the program is read a line at a time: reading holds far less than the values it makes
         CHECK(s.memory_parse < s.memory_run / 4);
@@ -192,4 +191,95 @@ TEST_CASE("a program's own option statements do not change how it is read") {
     CHECK(r.error == "test.ray:3:5: error: string longer than 10 bytes (option maxstring)");
     r = testkit::run(p, {"maxnest=2"});
     CHECK(r.error == "test.ray:4:7: error: expression nested deeper than 2 levels (option maxnest)");
+}
+
+namespace {
+// A while loop that builds a tree: `levels` times, `per` spheres and then `step`.
+std::string tree_program(int levels, int per, const char *step, const char *start = "nothing") {
+    char buf[700];
+    snprintf(buf, sizeof buf,
+             "M = color({1})\nAll = %s\nI = 0\nwhile I < %d\n  J = 0\n  U = nothing\n  while J < %d\n"
+             "    U = U | sphere(M, [J %% 50, I %% 50, J / 50 + I / 50], 0.3)\n    J = J + 1\n  endwhile\n"
+             "  %s\n  I = I + 1\nendwhile\n"
+             "perspective <1,0,0>, <0,0,-1>, [25,-150,5], [25,25,5]\nrendertiff All, dirlight({1}, <1,-2,3>)\n",
+             start, levels, per, step);
+    return buf;
+}
+} // namespace
+
+TEST_CASE("preparation is linear: chains built at either end, unions that pruned differences hide") {
+    struct Case {
+        const char *what;
+        std::string program;
+    } cases[] = {
+        // appending and prepending to a chain of 40 000: one node, each step O(1)
+        {"append", tree_program(400, 100, "All = All | U")},
+        {"prepend", tree_program(400, 100, "All = U | All")},
+        // 600 levels, each a difference whose subtracted sphere is far away (pruned): the unions
+        // of all levels become one node; copied level by level they would be 600 x 15 000
+        {"pruned differences", tree_program(600, 50, "All = (All | U) \\ sphere(M, [1000, 1000, 1000 + I], 0.1)")},
+        // 600 levels of intersections with half-spaces that hold everything
+        {"nested intersections", tree_program(600, 50, "All = (All | U) & plane(M, [0, 0, 1000 + I], <0, 0, 1>)")},
+        // intersections that pruned differences hide: a ball with 30 000 holes, 600 levels deep
+        {"pruned differences of intersections",
+         tree_program(600, 50, "All = (All & -U) \\ sphere(M, [1000, 1000, 1000 + I], 0.1)", "sphere(M, [25, 25, 5], 60)")},
+    };
+    for (const Case &k : cases) {
+        CAPTURE(k.what);
+        Run r = run_stats(k.program);
+        REQUIRE_MESSAGE(r.status == PRAY_OK, r.error);
+        CHECK(r.seconds < 10);  // about 0.1 s on a desktop machine (quadratic: 10 s and more)
+        CHECK(r.stats.primitives >= 30000);
+        CHECK(r.stats.memory_peak / r.stats.primitives_declared < 1500);
+        if (std::string(k.what) == "pruned differences") CHECK(r.stats.nodes == 1);
+    }
+    // the merged tree renders what the reference renders
+    std::string small = tree_program(40, 10, "All = (All | U) \\ sphere(M, [1000, 1000, 1000 + I], 0.1)");
+    testkit::Result a = testkit::run(small, {"width=24", "height=24"}),
+                    b = testkit::run(small, {"width=24", "height=24", "brute=1"});
+    REQUIRE(a.frames.size() == 1);
+    REQUIRE(b.frames.size() == 1);
+    CHECK(a.frames[0].pixels == b.frames[0].pixels);
+}
+
+TEST_CASE("every function name is known as one (names are looked up by halving an ordered table)") {
+    const char *names[] = {"abs", "arccos", "arcsin", "arctan", "arctan2", "color", "cos", "cylinder",
+                           "directionlight", "dirlight", "exp", "log", "mirror", "move", "norm", "one",
+                           "phong", "plane", "planemap", "pointlight", "sin", "sphere", "spheremap", "sqrt",
+                           "tan", "text", "tiff", "tiffbump", "transparent"};
+    for (const char *n : names) {
+        CAPTURE(n);
+        CHECK(testkit::error_of(std::string("X = ") + n + "\n") ==
+              std::string("test.ray:1:5: error: '") + n + "' is a function: write it with its arguments in parentheses");
+    }
+    // names around them are variables
+    CHECK(testkit::printed("aba = 1\nzz = 2\nsphere2 = 3\nSphere = 4\nprint aba, zz, sphere2, Sphere\n") == "1 2 3 4\n");
+}
+
+TEST_CASE("values that no later statement names are released; a rendered tree goes once flattened") {
+    // the spheres' values are not named after the rendertiff: the render holds none of them
+    std::string p = spheres_program(6000);
+    Run dead = run_stats(p), alive = run_stats(p + "print All\n");
+    REQUIRE_MESSAGE(dead.status == PRAY_OK, dead.error);
+    REQUIRE_MESSAGE(alive.status == PRAY_OK, alive.error);
+    // a sphere's value costs over 100 bytes: kept, every phase after the run holds them
+    CHECK(alive.stats.memory_render > dead.stats.memory_render + 100.0 * 6000);
+    CHECK(alive.stats.memory_accel > dead.stats.memory_accel + 100.0 * 6000);
+    CHECK(dead.stats.memory_render < dead.stats.memory_prepare);
+
+    // the same images whichever values go when; a message still suggests a released name
+    const char *twice = "M = color({1, 0.5, 0})\nBall = sphere(M, [0, 0, 0], 1)\n"
+                        "rendertiff Ball | sphere(M, [0.5, 0, 0.5], 0.5), none\nrendertiff Ball, none\n"
+                        "I = 0\nwhile I < 2\n  rendertiff Ball, none\n  I = I + 1\nendwhile\nprint Bal\n";
+    testkit::Result r = testkit::run(twice, {"width=8", "height=8"});
+    CHECK(r.error == "test.ray:10:7: error: undefined variable 'Bal'; did you mean 'Ball'?");
+    REQUIRE(r.frames.size() == 4);
+    CHECK(r.frames[1].pixels == r.frames[2].pixels);
+    CHECK(r.frames[1].pixels == r.frames[3].pixels);
+    CHECK(r.frames[0].pixels != r.frames[1].pixels);
+    CHECK(r.frames[1].at(4, 4, 0) == 1.0f);  // the model of the released tree is still there
+    CHECK(r.frames[1].at(4, 4, 1) == 0.5f);
+    r = testkit::run("A = sphere(color({1}), [0, 0, 0], 1)\nrendertiff A, none\nA = 2\nprint A\n", {"width=8", "height=8"});
+    CHECK(r.printed == "2\n");
+    CHECK(r.frames.size() == 1);
 }
