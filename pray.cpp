@@ -58,7 +58,7 @@
 #include <string.h>
 #include <time.h>
 
-#if PRAY_VERSION_MAJOR != 0 || PRAY_VERSION_MINOR != 2
+#if PRAY_VERSION_MAJOR != 0 || PRAY_VERSION_MINOR != 3
 #error "pray.cpp and pray.hpp are from different versions"
 #endif
 
@@ -501,6 +501,7 @@ struct pray_ctx {
     pray_alloc_fn alloc;
     void *alloc_ud;
     size_t used, limit;  // limit: the smaller of the host's cap and option maxmem (0 = none)
+    size_t peak;         // the most `used` has been since the phase began (mem_phase)
     size_t host_limit;   // what pray_set_memory_limit set
     int untrusted;       // pray_set_untrusted: limits have ceilings, files stay beside the program
     Block blocks;  // sentinel of the list of live blocks
@@ -530,6 +531,7 @@ struct pray_ctx {
     char *volatile temp_name;  // the temporary file being written now (pray_temp_file)
     unsigned temp_serial;    // makes temporary names unique
     double written;          // bytes of image files written by this run (option maxoutput)
+    pray_object *drop;       // given up by a program's rendertiff: released once flattened (scene_build)
     volatile sig_atomic_t cancel;  // pray_cancel: the running call stops at its next check
     int calls;               // cancellable public calls running (a run renders and writes)
 };
@@ -618,6 +620,7 @@ void *mem_alloc(pray_ctx *c, size_t n) {
     b->owner = c;
     block_link(&c->blocks, b);
     c->used += n + sizeof(Block);
+    if (c->used > c->peak) c->peak = c->used;
     return b + 1;
 }
 
@@ -647,6 +650,19 @@ void *mem_realloc(pray_ctx *c, void *p, size_t n) {
     memcpy(q, p, b->size < n ? b->size : n);
     mem_free(c, p);
     return q;
+}
+
+// Where a scene's bytes go (pray_stats): the phase that began at the last call ends now; the
+// most the context held during it goes into *phase (when more than what is there) and into the
+// peak of all phases. The next phase begins with what is held now.
+enum MemPhase { MEM_PARSE, MEM_RUN, MEM_PREPARE, MEM_ACCEL, MEM_RENDER };
+void mem_phase(pray_ctx *c, MemPhase phase) {
+    double *field[] = {&c->stats.memory_parse, &c->stats.memory_run, &c->stats.memory_prepare,
+                       &c->stats.memory_accel, &c->stats.memory_render};
+    double most = (double)c->peak;
+    if (most > *field[phase]) *field[phase] = most;
+    if (most > c->stats.memory_peak) c->stats.memory_peak = most;
+    c->peak = c->used;
 }
 
 char *mem_strdup(pray_ctx *c, const char *s, size_t n) {
@@ -681,6 +697,15 @@ template <class T> struct Array {
         if (!q) return false;
         p = q;
         cap = nc;
+        return true;
+    }
+    // Room for exactly `want` (no more), when that is more than there is.
+    bool reserve_exact(pray_ctx *c, int want) {
+        if (want <= cap) return true;
+        T *q = (T *)mem_realloc(c, p, (size_t)want * sizeof(T));
+        if (!q) return false;
+        p = q;
+        cap = want;
         return true;
     }
     bool push(pray_ctx *c, const T &v) {
@@ -893,6 +918,13 @@ struct Handle {
     unsigned magic;
 };
 enum ObjKind { O_SPHERE, O_PLANE, O_CYLINDER, O_ONE, O_NOTHING, O_UNION, O_INTER, O_DIFF, O_COMPL };
+// Texture coordinates of a primitive (planemap, spheremap): its U and V vectors. Kept apart, as
+// few primitives have them.
+struct MapInfo {
+    int kind;      // MapKind
+    int mirrored;  // a spheremap reflected by a negative scale: longitudes run the other way
+    pray_vec u, v;
+};
 struct LightSrc {
     int point;  // 1: point light at v; 0: directional light travelling along v
     pray_rgb intensity;
@@ -939,19 +971,18 @@ struct pray_light {
     LightSrc *src;
 };
 
-// A solid. Primitives use p, v, r; nodes use kids[0..nkids). Chains of one operation share one
-// growing Kids array, so `All = All | s` in a loop costs O(1) per step and builds one node.
+// A solid. Primitives use p, v, r; nodes use kids->k[k0 .. k0+nkids). Chains of one operation
+// share one Kids array that grows at either end, so `All = All | s` and `All = s | All` in a loop
+// cost O(1) per step and build one node.
 struct pray_object {
     Handle h;
     int kind;
     pray_model *mat;
     pray_vec p, v;
     double r;
-    int map;         // MapKind: texture coordinates (planemap, spheremap)
-    pray_vec mu, mv; // their U and V vectors
-    int mirrored;    // a spheremap reflected by a negative scale: longitudes run the other way
+    MapInfo *map;    // texture coordinates, or NULL
     Kids *kids;
-    int nkids;
+    int nkids, k0;
     long nprims;
     int depth;
 };
@@ -959,9 +990,10 @@ struct pray_object {
 namespace {
 struct Kids {
     Handle h;
-    int used, cap;
+    int lo, used, cap;  // k[lo .. used) hold children, of one node or of several sharing the array
     pray_object **k;
 };
+inline pray_object *kid(const pray_object *o, int i) { return o->kids->k[o->k0 + i]; }
 
 void *handle_new(pray_ctx *c, size_t size, int kind) {
     Handle *h = (Handle *)mem_zalloc(c, size);
@@ -984,11 +1016,12 @@ void release_handle(pray_ctx *c, void *p) {
         pray_object *o = (pray_object *)p;
         release_handle(c, o->mat);
         release_handle(c, o->kids);
+        mem_free(c, o->map);
         break;
     }
     case H_KIDS: {
         Kids *k = (Kids *)p;
-        for (int i = 0; i < k->used; i++) release_handle(c, k->k[i]);
+        for (int i = k->lo; i < k->used; i++) release_handle(c, k->k[i]);
         mem_free(c, k->k);
         break;
     }
@@ -1044,6 +1077,18 @@ pray_object *obj_new(pray_ctx *c, int kind, pray_model *m) {
     return o;
 }
 
+// Give primitive o texture coordinates; false when out of memory.
+bool obj_map(pray_ctx *c, pray_object *o, int kind, pray_vec u, pray_vec v, int mirrored) {
+    MapInfo *m = (MapInfo *)mem_alloc(c, sizeof(MapInfo));
+    if (!m) return false;
+    m->kind = kind;
+    m->mirrored = mirrored;
+    m->u = u;
+    m->v = v;
+    o->map = m;
+    return true;
+}
+
 Kids *kids_new(pray_ctx *c, int cap) {
     Kids *k = (Kids *)handle_new(c, sizeof(Kids), H_KIDS);
     if (!k) return NULL;
@@ -1084,11 +1129,29 @@ pray_object *csg_make(pray_ctx *c, int op, pray_object *a, pray_object *b) {
     }
     pray_object *o = obj_new(c, op, NULL);
     if (!o) return NULL;
+    // The array holds one reference to each child in it, whichever objects share it.
     Kids *k;
-    if (sa && a->nkids == a->kids->used && a->kids->cap >= na + nb) {
-        k = a->kids;  // append in place: a still sees only its first nkids children
+    int k0;
+    if (sa && a->k0 + a->nkids == a->kids->used && a->kids->cap - a->kids->used >= nb) {
+        k = a->kids;  // append in place: a still sees only its own children
+        k0 = a->k0;
         retain(k);
-    } else {
+        for (int i = 0; i < nb; i++) {
+            pray_object *x = sb ? kid(b, i) : b;
+            k->k[k->used++] = x;
+            retain(x);
+        }
+    } else if (sb && b->k0 == b->kids->lo && b->kids->lo >= na) {
+        k = b->kids;  // prepend in place: likewise b
+        k0 = b->k0 - na;
+        retain(k);
+        for (int i = 0; i < na; i++) {
+            pray_object *x = sa ? kid(a, i) : a;
+            k->k[k0 + i] = x;
+            retain(x);
+        }
+        k->lo = k0;
+    } else {  // a new array, with its room at the end that grew (the back when neither did)
         int cap = 2 * (na + nb);
         if (cap < 4) cap = 4;
         k = kids_new(c, cap);
@@ -1096,23 +1159,17 @@ pray_object *csg_make(pray_ctx *c, int op, pray_object *a, pray_object *b) {
             mem_free(c, o);
             return NULL;
         }
-        if (sa) {
-            for (int i = 0; i < na; i++) {
-                k->k[i] = a->kids->k[i];
-                retain(k->k[i]);
-            }
-        } else {
-            k->k[0] = a;
-            retain(a);
+        k0 = sb && !sa ? cap - (na + nb) : 0;
+        for (int i = 0; i < na + nb; i++) {
+            pray_object *x = i < na ? (sa ? kid(a, i) : a) : (sb ? kid(b, i - na) : b);
+            k->k[k0 + i] = x;
+            retain(x);
         }
-        k->used = na;
-    }
-    for (int i = 0; i < nb; i++) {
-        pray_object *x = sb ? b->kids->k[i] : b;
-        k->k[k->used++] = x;
-        retain(x);
+        k->lo = k0;
+        k->used = k0 + na + nb;
     }
     o->kids = k;
+    o->k0 = k0;
     o->nkids = na + nb;
     o->nprims = a->nprims + b->nprims;
     o->depth = depth;
@@ -1130,8 +1187,8 @@ pray_object *csg_op(pray_ctx *c, int op, pray_object *a, pray_object *b) {
 
 pray_object *complement_of(pray_ctx *c, pray_object *a) {
     if (a->kind == O_COMPL) {
-        retain(a->kids->k[0]);
-        return a->kids->k[0];
+        retain(kid(a, 0));
+        return kid(a, 0);
     }
     if (a->kind == O_NOTHING) return obj_new(c, O_ONE, NULL);
     if (a->kind == O_ONE) return obj_new(c, O_NOTHING, NULL);
@@ -1171,13 +1228,14 @@ pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
         break;
     default: break;
     }
-    o->map = a->map;
-    o->mirrored = a->mirrored ^ (xf_scale_of(f) < 0);
     bool map_ok = true;
     if (a->map) {  // texture coordinates go with the solid, scale included
-        o->mu = xf_dir(f, a->mu);
-        o->mv = xf_dir(f, a->mv);
-        map_ok = map_len_ok(o->mu) && map_len_ok(o->mv);
+        if (!obj_map(c, o, a->map->kind, xf_dir(f, a->map->u), xf_dir(f, a->map->v),
+                     a->map->mirrored ^ (xf_scale_of(f) < 0))) {
+            release_handle(c, o);
+            return NULL;
+        }
+        map_ok = map_len_ok(o->map->u) && map_len_ok(o->map->v);
     }
     switch (a->kind) {
     case O_CYLINDER:
@@ -1201,7 +1259,7 @@ pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
             return NULL;
         }
         for (int i = 0; i < a->nkids; i++) {
-            pray_object *k = obj_transform(c, a->kids->k[i], f);
+            pray_object *k = obj_transform(c, kid(a, i), f);
             if (!k) {
                 release_handle(c, o);
                 return NULL;
@@ -1556,6 +1614,14 @@ struct Box {
     real lo[3], hi[3];
 };
 
+// Texture coordinates of a primitive: origin p (the primitive's), U and V vectors. Apart from
+// the primitive, as few have them; each in a block of its own, so that a primitive's pointer
+// stays valid while the scene's arrays grow.
+struct PrimMap {
+    R3 u, v;
+    int mirrored;  // longitudes of a spheremap run the other way
+};
+
 struct Prim {
     int kind;           // O_SPHERE, O_PLANE, O_CYLINDER
     Axis axis;          // a plane whose normal lies along an axis: that component; else none
@@ -1564,9 +1630,8 @@ struct Prim {
     R3 n;               // unit outward normal of a plane, unit axis of a cylinder
     real r, r2, d;      // radius, radius squared, plane offset n.p
     const pray_model *mat;
-    int map;            // MapKind; texture coordinates from p (origin) and mu, mv
-    R3 mu, mv;
-    int mirrored;       // longitudes of a spheremap run the other way
+    int map;            // MapKind; with tm: the texture coordinates (NULL for MAP_NONE)
+    const PrimMap *tm;
     int id;             // position among the declared primitives, left to right
     int surf;           // the same number for primitives snapped to exactly one surface (twins)
     int parent;         // node index, -1 for the root
@@ -1593,6 +1658,8 @@ struct Accel;
 
 struct Scene {
     Array<Prim> prims;
+    Array<PrimMap *> maps;  // the primitives' PrimMap blocks
+    int models_held;        // each primitive holds a reference to its model (scene_hold_models)
     Array<Node> nodes;
     Array<int> kids;  // element codes of the nodes' children
     int root;
@@ -1623,9 +1690,14 @@ void scene_release(pray_ctx *c, Scene *s) {
     accel_release(c, s->accel);
     s->accel = NULL;
     s->kids.release(c);
-    s->prims.release(c);
     s->nodes.release(c);
     s->lights.release(c);
+    for (int i = 0; i < s->maps.n; i++) mem_free(c, s->maps[i]);
+    s->maps.release(c);
+    if (s->models_held)
+        for (int i = 0; i < s->prims.n; i++) release_handle(c, (pray_model *)s->prims[i].mat);
+    s->models_held = 0;
+    s->prims.release(c);
 }
 
 void set_parent(Scene *s, int e, int parent, bool first) {
@@ -1856,10 +1928,13 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o);
 
 // Add element e as a child of an `op` node being built: a node of the same operation (for a
 // difference, only as its first child) gives its children instead, so chains stay one node.
+// Unions and intersections are left nested here and merged by merge_chains: a union that a
+// pruned difference hides at every level of a deep tree would otherwise be copied into the level
+// above, again and again (time and memory quadratic in the tree's size).
 bool add_kid(pray_ctx *c, Scene *s, Array<int> *kids, int op, int e) {
     if (e >= 0 && e_is_node(e)) {
         const Node &nd = s->nodes[e_index(e)];
-        if (nd.op == op && (op == O_UNION || op == O_INTER || (op == O_DIFF && kids->n == 0))) {
+        if (nd.op == op && op == O_DIFF && kids->n == 0) {
             if (!kids->reserve(c, kids->n + nd.n)) return false;
             for (int i = 0; i < nd.n; i++) kids->push(c, s->kids[nd.k0 + i]);
             return true;
@@ -1893,10 +1968,18 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
         q.mat = o->mat;
         q.parent = -1;
         q.id = s->leaves++;
-        q.map = o->map;
-        q.mu = r3of(o->mu);
-        q.mv = r3of(o->mv);
-        q.mirrored = o->mirrored;
+        if (o->map) {
+            PrimMap *m = (PrimMap *)mem_alloc(c, sizeof(PrimMap));
+            if (!m || !s->maps.push(c, m)) {
+                mem_free(c, m);
+                return -3;
+            }
+            m->u = r3of(o->map->u);
+            m->v = r3of(o->map->v);
+            m->mirrored = o->map->mirrored;
+            q.map = o->map->kind;
+            q.tm = m;
+        }
         if (o->kind == O_SPHERE) {
             q.r = (real)o->r;
         } else if (o->kind == O_PLANE) {
@@ -1910,6 +1993,7 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
         q.r2 = q.r * q.r;
         q.box = prim_box(q);
         if (!s->prims.push(c, q)) return -3;
+        retain((void *)q.mat);  // (the tree may go before the scene: scene_build)
         return 2 * (s->prims.n - 1);
     }
     default: break;
@@ -1920,10 +2004,10 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
     int result = -4;  // undecided
     for (int i = 0; i < o->nkids; i++) {
         if (result != -4) {  // decided: the rest is not needed, but keeps its primitives' numbers
-            s->leaves += (int)o->kids->k[i]->nprims;
+            s->leaves += (int)kid(o, i)->nprims;
             continue;
         }
-        int e = flatten(c, s, o->kids->k[i]);
+        int e = flatten(c, s, kid(o, i));
         if (e == -3) result = -3;
         else if (op == O_UNION) {
             if (e == E_ALL) result = E_ALL;
@@ -2127,12 +2211,173 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
     return PRAY_OK;
 }
 
+// Unions that are children of unions, and intersections of intersections, give their children
+// to the node above (as flattening does for a difference's first child, add_kid): each child is
+// moved once, to the topmost node of its chain, so the work is linear. The merged lists go to
+// the end of s->kids; what they leave behind is dropped by scene_compact. A merged union's box
+// is the hull of its children's either way; a merged intersection's is made again from its whole
+// list, as for one built at once (add_node).
+inline bool chains(const Scene *s, int op, int e) {
+    return (op == O_UNION || op == O_INTER) && e_is_node(e) && s->nodes[e_index(e)].op == op;
+}
+pray_status merge_chains(pray_ctx *c, Scene *s) {
+    bool any = false;
+    for (int j = 0; j < s->nodes.n && !any; j++) {
+        const Node &nd = s->nodes[j];
+        for (int i = 0; i < nd.n && !any; i++) any = chains(s, nd.op, s->kids[nd.k0 + i]);
+    }
+    if (!any || s->root < 0 || !e_is_node(s->root)) return PRAY_OK;
+    Array<int> todo, stack, list;  // nodes to visit; a chain's walk: (node, next child); its new list
+    todo.init();
+    stack.init();
+    list.init();
+    bool ok = todo.push(c, e_index(s->root));
+    while (ok && todo.n) {
+        int j = todo[--todo.n];
+        int op = s->nodes[j].op;
+        list.n = 0;
+        ok = stack.push(c, j) && stack.push(c, 0);
+        bool merged = false;
+        while (ok && stack.n) {
+            int m = stack[stack.n - 2], k = stack[stack.n - 1];
+            if (k == s->nodes[m].n) {
+                stack.n -= 2;
+                continue;
+            }
+            stack[stack.n - 1] = k + 1;
+            int e = s->kids[s->nodes[m].k0 + k];
+            if (chains(s, op, e)) {
+                merged = true;
+                ok = stack.push(c, e_index(e)) && stack.push(c, 0);
+            } else {
+                ok = list.push(c, e) && (!e_is_node(e) || todo.push(c, e_index(e)));
+            }
+        }
+        if (ok && merged) {
+            int k0 = s->kids.n;
+            for (int i = 0; i < list.n && ok; i++) ok = s->kids.push(c, list[i]);
+            s->nodes[j].k0 = k0;
+            s->nodes[j].n = list.n;
+            if (ok && op == O_INTER) {
+                Box &b = s->nodes[j].box;
+                b = box_all();
+                for (int i = 0; i < list.n; i++) box_clip(&b, elem_box(s, list[i]));
+                polyhedron_box(s, s->kids.p + k0, list.n, &b);
+            }
+        }
+    }
+    todo.release(c);
+    stack.release(c);
+    list.release(c);
+    return ok ? PRAY_OK : c->status;
+}
+
+// Parents and `settles` of a compacted scene.
+void scene_link(Scene *s) {
+    Array<Prim> &prims = s->prims;
+    Array<Node> &nodes = s->nodes;
+    for (int i = 0; i < prims.n; i++) prims[i].parent = -1;
+    for (int j = 0; j < nodes.n; j++) nodes[j].parent = -1;
+    for (int j = 0; j < nodes.n; j++)
+        for (int i = 0; i < nodes[j].n; i++) {
+            int e = s->kids[nodes[j].k0 + i];
+            if (e_is_node(e)) {
+                nodes[e_index(e)].parent = j;
+                nodes[e_index(e)].first = i == 0;
+            } else {
+                prims[e_index(e)].parent = j;
+                prims[e_index(e)].first = i == 0;
+            }
+        }
+    for (int i = 0; i < prims.n; i++) {
+        const Prim &q = prims[i];
+        int op = q.parent < 0 ? O_COMPL : nodes[q.parent].op;  // the root: either decides
+        prims[i].settles = (unsigned char)(op == O_UNION ? 2 : op == O_INTER ? 1 : op == O_DIFF ? (q.first ? 1 : 2) : 3);
+    }
+}
+
+// scene_compact in place, without a second copy of the scene: possible when the post-order
+// from the root meets the elements in the order they were flattened in (it does: flattening
+// is a post-order walk too, and folding, merging and pruning only leave elements out). `num`
+// gives the new numbers (prims, then nodes; -1 for those left out). False when the order
+// differs.
+bool compact_in_place(pray_ctx *c, Scene *s, const int *num, int root) {
+    int np = s->prims.n, nn = s->nodes.n;
+    int last = -1;
+    for (int i = 0; i < np; i++)
+        if (num[i] >= 0) {
+            if (num[i] <= last) return false;
+            last = num[i];
+        }
+    last = -1;
+    for (int j = 0; j < nn; j++)
+        if (num[np + j] >= 0) {
+            if (num[np + j] <= last) return false;
+            last = num[np + j];
+        }
+    for (int j = 1; j < nn; j++)  // each node's children follow those of the nodes before it
+        if (s->nodes[j].k0 < s->nodes[j - 1].k0 + s->nodes[j - 1].n) return false;
+    int pc = 0, nc = 0, w = 0;
+    for (int i = 0; i < np; i++)
+        if (num[i] >= 0) s->prims[pc++] = s->prims[i];
+        else release_handle(c, (pray_model *)s->prims[i].mat);
+    for (int j = 0; j < nn; j++) {
+        if (num[np + j] < 0) continue;
+        Node nd = s->nodes[j];
+        for (int k = 0; k < nd.n; k++) {  // (w <= nd.k0 + k: copied forwards, never over what is still to read)
+            int e = s->kids[nd.k0 + k];
+            s->kids[w + k] = e_is_node(e) ? 2 * num[np + e_index(e)] + 1 : 2 * num[e_index(e)];
+        }
+        nd.k0 = w;
+        w += nd.n;
+        s->nodes[nc++] = nd;
+    }
+    s->prims.n = pc;
+    s->nodes.n = nc;
+    s->kids.n = w;
+    s->root = e_is_node(root) ? 2 * num[np + e_index(root)] + 1 : 2 * num[e_index(root)];
+    scene_link(s);
+    return true;
+}
+
 // Keep only what the root reaches, renumbered in post-order (flattening leaves folded and
 // pruned parts behind).
 pray_status scene_compact(pray_ctx *c, Scene *s) {
     if (s->root < 0) {
+        for (int i = 0; i < s->prims.n; i++) release_handle(c, (pray_model *)s->prims[i].mat);
         s->prims.n = s->nodes.n = s->kids.n = 0;
         return PRAY_OK;
+    }
+    {
+        // the new numbers, by a post-order walk from the root with a stack of (element, next child)
+        int np = s->prims.n, nn = s->nodes.n;
+        int *num = (int *)mem_alloc(c, sizeof(int) * ((size_t)np + (size_t)nn));
+        Array<int> stack;
+        stack.init();
+        if (!num) return c->status;
+        for (int i = 0; i < np + nn; i++) num[i] = -1;
+        int pc = 0, nc = 0;
+        bool ok = stack.push(c, s->root) && stack.push(c, 0);
+        while (ok && stack.n) {
+            int e = stack[stack.n - 2], k = stack[stack.n - 1];
+            if (e_is_node(e)) {
+                const Node &nd = s->nodes[e_index(e)];
+                if (k < nd.n) {
+                    stack[stack.n - 1] = k + 1;
+                    ok = stack.push(c, s->kids[nd.k0 + k]) && stack.push(c, 0);
+                    continue;
+                }
+                num[np + e_index(e)] = nc++;
+            } else {
+                num[e_index(e)] = pc++;
+            }
+            stack.n -= 2;
+        }
+        stack.release(c);
+        bool done = ok && compact_in_place(c, s, num, s->root);
+        mem_free(c, num);
+        if (!ok) return c->status;
+        if (done) return PRAY_OK;
     }
     Array<Prim> prims;
     Array<Node> nodes;
@@ -2174,18 +2419,8 @@ pray_status scene_compact(pray_ctx *c, Scene *s) {
         if (st == PRAY_OK && !done.push(c, code)) st = c->status;
     }
     if (st == PRAY_OK) {
-        // re-link the parents
-        for (int j = 0; j < nodes.n; j++)
-            for (int i = 0; i < nodes[j].n; i++) {
-                int e = kids[nodes[j].k0 + i];
-                if (e_is_node(e)) {
-                    nodes[e_index(e)].parent = j;
-                    nodes[e_index(e)].first = i == 0;
-                } else {
-                    prims[e_index(e)].parent = j;
-                    prims[e_index(e)].first = i == 0;
-                }
-            }
+        for (int i = 0; i < prims.n; i++) retain((void *)prims[i].mat);  // what is left out lets go
+        for (int i = 0; i < s->prims.n; i++) release_handle(c, (pray_model *)s->prims[i].mat);
         s->prims.release(c);
         s->nodes.release(c);
         s->kids.release(c);
@@ -2193,11 +2428,7 @@ pray_status scene_compact(pray_ctx *c, Scene *s) {
         s->nodes = nodes;
         s->kids = kids;
         s->root = done[0];
-        for (int i = 0; i < prims.n; i++) {
-            const Prim &q = prims[i];
-            int op = q.parent < 0 ? O_COMPL : nodes[q.parent].op;  // the root: either decides
-            prims[i].settles = (unsigned char)(op == O_UNION ? 2 : op == O_INTER ? 1 : op == O_DIFF ? (q.first ? 1 : 2) : 3);
-        }
+        scene_link(s);
     } else {
         prims.release(c);
         nodes.release(c);
@@ -5824,22 +6055,22 @@ void tex_coords(const Prim &q, R3 x, double *s, double *t, R3 *ds, R3 *dt) {
     *s = *t = 0;
     *ds = *dt = r3(0, 0, 0);
     if (q.map == MAP_PLANE) {
-        R3 d = x - q.p;
-        *s = (double)dot(d, q.mu) / (double)dot(q.mu, q.mu);
-        *t = (double)dot(d, q.mv) / (double)dot(q.mv, q.mv);
-        *ds = unit(q.mu - q.n * dot(q.mu, q.n));
-        *dt = unit(q.mv - q.n * dot(q.mv, q.n));
+        R3 d = x - q.p, mu = q.tm->u, mv = q.tm->v;
+        *s = (double)dot(d, mu) / (double)dot(mu, mu);
+        *t = (double)dot(d, mv) / (double)dot(mv, mv);
+        *ds = unit(mu - q.n * dot(mu, q.n));
+        *dt = unit(mv - q.n * dot(mv, q.n));
     } else if (q.map == MAP_SPHERE) {
-        R3 nrm = unit(x - q.p), north = unit(q.mu);
-        R3 e0 = unit(q.mv - north * dot(q.mv, north)), third = cross(north, e0);
+        R3 nrm = unit(x - q.p), north = unit(q.tm->u), mv = q.tm->v;
+        R3 e0 = unit(mv - north * dot(mv, north)), third = cross(north, e0);
         double lon = atan2((double)dot(nrm, third), (double)dot(nrm, e0));
-        if (q.mirrored) lon = -lon;
+        if (q.tm->mirrored) lon = -lon;
         if (lon < 0) lon += 2 * PI;
         *s = lon / (2 * PI);
         if (*s >= 1) *s = 0;
         double c = -(double)dot(nrm, north);
         *t = acos(c > 1 ? 1 : c < -1 ? -1 : c) / PI;
-        *ds = unit(cross(north, nrm)) * (real)(q.mirrored ? -1 : 1);
+        *ds = unit(cross(north, nrm)) * (real)(q.tm->mirrored ? -1 : 1);
         *dt = unit(north - nrm * dot(north, nrm));
     }
 }
@@ -6219,16 +6450,24 @@ void scene_camera(const pray_ctx *c, Scene *s) {
 pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *lights, bool render) {
     memset(s, 0, sizeof *s);
     s->prims.init();
+    s->maps.init();
     s->nodes.init();
     s->lights.init();
     s->kids.init();
     s->prune = opt_int(c, OPT_BOUNDS) && !opt_int(c, OPT_BRUTE);
+    s->models_held = 1;  // each primitive flattened holds its model
+    // room for every primitive the tree stands for, and no more (folding may leave some out)
+    if (root->nprims > 0 && !s->prims.reserve_exact(c, (int)root->nprims)) return c->status;
     s->root = flatten(c, s, root);
+    c->stats.primitives_declared = root->nprims;
+    if (s->root != -3 && c->drop == root) {  // the tree is not needed any more
+        c->drop = NULL;
+        release_handle(c, root);
+    }
     // snapped before compaction, over every primitive flattened, so that the reference and the
     // simplified scene give the same surviving primitives the same numbers
-    if (s->root == -3 || snap_coincident(c, s) || scene_compact(c, s)) return c->status;
+    if (s->root == -3 || snap_coincident(c, s) || merge_chains(c, s) || scene_compact(c, s)) return c->status;
     if (cancelled(c)) return fail_cancelled(c);
-    c->stats.primitives_declared = root->nprims;
     for (int i = 0; lights && i < lights->n; i++) {
         const LightSrc &src = lights->src[i];
         Light L;
@@ -6238,7 +6477,9 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
         if (!s->lights.push(c, L)) return c->status;
     }
     scene_camera(c, s);
+    mem_phase(c, MEM_PREPARE);
     if (!opt_int(c, OPT_BRUTE) && accel_build(c, s, render)) return c->status;  // (the eye's buffer: after the camera)
+    mem_phase(c, MEM_ACCEL);
     s->depth = opt_int(c, OPT_DEPTH);
     s->shadows = opt_int(c, OPT_SHADOWS);
     s->antialias = opt_int(c, OPT_ANTIALIAS);
@@ -7380,20 +7621,20 @@ bool bad_pair(pray_ctx *c, pray_vec u, pray_vec v, const char *what) {
 pray_object *pray_planemap(pray_ctx *c, pray_model *m, pray_vec point, pray_vec normal, pray_vec u, pray_vec v) {
     if (!c || !model_ok(c, m, "pray_planemap") || bad_pair(c, u, v, "planemap")) return NULL;
     pray_object *o = pray_plane(c, m, point, normal);
-    if (!o) return NULL;
-    o->map = MAP_PLANE;
-    o->mu = u;
-    o->mv = v;
+    if (o && !obj_map(c, o, MAP_PLANE, u, v, 0)) {
+        release_handle(c, o);
+        return NULL;
+    }
     return o;
 }
 
 pray_object *pray_spheremap(pray_ctx *c, pray_model *m, pray_vec centre, double r, pray_vec north, pray_vec zero) {
     if (!c || !model_ok(c, m, "pray_spheremap") || bad_pair(c, north, zero, "spheremap")) return NULL;
     pray_object *o = pray_sphere(c, m, centre, r);
-    if (!o) return NULL;
-    o->map = MAP_SPHERE;
-    o->mu = north;
-    o->mv = zero;
+    if (o && !obj_map(c, o, MAP_SPHERE, north, zero, 0)) {
+        release_handle(c, o);
+        return NULL;
+    }
     return o;
 }
 
@@ -7798,6 +8039,7 @@ pray_status image_limits(pray_ctx *c) {
 pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, const pray_rect &r,
                         const pray_buffers &out) {
     double t0 = clock_seconds();
+    mem_phase(c, MEM_RUN);
     Scene s;
     pray_status st = scene_build(c, &s, root, lights, true);
     double t1 = clock_seconds();
@@ -7809,6 +8051,7 @@ pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, cons
     c->stats.time_prepare += t1 - t0;
     c->stats.time_render += clock_seconds() - t1;
     scene_release(c, &s);
+    mem_phase(c, st == PRAY_OK ? MEM_RENDER : MEM_PREPARE);  // (what the scene held is counted)
     return st;
 }
 // What pray_render and pray_render_into check of the scene.
@@ -8052,26 +8295,28 @@ pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *pat
 // =============================================================================================
 namespace {
 
-// Memory for one run's syntax tree and strings, freed all at once.
+// Memory for pieces of a program (a statement's syntax tree, a line's names and strings, the
+// names of variables), freed all at once: at the end of a run, or by reset for the next piece.
 struct Arena {
     Array<char *> chunks;
-    size_t left;
+    size_t left, size0;  // size0: of the first chunk, which reset keeps
     char *next;
     void init() {
         chunks.init();
-        left = 0;
+        left = size0 = 0;
         next = NULL;
     }
     void *get(pray_ctx *c, size_t n) {
         n = (n + 15) & ~(size_t)15;
         if (n > left) {
-            size_t sz = n > 65536 ? n : 65536;
+            size_t sz = n > 16384 ? n : 16384;
             char *p = (char *)mem_alloc(c, sz);
             if (!p) return NULL;
             if (!chunks.push(c, p)) {
                 mem_free(c, p);
                 return NULL;
             }
+            if (chunks.n == 1) size0 = sz;
             next = p;
             left = sz;
         }
@@ -8080,6 +8325,14 @@ struct Arena {
         left -= n;
         memset(r, 0, n);
         return r;
+    }
+    // Everything given out so far is forgotten; the first chunk stays for what comes next.
+    void reset(pray_ctx *c) {
+        if (!chunks.n) return;
+        for (int i = 1; i < chunks.n; i++) mem_free(c, chunks[i]);
+        chunks.n = 1;
+        next = chunks[0];
+        left = size0;
     }
     void release(pray_ctx *c) {
         for (int i = 0; i < chunks.n; i++) mem_free(c, chunks[i]);
@@ -8100,13 +8353,18 @@ struct Tok {
     int dotnum;     // a number written with a leading '.'
 };
 
+// The lexer hands out one line at a time (lex_line): the parser never holds the tokens of more
+// than the line it is reading, so a program of any length is read in little memory.
 struct Lexer {
     pray_ctx *c;
     const char *name;
     const unsigned char *p, *end;
     int line, col;
-    Arena *arena;
-    Array<Tok> toks;
+    Arena *text;       // the names and strings of the tokens in toks
+    Array<Tok> toks;   // the tokens of the current line
+    double maxstring;  // option maxstring as the run started: literals are checked against it
+    int at_end;        // toks ends with T_EOF
+    int failed;        // lex_line found an error
 };
 
 pray_status perr(pray_ctx *c, const char *name, int line, int col, pray_status s, const char *fmt, ...)
@@ -8274,9 +8532,9 @@ pray_status lex_string(Lexer &L) {
         int n;
         st = lex_text_char(L, &n);
         if (st) break;
-        if ((double)t.a.n + n > L.c->cur.opt.v[OPT_MAXSTRING]) {
+        if ((double)t.a.n + n > L.maxstring) {
             st = perr(L.c, L.name, line, col, PRAY_ERR_LIMIT, "string longer than %.0f bytes (option maxstring)",
-                      L.c->cur.opt.v[OPT_MAXSTRING]);
+                      L.maxstring);
             break;
         }
         if (!t.add(L.c, (const char *)L.p, (size_t)n)) {
@@ -8286,7 +8544,7 @@ pray_status lex_string(Lexer &L) {
         lex_adv(L, n);
     }
     if (st == PRAY_OK) {
-        char *s = (char *)L.arena->get(L.c, (size_t)t.a.n + 1);
+        char *s = (char *)L.text->get(L.c, (size_t)t.a.n + 1);
         if (!s || !push_tok(L, T_STR, 0, line, col)) st = L.c->status;
         else {
             memcpy(s, t.str(), (size_t)t.a.n + 1);
@@ -8323,9 +8581,9 @@ pray_status check_line_lengths(Lexer &L) {
     return PRAY_OK;
 }
 
-pray_status lex(Lexer &L) {
-    int last_line = 1;
-    if (check_line_lengths(L)) return L.c->status;
+// The tokens of one line up to its T_NL (a continued line is one line); at the end of the
+// program T_NL and T_EOF.
+pray_status lex_tokens(Lexer &L) {
     while (L.p < L.end) {
         unsigned ch = *L.p;
         if (ch == ' ' || ch == '\t') {
@@ -8335,7 +8593,7 @@ pray_status lex(Lexer &L) {
         if (ch == '\n' || (ch == '\r' && L.p + 1 < L.end && L.p[1] == '\n')) {
             if (!push_tok(L, T_NL, 0, L.line, L.col)) return L.c->status;
             lex_newline(L);
-            continue;
+            return PRAY_OK;
         }
         if (ch == '/' && L.p + 1 < L.end && L.p[1] == '/') {
             pray_status st = lex_comment(L);
@@ -8356,7 +8614,6 @@ pray_status lex(Lexer &L) {
                 return perr(L.c, L.name, line, col, PRAY_ERR_SYNTAX, "line continuation at the end of the file");
             continue;
         }
-        last_line = L.line;
         if (is_digit((int)ch) || (ch == '.' && L.p + 1 < L.end && is_digit(L.p[1]))) {
             pray_status st = lex_number(L);
             if (st) return st;
@@ -8367,7 +8624,7 @@ pray_status lex(Lexer &L) {
             int col = L.col;
             while (L.p < L.end && (is_alpha(*L.p) || is_digit(*L.p))) lex_adv(L, 1);
             int n = (int)(L.p - s);
-            char *name = (char *)L.arena->get(L.c, (size_t)n + 1);
+            char *name = (char *)L.text->get(L.c, (size_t)n + 1);
             if (!name || !push_tok(L, T_NAME, 0, L.line, col)) return L.c->status;
             memcpy(name, s, (size_t)n);
             L.toks[L.toks.n - 1].s = name;
@@ -8416,9 +8673,36 @@ pray_status lex(Lexer &L) {
         snprintf(msg, sizeof msg, "unexpected character '%s' (U+%04lX)", what, cp);
         return lex_err(L, "%s", msg);
     }
-    (void)last_line;
     if (!push_tok(L, T_NL, 0, L.line, L.col) || !push_tok(L, T_EOF, 0, L.line, L.col)) return L.c->status;
+    L.at_end = 1;
     return PRAY_OK;
+}
+
+// The next line's tokens replace the current line's.
+pray_status lex_line(Lexer &L) {
+    L.toks.n = 0;
+    L.text->reset(L.c);
+    if (L.at_end) return push_tok(L, T_EOF, 0, L.line, L.col) ? PRAY_OK : L.c->status;
+    pray_status st = lex_tokens(L);
+    if (st) L.failed = 1;
+    return st;
+}
+
+// Start reading the program from its beginning, the first time with the check of its lines'
+// lengths: the first line's tokens.
+pray_status lex_start(Lexer &L, const char *text, size_t len, bool check) {
+    L.p = (const unsigned char *)text;
+    L.end = L.p + len;
+    L.line = 1;
+    L.col = 1;
+    L.at_end = L.failed = 0;
+    // a UTF-8 byte order mark is allowed at the start
+    if (len >= 3 && L.p[0] == 0xEF && L.p[1] == 0xBB && L.p[2] == 0xBF) L.p += 3;
+    if (check && check_line_lengths(L)) {
+        L.failed = 1;
+        return L.c->status;
+    }
+    return lex_line(L);
 }
 
 } // namespace
@@ -8475,14 +8759,29 @@ struct Var {
 struct Parser {
     pray_ctx *c;
     const char *name;
+    Lexer *L;    // the tokens of the current line: t[0 .. L->toks.n)
     Tok *t;
     int pos;
     int depth;   // nesting of parentheses, literals, calls, unary operators, powers
     int blocks;  // nesting of if and while
-    Arena *arena;
+    double maxnest;  // option maxnest as the run started
+    Arena *arena;    // the syntax tree of the statement being read
+    Arena *names;    // the names of variables, for the whole run
     Array<Var> *vars;
     Array<int> hash;  // open addressing: slot + 1, 0 = empty; size a power of two
 };
+
+// Past the T_NL at the current position: the tokens of the next line, when it takes them.
+// Only here does the parser leave a line, so a token of the line before is never looked at
+// again (the lexer reuses their memory).
+pray_status next_line(Parser &P) {
+    P.pos++;
+    if (P.pos < P.L->toks.n) return PRAY_OK;
+    pray_status st = lex_line(*P.L);
+    P.t = P.L->toks.p;
+    P.pos = 0;
+    return st;
+}
 
 Tok &cur(Parser &P) { return P.t[P.pos]; }
 bool is_op(const Tok &t, int op) { return t.kind == T_OP && t.op == op; }
@@ -8526,7 +8825,11 @@ pray_status expect_op(Parser &P, int op, const char *what) {
     return syn(P, cur(P), "%s", msg);
 }
 
+// Every predefined word (keyword, constant, function) starts with a lower-case letter.
+inline bool may_be_predefined(const char *s) { return *s >= 'a' && *s <= 'z'; }
+
 bool is_reserved(const char *s) {
+    if (!may_be_predefined(s)) return false;
     for (size_t i = 0; i < sizeof KEYWORDS / sizeof KEYWORDS[0]; i++)
         if (strcmp(KEYWORDS[i], s) == 0) return true;
     return builtin_find(s) != NULL;
@@ -8561,7 +8864,11 @@ int var_slot(Parser &P, const char *name) {
     for (; h[(int)k]; k = (k + 1) & (unsigned)(h.n - 1))
         if (strcmp((*P.vars)[h[(int)k] - 1].name, name) == 0) return h[(int)k] - 1;
     Var v;
-    v.name = name;
+    size_t len = strlen(name);
+    char *kept = (char *)P.names->get(P.c, len + 1);
+    if (!kept) return -1;
+    memcpy(kept, name, len + 1);
+    v.name = kept;
     if (!P.vars->push(P.c, v)) return -1;
     h[(int)k] = P.vars->n;
     return P.vars->n - 1;
@@ -8660,22 +8967,23 @@ Expr *parse_primary(Parser &P) {
     if (t.kind == T_STR) {
         P.pos++;
         Expr *e = new_expr(P, EX_STR, t);
-        if (e) {
-            e->s = t.s;
-            e->n = t.n;
-        }
+        char *str = e ? (char *)P.arena->get(P.c, (size_t)t.n + 1) : NULL;
+        if (!str) return NULL;
+        memcpy(str, t.s, (size_t)t.n + 1);
+        e->s = str;
+        e->n = t.n;
         return e;
     }
     if (t.kind == T_NAME) {
         P.pos++;
         static const char *const consts[] = {"true", "false", "nothing", "none", "pi"};
-        for (int i = 0; i < 5; i++)
+        for (int i = 0; i < 5 && may_be_predefined(t.s); i++)
             if (strcmp(t.s, consts[i]) == 0) {
                 Expr *e = new_expr(P, EX_CONST, t);
                 if (e) e->n = i;
                 return e;
             }
-        const Builtin *b = builtin_find(t.s);
+        const Builtin *b = may_be_predefined(t.s) ? builtin_find(t.s) : NULL;
         if (b) {
             if (!is_op(cur(P), '(')) {
                 syn(P, t, "'%s' is a function: write it with its arguments in parentheses", t.s);
@@ -8686,7 +8994,7 @@ Expr *parse_primary(Parser &P) {
             Expr *e = new_expr(P, EX_CALL, t);
             if (!e) return NULL;
             e->n = builtin_index(b);
-            e->s = t.s;
+            e->s = builtin_name(e->n);
             Array<Expr *> args;
             args.init();
             bool ok = true;
@@ -8727,9 +9035,10 @@ Expr *parse_primary(Parser &P) {
         }
         Expr *e = new_expr(P, EX_VAR, t);
         if (!e) return NULL;
-        e->s = t.s;
         e->n = var_slot(P, t.s);
-        return e->n < 0 ? NULL : e;
+        if (e->n < 0) return NULL;
+        e->s = (*P.vars)[e->n].name;
+        return e;
     }
     if (is_op(t, '(')) {
         if (!enter(P)) return NULL;
@@ -8748,9 +9057,9 @@ Expr *parse_primary(Parser &P) {
 
 // One level deeper, at token `at` (default: the current token).
 bool enter(Parser &P, const Tok *at) {
-    if (++P.depth > P.c->cur.opt.v[OPT_MAXNEST]) {
+    if (++P.depth > P.maxnest) {
         char msg[80];
-        double lim = P.c->cur.opt.v[OPT_MAXNEST];
+        double lim = P.maxnest;
         snprintf(msg, sizeof msg, "expression nested deeper than %.0f level%s (option maxnest)", lim, lim == 1 ? "" : "s");
         syn(P, at ? *at : cur(P), "%s", msg);
         return false;
@@ -8867,10 +9176,7 @@ Expr *parse_and(Parser &P) { return parse_chain(P, parse_cmp, is_and); }
 Expr *parse_expr(Parser &P) { return parse_chain(P, parse_and, is_orop); }
 
 pray_status end_of_line(Parser &P) {
-    if (cur(P).kind == T_NL) {
-        P.pos++;
-        return PRAY_OK;
-    }
+    if (cur(P).kind == T_NL) return next_line(P);
     char buf[80];
     return syn(P, cur(P), "expected end of line, found '%s'", tok_text(cur(P), buf, sizeof buf));
 }
@@ -8994,11 +9300,13 @@ Stmt *parse_statement(Parser &P) {
     }
     if (is_word(t, "if") || is_word(t, "while")) {
         bool is_if = is_word(t, "if");
-        s = new_stmt(P, is_if ? ST_IF : ST_WHILE, t);
+        Tok word = t;  // (the block takes the lines after this one's)
+        word.s = is_if ? "if" : "while";
+        s = new_stmt(P, is_if ? ST_IF : ST_WHILE, word);
         if (!s) return NULL;
         P.pos++;
         if (cur(P).kind == T_NL) {
-            syn(P, cur(P), "'%s' needs a condition", t.s);
+            syn(P, cur(P), "'%s' needs a condition", word.s);
             return NULL;
         }
         Expr *cond = parse_expr(P);
@@ -9009,9 +9317,9 @@ Stmt *parse_statement(Parser &P) {
         s->nargs = 1;
         if (is_if && is_word(cur(P), "then")) P.pos++;
         if (end_of_line(P)) return NULL;
-        if (++P.blocks > P.c->cur.opt.v[OPT_MAXNEST]) {
-            double lim = P.c->cur.opt.v[OPT_MAXNEST];
-            syn(P, t, "blocks nested deeper than %.0f level%s (option maxnest)", lim, lim == 1 ? "" : "s");
+        if (++P.blocks > P.maxnest) {
+            double lim = P.maxnest;
+            syn(P, word, "blocks nested deeper than %.0f level%s (option maxnest)", lim, lim == 1 ? "" : "s");
             return NULL;
         }
         Array<Stmt *> body;
@@ -9044,11 +9352,11 @@ Stmt *parse_statement(Parser &P) {
             char msg[200];
             if (stop)
                 snprintf(msg, sizeof msg, "'%s' where '%s' was expected to close the '%s' of line %d",
-                         stop, want, t.s, t.line);
+                         stop, want, word.s, word.line);
             else
-                snprintf(msg, sizeof msg, "'%s' without '%s'", t.s, want);
+                snprintf(msg, sizeof msg, "'%s' without '%s'", word.s, want);
             if (stop) syn(P, cur(P), "%s", msg);
-            else syn(P, t, "%s", msg);
+            else syn(P, word, "%s", msg);
             return NULL;
         }
         P.pos++;
@@ -9082,6 +9390,14 @@ Stmt *parse_statement(Parser &P) {
     return NULL;
 }
 
+// The word that ends a block ('else', 'endif', 'endwhile') at the current token, or NULL.
+const char *block_end(Parser &P) {
+    static const char *const ends[] = {"else", "endif", "endwhile"};
+    for (int i = 0; i < 3; i++)
+        if (is_word(cur(P), ends[i])) return ends[i];
+    return NULL;
+}
+
 // block -> { statement NL }  up to 'else', 'endif', 'endwhile' or the end of the file
 bool parse_block(Parser &P, Array<Stmt *> *out, const char **stop) {
     *stop = NULL;
@@ -9089,13 +9405,10 @@ bool parse_block(Parser &P, Array<Stmt *> *out, const char **stop) {
         Tok &t = cur(P);
         if (t.kind == T_EOF) return true;
         if (t.kind == T_NL) {
-            P.pos++;
+            if (next_line(P)) return false;
             continue;
         }
-        if (is_word(t, "else") || is_word(t, "endif") || is_word(t, "endwhile")) {
-            *stop = t.s;
-            return true;
-        }
+        if ((*stop = block_end(P)) != NULL) return true;
         Stmt *s = parse_statement(P);
         if (!s || !out->push(P.c, s)) return false;
     }
@@ -9134,6 +9447,14 @@ struct Interp {
     const char *name;
     Array<Var> vars;
     Array<Value> vals;  // by variable slot
+    // Values no statement after will use are released (release_dead): last[slot] is the last
+    // statement of the top level that names the slot; `order` the slots by it, `dead` how many of
+    // them are released; dropped[slot]: released so (still a name with a value, for messages).
+    Array<int> last, order;
+    Array<unsigned char> dropped;
+    int dead;
+    const void *top;  // the statement of the top level running now, and its number
+    int top_index;
     double steps;
     int quit;
     int frames;
@@ -9473,9 +9794,15 @@ const Builtin BUILTINS[] = {
 };
 const int NBUILTINS = (int)(sizeof BUILTINS / sizeof BUILTINS[0]);
 
+// The table is in alphabetical order: found by halving (every name of a program is looked up).
 const Builtin *builtin_find(const char *name) {
-    for (int i = 0; i < NBUILTINS; i++)
-        if (strcmp(BUILTINS[i].name, name) == 0) return &BUILTINS[i];
+    int lo = 0, hi = NBUILTINS - 1;
+    while (lo <= hi) {
+        int mid = (lo + hi) / 2, d = strcmp(BUILTINS[mid].name, name);
+        if (d == 0) return &BUILTINS[mid];
+        if (d < 0) lo = mid + 1;
+        else hi = mid - 1;
+    }
     return NULL;
 }
 int builtin_index(const Builtin *b) { return (int)(b - BUILTINS); }
@@ -9728,7 +10055,7 @@ pray_status undefined_var(Interp &I, const Expr *e) {
     Suggest sg;
     sg.init(e->s);
     for (int i = 0; i < I.vars.n; i++)
-        if (I.vals[i].t != V_NONE) sg.offer(I.vars[i].name);
+        if (I.vals[i].t != V_NONE || (i < I.dropped.n && I.dropped[i])) sg.offer(I.vars[i].name);
     if (sg.best)
         return rerr(I, e, PRAY_ERR_RUNTIME, "undefined variable '%s'; did you mean '%s'?", *Shown(e->s), sg.best);
     return rerr(I, e, PRAY_ERR_RUNTIME, "undefined variable '%s'", *Shown(e->s));
@@ -9929,7 +10256,12 @@ pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
     frame_name(name, keep + 40, base, I.names[slot].frames);
     warn_aspect(I, s);
     pray_image img;
+    // this reference to the object is given up once the scene is flattened: when no variable
+    // holds it any more, its tree is freed before the rest of the scene is built
+    c->drop = (pray_object *)a[0].ref;
     pray_status st = pray_render(c, (pray_object *)a[0].ref, all, &img);
+    if (c->drop == NULL) a[0].ref = NULL, a[0].t = V_NONE;
+    c->drop = NULL;
     release_handle(c, all);
     if (st) {
         mem_free(c, base);
@@ -9964,6 +10296,17 @@ void print_out(pray_ctx *c, const char *s, size_t n) {
 }
 
 pray_status exec_block(Interp &I, Stmt **body, int n);
+
+// Release the values of the variables that no statement after the top level's statement k names.
+void release_dead(Interp &I, int k) {
+    while (I.dead < I.order.n && I.last[I.order[I.dead]] <= k) {
+        int slot = I.order[I.dead++];
+        if (slot < I.vals.n && I.vals[slot].t != V_NONE) {
+            vrelease(I, I.vals[slot]);
+            I.dropped[slot] = 1;
+        }
+    }
+}
 
 pray_status step(Interp &I, const Stmt *s) {
     if (cancelled(I.c)) return perr(I.c, I.name, s->line, s->col, PRAY_ERR_CANCELLED, "cancelled");
@@ -10020,6 +10363,7 @@ pray_status exec(Interp &I, const Stmt *s) {
     pray_status st = PRAY_OK;
     int done = 0;
     for (; done < n && st == PRAY_OK; done++) st = eval(I, s->args[done], &args[done]);
+    if (st == PRAY_OK && s->kind == ST_RENDER && s == I.top) release_dead(I, I.top_index);  // before the render
     if (st == PRAY_OK) {
         switch (s->kind) {
         case ST_PRINT: {
@@ -10081,62 +10425,196 @@ pray_status exec_block(Interp &I, Stmt **body, int n) {
     return PRAY_OK;
 }
 
-pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t len) {
+// The variables that statement k of the top level names (I.last).
+bool note_uses(Interp &I, const Expr *e, int k);
+bool note_slot(Interp &I, int slot, int k) {
+    if (slot >= I.last.n) {
+        if (!I.last.reserve(I.c, slot + 1)) return false;
+        while (I.last.n <= slot) I.last.p[I.last.n++] = -1;
+    }
+    I.last[slot] = k;
+    return true;
+}
+bool note_uses(Interp &I, const Expr *e, int k) {
+    if (!e) return true;
+    if (e->kind == EX_VAR && !note_slot(I, e->n, k)) return false;
+    if (!note_uses(I, e->a, k) || (e->b != e->a && !note_uses(I, e->b, k)) || (e->c != e->a && !note_uses(I, e->c, k)))
+        return false;
+    for (int i = 0; i < e->nargs; i++)
+        if (!note_uses(I, e->args[i], k)) return false;
+    return true;
+}
+bool note_uses(Interp &I, const Stmt *s, int k) {
+    if (s->kind == ST_ASSIGN && !note_slot(I, s->slot, k)) return false;
+    for (int i = 0; i < s->nargs; i++)
+        if (!note_uses(I, s->args[i], k)) return false;
+    for (int i = 0; i < s->nbody; i++)
+        if (!note_uses(I, s->body[i], k)) return false;
+    for (int i = 0; i < s->nels; i++)
+        if (!note_uses(I, s->els[i], k)) return false;
+    return true;
+}
+
+struct SlotLast {
+    int last, slot;
+};
+int slot_last_cmp(const void *pa, const void *pb) {
+    const SlotLast *a = (const SlotLast *)pa, *b = (const SlotLast *)pb;
+    if (a->last != b->last) return a->last < b->last ? -1 : 1;
+    return a->slot - b->slot;
+}
+
+// I.order: the slots in the order in which they die (by I.last).
+bool order_slots(Interp &I) {
+    int n = I.vars.n;
+    if (!I.last.reserve(I.c, n)) return false;
+    while (I.last.n < n) I.last.p[I.last.n++] = -1;  // (every slot was named; kept safe all the same)
+    SlotLast *sl = (SlotLast *)mem_alloc(I.c, sizeof(SlotLast) * (size_t)n);
+    if (!sl || !I.order.reserve(I.c, n) || !I.dropped.reserve(I.c, n)) {
+        mem_free(I.c, sl);
+        return false;
+    }
+    for (int i = 0; i < n; i++) {
+        sl[i].last = I.last[i];
+        sl[i].slot = i;
+    }
+    qsort(sl, (size_t)n, sizeof(SlotLast), slot_last_cmp);
+    for (int i = 0; i < n; i++) I.order.p[i] = sl[i].slot;
+    I.order.n = n;
+    memset(I.dropped.p, 0, (size_t)n);
+    I.dropped.n = n;
+    mem_free(I.c, sl);
+    return true;
+}
+
+// Read the program from its start, one statement of the top level at a time; only that
+// statement's tree and its current line's tokens are held. Without `run` the program is only
+// checked, so that a malformed program runs none of its statements, and the variables each
+// statement names are noted; with it each statement runs as soon as it is read, and the values
+// of variables that no statement after it names are released. *parse_time: seconds spent
+// reading.
+pray_status read_statements(Parser &P, const char *text, size_t len, Interp *I, bool run, double *parse_time) {
+    pray_ctx *c = P.c;
+    int k = 0;  // statements of the top level read so far
     double t0 = clock_seconds();
-    Arena arena;
-    arena.init();
+    P.depth = P.blocks = 0;
+    pray_status st = lex_start(*P.L, text, len, !run);
+    P.t = P.L->toks.p;
+    P.pos = 0;
+    while (st == PRAY_OK) {
+        if (cur(P).kind == T_EOF) break;
+        if (cur(P).kind == T_NL) {
+            st = next_line(P);
+            continue;
+        }
+        const char *stop = block_end(P);
+        if (stop) {
+            st = syn(P, cur(P), "'%s' without a matching '%s'", stop, strcmp(stop, "endwhile") == 0 ? "while" : "if");
+            break;
+        }
+        Stmt *s = parse_statement(P);
+        if (!s) {
+            st = c->status;
+            break;
+        }
+        if (!run && !note_uses(*I, s, k)) {
+            st = c->status;
+            break;
+        }
+        if (run) {
+            if (I->vars.n > I->vals.n) {  // (the check found every name already)
+                if (!I->vals.reserve(c, I->vars.n)) {
+                    st = c->status;
+                    break;
+                }
+                memset(I->vals.p + I->vals.n, 0, sizeof(Value) * (size_t)(I->vars.n - I->vals.n));
+                I->vals.n = I->vars.n;
+            }
+            double t1 = clock_seconds();
+            *parse_time += t1 - t0;
+            I->top = s;
+            I->top_index = k;
+            st = exec(*I, s);
+            if (st == PRAY_OK) release_dead(*I, k);
+            t0 = clock_seconds();
+            if (I->quit) break;
+        }
+        k++;
+        P.arena->reset(c);
+    }
+    *parse_time += clock_seconds() - t0;
+    if (st && !run && !P.L->failed) {
+        // the program is wrong: an error of its characters, anywhere, is the one to report
+        // (as when the whole text is lexed first); else this one
+        pray_status first = st;
+        char msg[sizeof c->msg];
+        memcpy(msg, c->msg, sizeof msg);
+        while (!P.L->at_end && lex_line(*P.L) == PRAY_OK) {
+        }
+        if (P.L->failed) return c->status;
+        c->status = first;
+        memcpy(c->msg, msg, sizeof msg);
+    }
+    return st;
+}
+
+pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t len) {
+    Arena tree, words, names;  // a statement's syntax tree; a line's names and strings; variables' names
+    tree.init();
+    words.init();
+    names.init();
     Lexer L;
+    memset(&L, 0, sizeof L);
     L.c = c;
     L.name = name;
-    L.p = (const unsigned char *)text;
-    L.end = L.p + len;
-    L.line = 1;
-    L.col = 1;
-    L.arena = &arena;
+    L.text = &words;
     L.toks.init();
-    // a UTF-8 byte order mark is allowed at the start
-    if (len >= 3 && L.p[0] == 0xEF && L.p[1] == 0xBB && L.p[2] == 0xBF) L.p += 3;
+    L.maxstring = c->cur.opt.v[OPT_MAXSTRING];
     Interp I;
     memset(&I, 0, sizeof I);
     I.c = c;
     I.name = name;
     I.vars.init();
     I.vals.init();
-    Array<Stmt *> prog;
-    prog.init();
-    pray_status st = lex(L);
-    if (st == PRAY_OK) {
-        Parser P;
-        P.c = c;
-        P.name = name;
-        P.t = L.toks.p;
-        P.pos = 0;
-        P.depth = 0;
-        P.blocks = 0;
-        P.arena = &arena;
-        P.vars = &I.vars;
-        P.hash.init();
-        const char *stop = NULL;
-        if (!parse_block(P, &prog, &stop)) st = c->status;
-        else if (stop)
-            st = syn(P, cur(P), "'%s' without a matching '%s'", stop, strcmp(stop, "endwhile") == 0 ? "while" : "if");
-        P.hash.release(c);
-    }
-    if (st == PRAY_OK && I.vars.n && !I.vals.reserve(c, I.vars.n)) st = c->status;
-    c->stats.time_parse += clock_seconds() - t0;
+    Parser P;
+    memset(&P, 0, sizeof P);
+    P.c = c;
+    P.name = name;
+    P.L = &L;
+    P.maxnest = c->cur.opt.v[OPT_MAXNEST];
+    P.arena = &tree;
+    P.names = &names;
+    P.vars = &I.vars;
+    P.hash.init();
+    // first the whole program is checked, then it is read again and run statement by statement
+    double parse_time = 0;
+    I.last.init();
+    I.order.init();
+    I.dropped.init();
+    pray_status st = read_statements(P, text, len, &I, false, &parse_time);
+    if (st == PRAY_OK && I.vars.n && (!I.vals.reserve(c, I.vars.n) || !order_slots(I))) st = c->status;
+    mem_phase(c, MEM_PARSE);
     if (st == PRAY_OK) {
         if (I.vars.n) memset(I.vals.p, 0, sizeof(Value) * (size_t)I.vars.n);
         I.vals.n = I.vars.n;
-        st = exec_block(I, prog.p, prog.n);
+        tree.reset(c);
+        st = read_statements(P, text, len, &I, true, &parse_time);
     }
+    c->stats.time_parse += parse_time;
+    mem_phase(c, MEM_RUN);
     for (int i = 0; i < I.vals.n; i++) vrelease(I, I.vals[i]);
     I.vals.release(c);
+    I.last.release(c);
+    I.order.release(c);
+    I.dropped.release(c);
     for (int i = 0; i < I.names.n; i++) mem_free(c, I.names[i].name);
     I.names.release(c);
     I.vars.release(c);
-    prog.release(c);
+    P.hash.release(c);
     L.toks.release(c);
-    arena.release(c);
+    tree.release(c);
+    words.release(c);
+    names.release(c);
     return st;
 }
 
@@ -10152,6 +10630,7 @@ void reset_run(pray_ctx *c) {
     c->cur = c->base;
     texture_cache_clear(c);  // files are read again by the next run
     memset(&c->stats, 0, sizeof c->stats);
+    c->peak = c->used;
     c->frames = 0;
     c->written = 0;
     c->status = PRAY_OK;
@@ -10223,8 +10702,19 @@ pray_status pray_run_file(pray_ctx *c, const char *path) {
     if (!f) return c->status;
     Text t;
     t.init();
-    bool ok = read_program(c, f, &t);
-    bool bad = ferror(f) != 0;
+    // a file whose size is known is read into a buffer of that size (it is held while it runs)
+    long size = -1;
+    bool bad = false;
+    if (!in && fseek(f, 0, SEEK_END) == 0) {
+        size = ftell(f);
+        bad = fseek(f, 0, SEEK_SET) != 0;
+    }
+    // (only where it fits under the cap: else reading finds what is wrong, a long line or the cap)
+    if (size > 0 && size < INT_MAX - 1 && (c->limit == 0 || (size_t)size + 65536 < c->limit - c->used) &&
+        !t.a.reserve_exact(c, (int)size + 1))
+        pray_clear_error(c);  // read as it comes
+    bool ok = bad || read_program(c, f, &t);
+    bad = bad || ferror(f) != 0;
     if (!in) fclose(f);
     pray_status st;
     if (!ok) st = c->status;
@@ -10343,11 +10833,13 @@ void print_stats(pray_ctx *c) {
             "traversal: %.0f voxel steps, %.0f area moves\n"
             "actions: set inside %.0f, set outside %.0f, check %.0f (frozen skips %.0f)\n"
             "intersection tests %.0f\n"
-            "time: parse %.3f s, prepare %.3f s, render %.3f s on %d thread%s\n",
+            "time: parse %.3f s, prepare %.3f s, render %.3f s on %d thread%s\n"
+            "memory: peak %.0f bytes; by phase: parse %.0f, run %.0f, prepare %.0f, acceleration %.0f, render %.0f\n",
             s.primitives_declared, s.primitives, s.nodes, s.grid[0], s.grid[1], s.grid[2], s.voxels, s.nested_voxels, s.nested_grids, s.lists,
             s.areas, s.memory, s.rays_primary, s.rays_primary_full, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.lightbuf_voxels, s.rays_lightbuf, s.eyebuf_voxels, s.rays_eyebuf, s.rays_shadowcache, s.voxel_steps,
             s.area_moves, s.set_inside, s.set_outside, s.checks, s.frozen_skips, s.intersection_tests,
-            s.time_parse, s.time_prepare, s.time_render, s.threads, s.threads == 1 ? "" : "s");
+            s.time_parse, s.time_prepare, s.time_render, s.threads, s.threads == 1 ? "" : "s", s.memory_peak,
+            s.memory_parse, s.memory_run, s.memory_prepare, s.memory_accel, s.memory_render);
 }
 
 // SIGINT and SIGTERM while an image is written: remove its temporary file, then die of the

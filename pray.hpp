@@ -9,9 +9,9 @@
 #define PRAY_HPP
 
 #define PRAY_VERSION_MAJOR 0
-#define PRAY_VERSION_MINOR 2
+#define PRAY_VERSION_MINOR 3
 #define PRAY_VERSION_PATCH 0
-#define PRAY_VERSION_STRING "0.2.0"
+#define PRAY_VERSION_STRING "0.3.0"
 
 /* ---------------------------------------------------------------------------------------------
    Configuration. Every macro is optional; define it on the command line or in a header named by
@@ -54,7 +54,7 @@ typedef enum pray_status {
 
 /* The text of a status code ("ok", "out of memory", ...). Never NULL. */
 const char *pray_status_text(pray_status s);
-/* "0.2.0". */
+/* "0.3.0". */
 const char *pray_version(void);
 /* The configuration compiled in, e.g. "interp stdio png threads real=double". */
 const char *pray_features(void);
@@ -208,7 +208,9 @@ double pray_option_get(const pray_ctx *ctx, const char *name);
    ------------------------------------------------------------------------------------------- */
 /* Run a program held in memory. `name` is used in messages, for the default output name (name
    with its extension replaced by .tif) and as the place beside which texture files are looked for
-   (its directory). `text` need not be NUL-terminated. */
+   (its directory). `text` need not be NUL-terminated. The whole program is checked before its
+   first statement runs, so a malformed one runs none; it is then read again and run a statement
+   at a time, holding only the current line's tokens and the current statement's tree. */
 pray_status pray_run_string(pray_ctx *ctx, const char *name, const char *text, size_t len);
 /* Run a program file (a regular file; a FIFO, directory or device is refused); "-" reads
    standard input (named "stdin.ray" in messages). Reading stops at the first line longer than
@@ -336,6 +338,14 @@ typedef struct pray_stats {
     double intersection_tests;       /* ray/primitive intersections computed */
     double frozen_skips;             /* checks skipped because the node was frozen */
     double time_parse, time_prepare, time_render; /* seconds */
+    /* Memory: the most bytes the context held at once (every block pray allocated in it, with
+       its bookkeeping), over the whole time and in each phase: reading the program (lexing and
+       parsing it, before it runs); running it (its values and everything else outside the
+       three phases after); preparing a scene (flattening and simplifying the tree); building
+       its acceleration structure; rendering (the image and the renderer's scratch). A host's
+       own calls count as running. */
+    double memory_peak;
+    double memory_parse, memory_run, memory_prepare, memory_accel, memory_render;
     long nested_grids, nested_voxels; /* grids nested in crowded voxels, and their voxels */
 } pray_stats;
 
