@@ -511,8 +511,13 @@ struct pray_ctx {
     int print_set;
     pray_progress_fn progress_fn;
     void *progress_ud;
-    pray_frame_fn frame_fn;
+    pray_frame_fn frame_fn;  // what a program's rendertiff hands its frame to (see frame_route)
     void *frame_ud;
+    pray_frame_fn host_frame_fn;  // pray_set_frame
+    void *host_frame_ud;
+    pray_render_fn render_fn;     // pray_set_render: the host renders a program's frames
+    void *render_ud;
+    int in_render_fn;             // render_fn is running: pray_render inside it renders
     pray_write_fn warn_fn;  // pray_set_warning
     void *warn_ud;
     Setup cur;       // in force now
@@ -6591,28 +6596,32 @@ bool image_ok(pray_ctx *c, const pray_image *img) {
     return true;
 }
 
-// Baseline TIFF 6.0: one strip, RGB, uncompressed, 8 or 16 bits per sample.
-pray_status write_tiff(pray_ctx *c, const pray_image *img, int bits, Sink &out) {
-    const int ntags = 12;
-    const unsigned long ifd = 8, bps = ifd + 2 + ntags * 12 + 4, xres = bps + 6, yres = xres + 8,
-                        data = yres + 8;
+// Baseline TIFF 6.0: one strip, RGB, uncompressed, 8 or 16 bits per sample. A note (printable
+// ASCII, see pray_write_image_note) becomes the ImageDescription, between the resolutions and the
+// samples; without one the file is the same but for that tag.
+pray_status write_tiff(pray_ctx *c, const pray_image *img, int bits, Sink &out, const char *note = NULL) {
+    const unsigned long nlen = note ? (unsigned long)strlen(note) + 1 : 0;
+    const int ntags = note ? 13 : 12;
+    const unsigned long ifd = 8, bps = ifd + 2 + ntags * 12 + 4, xres = bps + 6, yres = xres + 8, desc = yres + 8,
+                        data = desc + nlen;
     unsigned long W = (unsigned long)img->width, H = (unsigned long)img->height;
     unsigned long bytes = W * H * 3 * (bits / 8);
-    unsigned char h[data];
+    unsigned char h[8 + 2 + 13 * 12 + 4 + 6 + 16];
     memset(h, 0, sizeof h);
     h[0] = 'I';
     h[1] = 'I';
     le16(h + 2, 42);
     le32(h + 4, ifd);
-    le16(h + ifd, ntags);
-    // tag, type (3 SHORT, 4 LONG, 5 RATIONAL), count, value or offset
-    static const unsigned short tags[ntags][2] = {
-        {256, 4}, {257, 4}, {258, 3}, {259, 3}, {262, 3}, {273, 4},
+    le16(h + ifd, (unsigned)ntags);
+    // tag, type (2 ASCII, 3 SHORT, 4 LONG, 5 RATIONAL), count, value or offset
+    static const unsigned short tags[13][2] = {
+        {256, 4}, {257, 4}, {258, 3}, {259, 3}, {262, 3}, {270, 2}, {273, 4},
         {277, 3}, {278, 4}, {279, 4}, {282, 5}, {283, 5}, {296, 3}};
-    unsigned long vals[ntags] = {W, H, bps, 1, 2, data, 3, H, bytes, xres, yres, 2};
-    unsigned long counts[ntags] = {1, 1, 3, 1, 1, 1, 1, 1, 1, 1, 1, 1};
-    for (int i = 0; i < ntags; i++) {
-        unsigned char *e = h + ifd + 2 + 12 * i;
+    unsigned long vals[13] = {W, H, bps, 1, 2, desc, data, 3, H, bytes, xres, yres, 2};
+    unsigned long counts[13] = {1, 1, 3, 1, 1, nlen, 1, 1, 1, 1, 1, 1, 1};
+    for (int i = 0, k = 0; i < 13; i++) {
+        if (tags[i][0] == 270 && !note) continue;
+        unsigned char *e = h + ifd + 2 + 12 * k++;
         le16(e, tags[i][0]);
         le16(e + 2, tags[i][1]);
         le32(e + 4, counts[i]);
@@ -6628,7 +6637,8 @@ pray_status write_tiff(pray_ctx *c, const pray_image *img, int bits, Sink &out) 
     size_t rowbytes = (size_t)W * 3 * (bits / 8);
     unsigned char *row = (unsigned char *)mem_alloc(c, rowbytes);
     if (!row) return c->status;
-    out.put(h, sizeof h);
+    out.put(h, desc);
+    if (note) out.put(note, nlen);  // with its NUL, as ASCII fields end
     for (unsigned long y = 0; y < H; y++) {
         if (cancelled(c)) {
             mem_free(c, row);
@@ -6645,14 +6655,21 @@ pray_status write_tiff(pray_ctx *c, const pray_image *img, int bits, Sink &out) 
     return PRAY_OK;
 }
 
-// Binary PPM (P6); 16-bit samples are big-endian, as the format says.
-pray_status write_ppm(pray_ctx *c, const pray_image *img, int bits, Sink &out) {
+// Binary PPM (P6); 16-bit samples are big-endian, as the format says. A note is a comment line
+// after the magic number: "P6\n# NOTE\n...".
+pray_status write_ppm(pray_ctx *c, const pray_image *img, int bits, Sink &out, const char *note = NULL) {
     char head[64];
-    int n = snprintf(head, sizeof head, "P6\n%d %d\n%u\n", img->width, img->height,
+    int n = snprintf(head, sizeof head, "%d %d\n%u\n", img->width, img->height,
                      bits == 8 ? 255u : 65535u);
     size_t rowbytes = (size_t)img->width * 3 * (bits / 8);
     unsigned char *row = (unsigned char *)mem_alloc(c, rowbytes);
     if (!row) return c->status;
+    out.put("P6\n", 3);
+    if (note) {
+        out.put("# ", 2);
+        out.put(note, strlen(note));
+        out.put("\n", 1);
+    }
     out.put(head, (size_t)n);
     for (int y = 0; y < img->height; y++) {
         if (cancelled(c)) {
@@ -6758,9 +6775,9 @@ int image_format(const char *path) {
 }
 
 #if PRAY_HAS_STDIO
-pray_status write_format(pray_ctx *c, const pray_image *img, int fmt, int bits, Sink &out) {
-    if (fmt == FMT_TIFF) return write_tiff(c, img, bits, out);
-    if (fmt == FMT_PPM) return write_ppm(c, img, bits, out);
+pray_status write_format(pray_ctx *c, const pray_image *img, int fmt, int bits, Sink &out, const char *note) {
+    if (fmt == FMT_TIFF) return write_tiff(c, img, bits, out, note);
+    if (fmt == FMT_PPM) return write_ppm(c, img, bits, out, note);
 #if PRAY_HAS_PNG
     if (fmt == FMT_PNG) return write_png(c, img, out);
 #endif
@@ -6983,10 +7000,34 @@ void pray_set_progress(pray_ctx *c, pray_progress_fn fn, void *ud) {
     c->progress_fn = fn;
     c->progress_ud = ud;
 }
+namespace {
+// A frame of a program whose rendering the host does (pray_set_render): none when it left the
+// image empty, else the host's frame callback or the file, as without it.
+pray_status frame_of_host(void *ud, const pray_image *img, const char *name) {
+    pray_ctx *c = (pray_ctx *)ud;
+    if (!img->pixels) return PRAY_OK;
+    if (c->host_frame_fn) return c->host_frame_fn(c->host_frame_ud, img, name);
+    return pray_write_image(c, img, name, opt_int(c, OPT_BITS));
+}
+// What a program's rendertiff hands its frame to (frame_fn): the host's callback, or
+// frame_of_host while the host renders the frames.
+void frame_route(pray_ctx *c) {
+    c->frame_fn = c->render_fn ? frame_of_host : c->host_frame_fn;
+    c->frame_ud = c->render_fn ? (void *)c : c->host_frame_ud;
+}
+} // namespace
+
 void pray_set_frame(pray_ctx *c, pray_frame_fn fn, void *ud) {
     if (!c) return;
-    c->frame_fn = fn;
-    c->frame_ud = ud;
+    c->host_frame_fn = fn;
+    c->host_frame_ud = ud;
+    frame_route(c);
+}
+void pray_set_render(pray_ctx *c, pray_render_fn fn, void *ud) {
+    if (!c) return;
+    c->render_fn = fn;
+    c->render_ud = ud;
+    frame_route(c);
 }
 
 void pray_cancel(pray_ctx *c) {
@@ -7670,6 +7711,15 @@ pray_status pray_render(pray_ctx *c, pray_object *root, pray_light *lights, pray
     if (!c) return PRAY_ERR_ARG;
     Call call(c);
     if (!out) return fail(c, PRAY_ERR_ARG, "pray_render: no image to render into");
+    if (c->render_fn && c->running && !c->in_render_fn) {  // a program's frame, rendered by the host
+        c->in_render_fn = 1;
+        pray_status st = c->render_fn(c->render_ud, c, root, lights, c->frames, out);
+        c->in_render_fn = 0;
+        if (st == PRAY_OK) return PRAY_OK;
+        pray_image_free(c, out);
+        if (c->status == PRAY_OK || !c->msg[0]) fail(c, st, "the render function failed");
+        return c->status = st;
+    }
     if (!scene_ok(c, root, lights, "pray_render") || image_limits(c)) return c->status;
     int W = opt_int(c, OPT_WIDTH), H = opt_int(c, OPT_HEIGHT);
     pray_rect r = {0, 0, W, H};
@@ -7839,9 +7889,9 @@ pray_status pray_write_png(pray_ctx *c, const pray_image *img, pray_write_fn fn,
 #endif
 }
 
-pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *path, int bits) {
-    if (!c) return PRAY_ERR_ARG;
-    Call call(c);
+namespace {
+// pray_write_image and pray_write_image_note: the one way files are written.
+pray_status write_image_file(pray_ctx *c, const pray_image *img, const char *path, int bits, const char *note) {
     if (!image_ok(c, img)) return c->status;
     if (!path || !*path) return fail(c, PRAY_ERR_ARG, "no file name");
     if (bits != 8 && bits != 16) return fail(c, PRAY_ERR_ARG, "bits must be 8 or 16");
@@ -7850,6 +7900,16 @@ pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *pat
         return fail(c, PRAY_ERR_ARG, "cannot tell the image format of '%s' (use .tif, .ppm%s)", path,
                     PRAY_HAS_PNG ? " or .png" : "");
     if (fmt == FMT_PNG && bits != 8) return fail(c, PRAY_ERR_ARG, "PNG output has 8 bits only");
+    if (note) {
+        if (fmt == FMT_PNG)
+            return fail(c, PRAY_ERR_ARG, "cannot write a note into '%s': notes go into TIFF and PPM files only",
+                        path);
+        size_t i = 0;
+        for (; note[i]; i++)
+            if ((unsigned char)note[i] < 32 || (unsigned char)note[i] > 126 || i >= PRAY_NOTE_MAX) break;
+        if (note[i]) return fail(c, PRAY_ERR_ARG, "a note must be printable ASCII of at most %d characters",
+                                 PRAY_NOTE_MAX);
+    }
 #if PRAY_HAS_STDIO
     if (is_program(c, path))
         return fail(c, PRAY_ERR_IO, "cannot write '%s': it is the program being run (choose another output name)",
@@ -7867,7 +7927,7 @@ pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *pat
     pray_status st = PRAY_OK;
     if (fs.f) {  // (create_temp has named it for pray_temp_file: a signal handler may remove it)
         Sink s = {file_put, &fs};
-        st = write_format(c, img, fmt, bits, s);
+        st = write_format(c, img, fmt, bits, s, note);
         if (fflush(fs.f) != 0 && !fs.err) fs.err = errno ? errno : EIO;
         if (fclose(fs.f) != 0 && !fs.err) fs.err = errno ? errno : EIO;
         if (st == PRAY_OK && !fs.err && !file_replace(tmp, path)) fs.err = errno ? errno : EIO;
@@ -7885,6 +7945,49 @@ pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *pat
 #else
     return fail(c, PRAY_ERR_IO, "this build has no file access");
 #endif
+}
+} // namespace
+
+pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *path, int bits) {
+    if (!c) return PRAY_ERR_ARG;
+    Call call(c);
+    return write_image_file(c, img, path, bits, NULL);
+}
+
+pray_status pray_write_image_note(pray_ctx *c, const pray_image *img, const char *path, int bits,
+                                  const char *note) {
+    if (!c) return PRAY_ERR_ARG;
+    Call call(c);
+    if (!note) return fail(c, PRAY_ERR_ARG, "pray_write_image_note: no note");
+    return write_image_file(c, img, path, bits, note);
+}
+
+pray_status pray_image_new(pray_ctx *c, int width, int height, pray_image *out) {
+    if (out) {
+        out->width = out->height = 0;
+        out->pixels = NULL;
+    }
+    if (!c) return PRAY_ERR_ARG;
+    if (!out) return fail(c, PRAY_ERR_ARG, "pray_image_new: no image to make");
+    if (width < 1 || height < 1 || width > MAX_IMAGE_SIDE || height > MAX_IMAGE_SIDE ||
+        (double)width * height > MAX_IMAGE_PIXELS)
+        return fail(c, PRAY_ERR_ARG, "pray_image_new: no image can be %d x %d pixels", width, height);
+    float *p = (float *)mem_zalloc(c, sizeof(float) * 3 * (size_t)width * (size_t)height);
+    if (!p) return c->status;
+    out->pixels = p;
+    out->width = width;
+    out->height = height;
+    return PRAY_OK;
+}
+
+pray_status pray_set_error(pray_ctx *c, pray_status status, const char *message) {
+    if (!c) return PRAY_ERR_ARG;
+    if (status == PRAY_OK) {
+        pray_clear_error(c);
+        return PRAY_OK;
+    }
+    if ((int)status < 0 || (int)status > (int)PRAY_ERR_CANCELLED) status = PRAY_ERR_ARG;
+    return fail(c, status, "%s", message ? message : pray_status_text(status));
 }
 
 #if PRAY_HAS_INTERP
