@@ -159,8 +159,8 @@ void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
    signal handler that removes it before the program dies: reading it is async-signal-safe. */
 const char *pray_temp_file(const pray_ctx *ctx);
 /* Stop the call running on the context: pray_run_string, pray_run_file, pray_render,
-   pray_render_into, pray_prepare, pray_write_image, pray_write_tiff, pray_write_ppm or
-   pray_write_png. Safe from any thread and from a signal handler: it only sets a flag. The call stops at its next check (each statement
+   pray_render_into, pray_prepare, pray_write_image, pray_write_image_note, pray_write_tiff,
+   pray_write_ppm or pray_write_png. Safe from any thread and from a signal handler: it only sets a flag. The call stops at its next check (each statement
    of a program; each row of voxels while a scene is prepared; each row of an image rendered or
    written) with PRAY_ERR_CANCELLED, "error: cancelled" (with the place in a program). It leaves
    no file behind and no image; a byte sink has got part of one, to be thrown away. One of those
@@ -409,7 +409,8 @@ pray_status pray_write_image_note(pray_ctx *ctx, const pray_image *img, const ch
                                   const char *note);
 /* A new image of width x height pixels, all black, that belongs to the context like one
    pray_render made (pray_image_free, pray_free). *out is always set (0 x 0 and NULL on failure).
-   PRAY_ERR_ARG for a size pray cannot render (sides 1 to 65536, at most 2^28 pixels). */
+   PRAY_ERR_ARG for a size pray cannot render (sides 1 to 65536, at most 2^28 pixels);
+   PRAY_ERR_NOMEM over the context's memory cap. */
 pray_status pray_image_new(pray_ctx *ctx, int width, int height, pray_image *out);
 /* Record an error as pray's own calls do: status `status`, message "error: " + message (NULL:
    the status's text); returns status. For callbacks (render, frame) that fail with a message of

@@ -9,13 +9,19 @@
 # design) at SIZE pixels with antialias 2 and adaptive undersampling on.
 #
 #   sh tests/distributed.sh       (make check-mpi: builds ./pray and ./pray-mpi first)
-# PRAY, PRAY_MPI, MPIRUN and SIZE may be set; MPIRUN's default runs 3 ranks, as root too.
+# PRAY, PRAY_MPI, MPIRUN and SIZE may be set; MPIRUN's default runs 3 ranks, as root too; each
+# run of it may take TIMEOUT seconds (300).
 set -u
 cd "$(dirname "$0")/.." || exit 2
 : "${PRAY:=./pray}"
 : "${PRAY_MPI:=./pray-mpi}"
 : "${SIZE:=96x72}"
 : "${MPIRUN:=mpirun --oversubscribe --allow-run-as-root -np 3}"
+# a run that hangs fails the check instead of holding it
+if command -v timeout >/dev/null 2>&1; then MPIRUN="timeout ${TIMEOUT:-300} $MPIRUN"; fi
+# containers often forbid the cross-process memory copy of OpenMPI's shared-memory transport
+: "${OMPI_MCA_btl_vader_single_copy_mechanism:=none}"
+export OMPI_MCA_btl_vader_single_copy_mechanism
 OPTS="-s $SIZE -D antialias=2 -D adaptive=0.1 --threads 1"
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/pray-dist.XXXXXX") || exit 2
 trap 'rm -rf "$tmp"' EXIT

@@ -72,14 +72,33 @@ void die(pray_ctx *c, pray_status st) {
     exit(1);
 }
 
-// Rank 0 waits for a message without spinning: a worker's processor is not taken from it.
+// Rank 0 waits for a message without spinning (a blocking receive may poll a processor at full
+// speed): it sleeps between looks, from 20 microseconds up to 2 milliseconds while none comes.
 void wait_message(MPI_Status *s) {
+    long nap = 20000;
     for (;;) {
         int flag = 0;
         MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, MPI_COMM_WORLD, &flag, s);
         if (flag) return;
-        struct timespec ts = {0, 100000};  // 0.1 ms
+        struct timespec ts = {0, nap};
         nanosleep(&ts, NULL);
+        if (nap < 2000000) nap *= 2;
+    }
+}
+
+// Every rank waits here, sleeping, until all have come: no rank ends (MPI_Finalize) while
+// another may still fail and stop them all (MPI_Abort).
+void all_done() {
+    MPI_Request r;
+    MPI_Ibarrier(MPI_COMM_WORLD, &r);
+    long nap = 20000;
+    for (;;) {
+        int flag = 0;
+        MPI_Test(&r, &flag, MPI_STATUS_IGNORE);
+        if (flag) return;
+        struct timespec ts = {0, nap};
+        nanosleep(&ts, NULL);
+        if (nap < 2000000) nap *= 2;
     }
 }
 
@@ -417,6 +436,7 @@ int run(int argc, char **argv) {
         free(m.fh);
     }
     pray_free(c);
+    all_done();
     return 0;
 }
 
