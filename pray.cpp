@@ -10231,7 +10231,9 @@ namespace {
 #endif
 const char *const USAGE =
     "usage: pray [options] program.ray\n"
-    "Render a PRAY program. Options:\n"
+    "       pray --join OUT PART...\n"
+    "Render a PRAY program, or stack the row parts that --rows or --part wrote into the\n"
+    "image OUT. Options:\n"
     "  -o FILE          output file (" PRAY_FORMATS "); same as -D output=FILE\n"
     "  -s WxH           image size in pixels; same as -D width=W -D height=H\n"
     "  -D name=value    set an option of the language; wins over `option` in the program\n"
@@ -10245,8 +10247,6 @@ const char *const USAGE =
     "  --quiet          no progress bar\n"
     "  --version        print the version and the features compiled in\n"
     "  --help           print this text\n"
-    "   or: pray --join OUT PART...\n"
-    "Stack the row parts that --rows or --part wrote into the image OUT.\n"
     "A program of '-' is read from standard input.\n"
     "Exit status: 0 ok, 1 error in the program, 2 usage, 3 input/output error.\n";
 
@@ -10472,16 +10472,16 @@ int read_part(Part *pt) {
     if (size >= 8 && memcmp(buf, "II*\0", 4) == 0) {  // TIFF: the tags pray writes
         unsigned long ifd = rd32(buf + 4), tiff_data = 0, bytes = 0, desc = 0, desc_n = 0, bps_at = 0;
         unsigned comp = 0, photo = 0, spp = 0;
-        if (ifd + 2 > size) goto not_pray;
+        if (ifd > size || size - ifd < 2) goto not_pray;
         unsigned nt = rd16(buf + ifd);
-        if (ifd + 2 + 12UL * nt + 4 > size) goto not_pray;
+        if ((size - ifd - 2) / 12 < nt + 1UL) goto not_pray;  // the entries and the next offset
         for (unsigned i = 0; i < nt; i++) {
             const unsigned char *e = buf + ifd + 2 + 12 * i;
             unsigned tag = rd16(e), type = rd16(e + 2);
             unsigned long count = rd32(e + 4), v = type == 3 && count == 1 ? rd16(e + 8) : rd32(e + 8);
             switch (tag) {
-            case 256: pt->width = (int)v; break;
-            case 257: pt->rows = (int)v; break;
+            case 256: pt->width = v > 65536 ? 0 : (int)v; break;
+            case 257: pt->rows = v > 65536 ? 0 : (int)v; break;
             case 258: bps_at = count == 3 ? v : 0; break;
             case 259: comp = (unsigned)v; break;
             case 262: photo = (unsigned)v; break;
@@ -10491,14 +10491,15 @@ int read_part(Part *pt) {
             case 279: bytes = v; break;
             }
         }
-        if (comp != 1 || photo != 2 || spp != 3 || !bps_at || bps_at + 6 > size) goto not_pray;
+        if (comp != 1 || photo != 2 || spp != 3 || !bps_at || bps_at > size || size - bps_at < 6) goto not_pray;
         pt->bits = (int)rd16(buf + bps_at);
         if (rd16(buf + bps_at + 2) != (unsigned)pt->bits || rd16(buf + bps_at + 4) != (unsigned)pt->bits) goto not_pray;
-        if (desc_n > 1 && desc_n <= PRAY_NOTE_MAX + 1 && desc + desc_n <= size && buf[desc + desc_n - 1] == 0)
+        if (desc_n > 1 && desc_n <= PRAY_NOTE_MAX + 1 && desc <= size && desc_n <= size - desc &&
+            buf[desc + desc_n - 1] == 0)
             memcpy(note, buf + desc, desc_n);
         data = tiff_data;
-        if (pt->width < 1 || pt->rows < 1 || (pt->bits != 8 && pt->bits != 16) ||
-            bytes != (unsigned long)pt->width * pt->rows * 3 * (pt->bits / 8))
+        if (pt->width < 1 || pt->rows < 1 || pt->width > 65536 || pt->rows > 65536 ||
+            (pt->bits != 8 && pt->bits != 16) || (double)bytes != (double)pt->width * pt->rows * 3 * (pt->bits / 8))
             goto not_pray;
     } else if (size >= 3 && memcmp(buf, "P6\n", 3) == 0) {  // PPM: "P6\n# NOTE\nW H\nMAX\n"
         size_t i = 3;
@@ -10537,6 +10538,8 @@ int read_part(Part *pt) {
                     "writes them)\n", pt->name);
             return 1;
         }
+        for (char *ch = note; *ch; ch++)
+            if (*ch < 32 || *ch > 126) *ch = '?';  // shown in the message below
         if (sscanf(note, PART_NOTE "%n", &pt->row0, &pt->row1, &pt->height, &pt->frame, pt->id, &used) != 5 ||
             used != (int)strlen(note) || strlen(pt->id) != 16 || pt->row0 < 0 || pt->row1 <= pt->row0 ||
             pt->row1 > pt->height || pt->frame < 0) {
