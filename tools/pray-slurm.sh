@@ -15,7 +15,9 @@
 #   SPLIT=frames: frame K of the program (from 0), written where pray writes it.
 # Without SLURM_ARRAY_TASK_ID (the second job) it joins OUT.parts/* into OUT and removes them;
 # pray --join refuses parts that are missing, overlap or belong to another render.
-# PRAY names the program (default: pray beside this directory's parent, else pray on the PATH).
+# PRAY names the program (default: pray in the directory above this script's, else pray on the
+# PATH; sbatch runs a copy of the script from its spool directory, so export PRAY or put pray on
+# the PATH there).
 #SBATCH --job-name=pray
 #SBATCH --ntasks=1
 #SBATCH --output=pray-%A_%a.log

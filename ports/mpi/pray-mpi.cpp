@@ -18,10 +18,12 @@
 // exit status pray would have: 1 program, 2 usage, 3 input/output.
 #include <mpi.h>
 
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "pray.hpp"
 
@@ -47,6 +49,16 @@ enum { TAG_ASK = 1, TAG_RESULT = 2, TAG_DATA = 3, TAG_REPLY = 4 };
 enum { GIVE_BAND = 1, GIVE_FRAME = 2, NO_MORE = 3 };
 
 int rank, nranks;
+
+// SIGINT and SIGTERM (mpirun passes them on) while rank 0 writes an image: remove the temporary
+// file, then die of the signal, as pray does.
+pray_ctx *volatile the_ctx;
+extern "C" void on_signal(int sig) {
+    const char *t = the_ctx ? pray_temp_file(the_ctx) : NULL;
+    if (t) unlink(t);
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
 
 int exit_code(pray_status st) {
     switch (st) {
@@ -417,7 +429,17 @@ int run(int argc, char **argv) {
         }
         pray_set_render(c, worker_render, &w);
     }
+    if (rank == 0) {
+        the_ctx = c;
+        signal(SIGINT, on_signal);
+        signal(SIGTERM, on_signal);
+    }
     st = pray_run_file(c, program);
+    if (rank == 0) {
+        signal(SIGINT, SIG_DFL);
+        signal(SIGTERM, SIG_DFL);
+        the_ctx = NULL;
+    }
     if (st != PRAY_OK) die(c, st);
     if (rank == 0 && nranks > 1) {
         // every rank gets its last answer: rows, "done" for the last frame; frames, "no more"
