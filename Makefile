@@ -12,6 +12,9 @@
 #   make ports      build, run and compare every port (ports/check; installs cross compilers, qemu, wine)
 #   make check-bad  the catalogue of bad inputs (tests/bad/run.sh); the last step of check
 #   make cmake-check  pray as a CMake and pkg-config package: tests/cmake/run.sh builds a consumer
+#   make mpi        the MPI front end ./pray-mpi (ports/mpi; installs OpenMPI if missing)
+#   make check-mpi  pray-mpi, --part/--join, --frames and the recipes of docs/distributed.md
+#                   against one ./pray, byte for byte (tests/distributed.sh)
 #   make sanitize   the tests and the bad inputs under AddressSanitizer and UBSan
 #   make fuzz       build the libFuzzer harness and fuzz for FUZZ_SECONDS (needs clang)
 #   make fuzz-tiff  the same for the TIFF reader (textures and font atlases)
@@ -35,7 +38,7 @@ TESTS = tests/pray_tests$(EXE)
 TESTS_FLOAT = tests/pray_tests_float$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
-.PHONY: FORCE all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff fuzz-long textures gallery ports pov suite charts
+.PHONY: FORCE all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff fuzz-long textures gallery ports pov suite charts mpi mpi-deps check-mpi
 
 all: $(PRAY)
 
@@ -104,6 +107,32 @@ check: deps $(PRAY) textures $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embe
 check-bad: $(PRAY)
 	@echo "== bad inputs (tests/bad)"
 	PRAY=./$(PRAY) tests/bad/run.sh
+
+# The MPI front end (ports/mpi/pray-mpi.cpp), a host of the library: the library compiled as for
+# ./pray, the front end with the MPI compiler wrapper. OpenMPI comes from Debian when missing.
+MPICXX ?= mpicxx
+MPI_PACKAGES = libopenmpi-dev openmpi-bin
+PRAY_MPI = pray-mpi$(EXE)
+mpi-deps:
+	@missing=""; for p in $(MPI_PACKAGES) $(MPI_MORE); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing:$$missing"; \
+	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $$missing >/dev/null; \
+	fi
+mpi: mpi-deps
+	@$(MAKE) --no-print-directory $(PRAY_MPI)
+build/mpi/pray.o: pray.cpp pray.hpp build/png
+	@mkdir -p build/mpi
+	$(CXX) -std=c++98 $(CXXFLAGS) -c pray.cpp -o $@
+$(PRAY_MPI): ports/mpi/pray-mpi.cpp build/mpi/pray.o pray.hpp
+	$(MPICXX) -std=c++11 $(OPT) $(WARN) -DOMPI_SKIP_MPICXX -DMPICH_SKIP_MPICXX -I. ports/mpi/pray-mpi.cpp build/mpi/pray.o -o $@ $(LDLIBS) -lpthread
+
+# pray-mpi, the row parts and --join, --frames, and the recipes of docs/distributed.md (GNU
+# parallel, a Slurm job array, mpirun), each compared byte for byte with one ./pray.
+check-mpi: $(PRAY) textures
+	@$(MAKE) --no-print-directory mpi MPI_MORE=parallel
+	sh tests/distributed.sh
 
 # The consumer of tests/cmake/ built with add_subdirectory, find_package and pkg-config, in a
 # temporary directory (needs cmake and pkg-config).
@@ -188,4 +217,4 @@ ports:
 	sh ports/check
 
 clean:
-	rm -rf $(PRAY) $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embed$(EXE) tests/*.o tests/*.ppm out
+	rm -rf $(PRAY) $(PRAY_MPI) build/mpi $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embed$(EXE) tests/*.o tests/*.ppm out

@@ -512,8 +512,13 @@ struct pray_ctx {
     int print_set;
     pray_progress_fn progress_fn;
     void *progress_ud;
-    pray_frame_fn frame_fn;
+    pray_frame_fn frame_fn;  // what a program's rendertiff hands its frame to (see frame_route)
     void *frame_ud;
+    pray_frame_fn host_frame_fn;  // pray_set_frame
+    void *host_frame_ud;
+    pray_render_fn render_fn;     // pray_set_render: the host renders a program's frames
+    void *render_ud;
+    int in_render_fn;             // render_fn is running: pray_render inside it renders
     pray_write_fn warn_fn;  // pray_set_warning
     void *warn_ud;
     Setup cur;       // in force now
@@ -6991,28 +6996,32 @@ bool image_ok(pray_ctx *c, const pray_image *img) {
     return true;
 }
 
-// Baseline TIFF 6.0: one strip, RGB, uncompressed, 8 or 16 bits per sample.
-pray_status write_tiff(pray_ctx *c, const pray_image *img, int bits, Sink &out) {
-    const int ntags = 12;
-    const unsigned long ifd = 8, bps = ifd + 2 + ntags * 12 + 4, xres = bps + 6, yres = xres + 8,
-                        data = yres + 8;
+// Baseline TIFF 6.0: one strip, RGB, uncompressed, 8 or 16 bits per sample. A note (printable
+// ASCII, see pray_write_image_note) becomes the ImageDescription, between the resolutions and the
+// samples; without one the file is the same but for that tag.
+pray_status write_tiff(pray_ctx *c, const pray_image *img, int bits, Sink &out, const char *note = NULL) {
+    const unsigned long nlen = note ? (unsigned long)strlen(note) + 1 : 0;
+    const int ntags = note ? 13 : 12;
+    const unsigned long ifd = 8, bps = ifd + 2 + ntags * 12 + 4, xres = bps + 6, yres = xres + 8, desc = yres + 8,
+                        data = desc + nlen;
     unsigned long W = (unsigned long)img->width, H = (unsigned long)img->height;
     unsigned long bytes = W * H * 3 * (bits / 8);
-    unsigned char h[data];
+    unsigned char h[8 + 2 + 13 * 12 + 4 + 6 + 16];
     memset(h, 0, sizeof h);
     h[0] = 'I';
     h[1] = 'I';
     le16(h + 2, 42);
     le32(h + 4, ifd);
-    le16(h + ifd, ntags);
-    // tag, type (3 SHORT, 4 LONG, 5 RATIONAL), count, value or offset
-    static const unsigned short tags[ntags][2] = {
-        {256, 4}, {257, 4}, {258, 3}, {259, 3}, {262, 3}, {273, 4},
+    le16(h + ifd, (unsigned)ntags);
+    // tag, type (2 ASCII, 3 SHORT, 4 LONG, 5 RATIONAL), count, value or offset
+    static const unsigned short tags[13][2] = {
+        {256, 4}, {257, 4}, {258, 3}, {259, 3}, {262, 3}, {270, 2}, {273, 4},
         {277, 3}, {278, 4}, {279, 4}, {282, 5}, {283, 5}, {296, 3}};
-    unsigned long vals[ntags] = {W, H, bps, 1, 2, data, 3, H, bytes, xres, yres, 2};
-    unsigned long counts[ntags] = {1, 1, 3, 1, 1, 1, 1, 1, 1, 1, 1, 1};
-    for (int i = 0; i < ntags; i++) {
-        unsigned char *e = h + ifd + 2 + 12 * i;
+    unsigned long vals[13] = {W, H, bps, 1, 2, desc, data, 3, H, bytes, xres, yres, 2};
+    unsigned long counts[13] = {1, 1, 3, 1, 1, nlen, 1, 1, 1, 1, 1, 1, 1};
+    for (int i = 0, k = 0; i < 13; i++) {
+        if (tags[i][0] == 270 && !note) continue;
+        unsigned char *e = h + ifd + 2 + 12 * k++;
         le16(e, tags[i][0]);
         le16(e + 2, tags[i][1]);
         le32(e + 4, counts[i]);
@@ -7028,7 +7037,8 @@ pray_status write_tiff(pray_ctx *c, const pray_image *img, int bits, Sink &out) 
     size_t rowbytes = (size_t)W * 3 * (bits / 8);
     unsigned char *row = (unsigned char *)mem_alloc(c, rowbytes);
     if (!row) return c->status;
-    out.put(h, sizeof h);
+    out.put(h, desc);
+    if (note) out.put(note, nlen);  // with its NUL, as ASCII fields end
     for (unsigned long y = 0; y < H; y++) {
         if (cancelled(c)) {
             mem_free(c, row);
@@ -7045,14 +7055,21 @@ pray_status write_tiff(pray_ctx *c, const pray_image *img, int bits, Sink &out) 
     return PRAY_OK;
 }
 
-// Binary PPM (P6); 16-bit samples are big-endian, as the format says.
-pray_status write_ppm(pray_ctx *c, const pray_image *img, int bits, Sink &out) {
+// Binary PPM (P6); 16-bit samples are big-endian, as the format says. A note is a comment line
+// after the magic number: "P6\n# NOTE\n...".
+pray_status write_ppm(pray_ctx *c, const pray_image *img, int bits, Sink &out, const char *note = NULL) {
     char head[64];
-    int n = snprintf(head, sizeof head, "P6\n%d %d\n%u\n", img->width, img->height,
+    int n = snprintf(head, sizeof head, "%d %d\n%u\n", img->width, img->height,
                      bits == 8 ? 255u : 65535u);
     size_t rowbytes = (size_t)img->width * 3 * (bits / 8);
     unsigned char *row = (unsigned char *)mem_alloc(c, rowbytes);
     if (!row) return c->status;
+    out.put("P6\n", 3);
+    if (note) {
+        out.put("# ", 2);
+        out.put(note, strlen(note));
+        out.put("\n", 1);
+    }
     out.put(head, (size_t)n);
     for (int y = 0; y < img->height; y++) {
         if (cancelled(c)) {
@@ -7158,9 +7175,9 @@ int image_format(const char *path) {
 }
 
 #if PRAY_HAS_STDIO
-pray_status write_format(pray_ctx *c, const pray_image *img, int fmt, int bits, Sink &out) {
-    if (fmt == FMT_TIFF) return write_tiff(c, img, bits, out);
-    if (fmt == FMT_PPM) return write_ppm(c, img, bits, out);
+pray_status write_format(pray_ctx *c, const pray_image *img, int fmt, int bits, Sink &out, const char *note) {
+    if (fmt == FMT_TIFF) return write_tiff(c, img, bits, out, note);
+    if (fmt == FMT_PPM) return write_ppm(c, img, bits, out, note);
 #if PRAY_HAS_PNG
     if (fmt == FMT_PNG) return write_png(c, img, out);
 #endif
@@ -7383,10 +7400,34 @@ void pray_set_progress(pray_ctx *c, pray_progress_fn fn, void *ud) {
     c->progress_fn = fn;
     c->progress_ud = ud;
 }
+namespace {
+// A frame of a program whose rendering the host does (pray_set_render): none when it left the
+// image empty, else the host's frame callback or the file, as without it.
+pray_status frame_of_host(void *ud, const pray_image *img, const char *name) {
+    pray_ctx *c = (pray_ctx *)ud;
+    if (!img->pixels) return PRAY_OK;
+    if (c->host_frame_fn) return c->host_frame_fn(c->host_frame_ud, img, name);
+    return pray_write_image(c, img, name, opt_int(c, OPT_BITS));
+}
+// What a program's rendertiff hands its frame to (frame_fn): the host's callback, or
+// frame_of_host while the host renders the frames.
+void frame_route(pray_ctx *c) {
+    c->frame_fn = c->render_fn ? frame_of_host : c->host_frame_fn;
+    c->frame_ud = c->render_fn ? (void *)c : c->host_frame_ud;
+}
+} // namespace
+
 void pray_set_frame(pray_ctx *c, pray_frame_fn fn, void *ud) {
     if (!c) return;
-    c->frame_fn = fn;
-    c->frame_ud = ud;
+    c->host_frame_fn = fn;
+    c->host_frame_ud = ud;
+    frame_route(c);
+}
+void pray_set_render(pray_ctx *c, pray_render_fn fn, void *ud) {
+    if (!c) return;
+    c->render_fn = fn;
+    c->render_ud = ud;
+    frame_route(c);
 }
 
 void pray_cancel(pray_ctx *c) {
@@ -8072,6 +8113,15 @@ pray_status pray_render(pray_ctx *c, pray_object *root, pray_light *lights, pray
     if (!c) return PRAY_ERR_ARG;
     Call call(c);
     if (!out) return fail(c, PRAY_ERR_ARG, "pray_render: no image to render into");
+    if (c->render_fn && c->running && !c->in_render_fn) {  // a program's frame, rendered by the host
+        c->in_render_fn = 1;
+        pray_status st = c->render_fn(c->render_ud, c, root, lights, c->frames, out);
+        c->in_render_fn = 0;
+        if (st == PRAY_OK) return PRAY_OK;
+        pray_image_free(c, out);
+        if (c->status == PRAY_OK || !c->msg[0]) fail(c, st, "the render function failed");
+        return c->status = st;
+    }
     if (!scene_ok(c, root, lights, "pray_render") || image_limits(c)) return c->status;
     int W = opt_int(c, OPT_WIDTH), H = opt_int(c, OPT_HEIGHT);
     pray_rect r = {0, 0, W, H};
@@ -8241,9 +8291,9 @@ pray_status pray_write_png(pray_ctx *c, const pray_image *img, pray_write_fn fn,
 #endif
 }
 
-pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *path, int bits) {
-    if (!c) return PRAY_ERR_ARG;
-    Call call(c);
+namespace {
+// pray_write_image and pray_write_image_note: the one way files are written.
+pray_status write_image_file(pray_ctx *c, const pray_image *img, const char *path, int bits, const char *note) {
     if (!image_ok(c, img)) return c->status;
     if (!path || !*path) return fail(c, PRAY_ERR_ARG, "no file name");
     if (bits != 8 && bits != 16) return fail(c, PRAY_ERR_ARG, "bits must be 8 or 16");
@@ -8252,6 +8302,16 @@ pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *pat
         return fail(c, PRAY_ERR_ARG, "cannot tell the image format of '%s' (use .tif, .ppm%s)", path,
                     PRAY_HAS_PNG ? " or .png" : "");
     if (fmt == FMT_PNG && bits != 8) return fail(c, PRAY_ERR_ARG, "PNG output has 8 bits only");
+    if (note) {
+        if (fmt == FMT_PNG)
+            return fail(c, PRAY_ERR_ARG, "cannot write a note into '%s': notes go into TIFF and PPM files only",
+                        path);
+        size_t i = 0;
+        for (; note[i]; i++)
+            if ((unsigned char)note[i] < 32 || (unsigned char)note[i] > 126 || i >= PRAY_NOTE_MAX) break;
+        if (note[i]) return fail(c, PRAY_ERR_ARG, "a note must be printable ASCII of at most %d characters",
+                                 PRAY_NOTE_MAX);
+    }
 #if PRAY_HAS_STDIO
     if (is_program(c, path))
         return fail(c, PRAY_ERR_IO, "cannot write '%s': it is the program being run (choose another output name)",
@@ -8269,7 +8329,7 @@ pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *pat
     pray_status st = PRAY_OK;
     if (fs.f) {  // (create_temp has named it for pray_temp_file: a signal handler may remove it)
         Sink s = {file_put, &fs};
-        st = write_format(c, img, fmt, bits, s);
+        st = write_format(c, img, fmt, bits, s, note);
         if (fflush(fs.f) != 0 && !fs.err) fs.err = errno ? errno : EIO;
         if (fclose(fs.f) != 0 && !fs.err) fs.err = errno ? errno : EIO;
         if (st == PRAY_OK && !fs.err && !file_replace(tmp, path)) fs.err = errno ? errno : EIO;
@@ -8287,6 +8347,49 @@ pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *pat
 #else
     return fail(c, PRAY_ERR_IO, "this build has no file access");
 #endif
+}
+} // namespace
+
+pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *path, int bits) {
+    if (!c) return PRAY_ERR_ARG;
+    Call call(c);
+    return write_image_file(c, img, path, bits, NULL);
+}
+
+pray_status pray_write_image_note(pray_ctx *c, const pray_image *img, const char *path, int bits,
+                                  const char *note) {
+    if (!c) return PRAY_ERR_ARG;
+    Call call(c);
+    if (!note) return fail(c, PRAY_ERR_ARG, "pray_write_image_note: no note");
+    return write_image_file(c, img, path, bits, note);
+}
+
+pray_status pray_image_new(pray_ctx *c, int width, int height, pray_image *out) {
+    if (out) {
+        out->width = out->height = 0;
+        out->pixels = NULL;
+    }
+    if (!c) return PRAY_ERR_ARG;
+    if (!out) return fail(c, PRAY_ERR_ARG, "pray_image_new: no image to make");
+    if (width < 1 || height < 1 || width > MAX_IMAGE_SIDE || height > MAX_IMAGE_SIDE ||
+        (double)width * height > MAX_IMAGE_PIXELS)
+        return fail(c, PRAY_ERR_ARG, "pray_image_new: no image can be %d x %d pixels", width, height);
+    float *p = (float *)mem_zalloc(c, sizeof(float) * 3 * (size_t)width * (size_t)height);
+    if (!p) return c->status;
+    out->pixels = p;
+    out->width = width;
+    out->height = height;
+    return PRAY_OK;
+}
+
+pray_status pray_set_error(pray_ctx *c, pray_status status, const char *message) {
+    if (!c) return PRAY_ERR_ARG;
+    if (status == PRAY_OK) {
+        pray_clear_error(c);
+        return PRAY_OK;
+    }
+    if ((int)status < 0 || (int)status > (int)PRAY_ERR_CANCELLED) status = PRAY_ERR_ARG;
+    return fail(c, status, "%s", message ? message : pray_status_text(status));
 }
 
 #if PRAY_HAS_INTERP
@@ -10777,7 +10880,9 @@ namespace {
 #endif
 const char *const USAGE =
     "usage: pray [options] program.ray\n"
-    "Render a PRAY program. Options:\n"
+    "       pray --join OUT PART...\n"
+    "Render a PRAY program, or stack the row parts that --rows or --part wrote into the\n"
+    "image OUT. Options:\n"
     "  -o FILE          output file (" PRAY_FORMATS "); same as -D output=FILE\n"
     "  -s WxH           image size in pixels; same as -D width=W -D height=H\n"
     "  -D name=value    set an option of the language; wins over `option` in the program\n"
@@ -10785,6 +10890,9 @@ const char *const USAGE =
     "  --brute          the brute-force reference renderer (no acceleration)\n"
     "  --threads N      threads to render with (0 = automatic)\n"
     "  --untrusted      tighter limits; the program reads files beside it only\n"
+    "  --rows A:B       render only rows A to B-1 of every image (a row part, .tif or .ppm)\n"
+    "  --part K/N       render only the K-th of N bands of rows of equal height (K from 1)\n"
+    "  --frames A:B     write only frames A to B-1 of the program (from 0)\n"
     "  --quiet          no progress bar\n"
     "  --version        print the version and the features compiled in\n"
     "  --help           print this text\n"
@@ -10842,6 +10950,361 @@ void print_stats(pray_ctx *c) {
             s.memory_parse, s.memory_run, s.memory_prepare, s.memory_accel, s.memory_render);
 }
 
+// ---- parts of a render: --rows, --part, --frames (docs/distributed.md) ----
+// A row part is an image file of rows A to B-1 whose note (TIFF ImageDescription, PPM comment)
+// says where they belong: "pray-part rows=A:B height=H frame=F id=X". X tells the renders apart:
+// a hash of the program's bytes and of the options that shape the image. --join reads it back.
+#define PART_NOTE "pray-part rows=%d:%d height=%d frame=%d id=%16s"
+
+struct Split {
+    pray_ctx *c;
+    int row0, row1;      // --rows (row1 0: not given)
+    int k, n;            // --part K/N (n 0: not given)
+    int frame0, frame1;  // --frames (frame1 0: not given)
+    int rendered;        // frames of the range met by the run
+    int y0, y1, height, frame;  // the rows of the frame being written, of an image of `height`
+    char id[17];
+};
+
+// Parse "A:B" (sep ':') or "K/N" (sep '/') of non-negative numbers below 2^30.
+bool parse_pair(const char *t, char sep, int *a, int *b) {
+    long v[2];
+    for (int i = 0; i < 2; i++) {
+        if (*t < '0' || *t > '9') return false;
+        v[i] = 0;
+        while (*t >= '0' && *t <= '9') {
+            v[i] = v[i] * 10 + (*t++ - '0');
+            if (v[i] >= 1L << 30) return false;
+        }
+        if (*t++ != (i == 0 ? sep : 0)) return false;
+    }
+    *a = (int)v[0];
+    *b = (int)v[1];
+    return true;
+}
+
+// Instead of rendering a program's frame (pray_set_render): skip it outside --frames, render only
+// the rows of --rows or --part.
+pray_status render_part(void *ud, pray_ctx *c, pray_object *root, pray_light *lights, int frame, pray_image *out) {
+    Split *sp = (Split *)ud;
+    if (sp->frame1 && (frame < sp->frame0 || frame >= sp->frame1)) return PRAY_OK;
+    sp->rendered++;
+    if (!sp->row1 && !sp->n) return pray_render(c, root, lights, out);
+    int W = (int)pray_option_get(c, "width"), H = (int)pray_option_get(c, "height");
+    char msg[200];
+    if (sp->n) {
+        if (sp->n > H) {
+            snprintf(msg, sizeof msg, "--part %d/%d: an image of %d rows cannot be cut into %d parts", sp->k, sp->n,
+                     H, sp->n);
+            return pray_set_error(c, PRAY_ERR_ARG, msg);
+        }
+        sp->y0 = (int)((unsigned long)(sp->k - 1) * (unsigned long)H / (unsigned long)sp->n);
+        sp->y1 = (int)((unsigned long)sp->k * (unsigned long)H / (unsigned long)sp->n);
+    } else {
+        if (sp->row1 > H) {
+            snprintf(msg, sizeof msg, "--rows %d:%d is not inside the image of %d rows", sp->row0, sp->row1, H);
+            return pray_set_error(c, PRAY_ERR_ARG, msg);
+        }
+        sp->y0 = sp->row0;
+        sp->y1 = sp->row1;
+    }
+    sp->height = H;
+    sp->frame = frame;
+    pray_rect r = {0, sp->y0, W, sp->y1 - sp->y0};
+    pray_status st = pray_image_new(c, W, r.height, out);
+    if (st != PRAY_OK) return st;
+    pray_buffers b = {NULL, NULL, NULL, NULL, 0};
+    b.rgb = out->pixels;
+    return pray_render_into(c, root, lights, &r, &b);
+}
+
+// A row part rendered by render_part, written with its note.
+pray_status write_part(void *ud, const pray_image *img, const char *name) {
+    Split *sp = (Split *)ud;
+    pray_ctx *c = sp->c;
+    char note[200];
+    size_t n = strlen(name);
+    if (n >= 4 && (strcmp(name + n - 4, ".png") == 0 || strcmp(name + n - 4, ".PNG") == 0)) {
+        char msg[PRAY_NOTE_MAX + 100];
+        snprintf(msg, sizeof msg, "row parts are written as .tif or .ppm, not as '%.900s' (--join makes the PNG)",
+                 name);
+        return pray_set_error(c, PRAY_ERR_ARG, msg);
+    }
+    snprintf(note, sizeof note, PART_NOTE, sp->y0, sp->y1, sp->height, sp->frame, sp->id);
+    return pray_write_image_note(c, img, name, (int)pray_option_get(c, "bits"), note);
+}
+
+// FNV-1a, twice with different starts: 16 hexadecimal digits for the part's id.
+void hash_bytes(unsigned long h[2], const void *p, size_t n) {
+    const unsigned char *b = (const unsigned char *)p;
+    for (size_t i = 0; i < n; i++)
+        for (int j = 0; j < 2; j++) h[j] = ((h[j] ^ b[i]) * 16777619UL) & 0xFFFFFFFFUL;
+}
+
+// The id of a render: the program's bytes and the arguments that shape its images (not -o,
+// --threads, --quiet, --stats, nor the choice of rows and frames).
+void render_id(char out[17], const char *program, int argc, char **argv) {
+    unsigned long h[2] = {2166136261UL, 3735928559UL};
+    FILE *f = strcmp(program, "-") == 0 ? NULL : fopen(program, "rb");
+    if (f) {
+        char buf[8192];
+        size_t n;
+        while ((n = fread(buf, 1, sizeof buf, f)) > 0) hash_bytes(h, buf, n);
+        fclose(f);
+    }
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0 || strcmp(a, "--stats") == 0) continue;
+        if (strcmp(a, "-o") == 0 || strcmp(a, "--threads") == 0 || strcmp(a, "--rows") == 0 ||
+            strcmp(a, "--part") == 0 || strcmp(a, "--frames") == 0) {
+            i++;
+            continue;
+        }
+        if (a == program) continue;
+        if (strcmp(a, "-D") == 0 && i + 1 < argc &&
+            (strncmp(argv[i + 1], "output=", 7) == 0 || strncmp(argv[i + 1], "threads=", 8) == 0)) {
+            i++;
+            continue;
+        }
+        hash_bytes(h, a, strlen(a) + 1);
+    }
+    snprintf(out, 17, "%08lx%08lx", h[0], h[1]);
+}
+
+// ---- pray --join OUT PART... ----
+struct Part {
+    const char *name;
+    unsigned char *file;  // the whole file
+    const unsigned char *samples;
+    int width, rows, bits, big_endian;
+    int row0, row1, height, frame;
+    char id[17];
+};
+
+unsigned rd16(const unsigned char *p) { return (unsigned)p[0] | (unsigned)p[1] << 8; }
+unsigned long rd32(const unsigned char *p) { return (unsigned long)rd16(p) | (unsigned long)rd16(p + 2) << 16; }
+
+// Read a part written by pray --rows: a TIFF or PPM file as pray writes them, with its note.
+// Returns 0, or the exit status after printing the error.
+int read_part(Part *pt) {
+    FILE *f = fopen(pt->name, "rb");
+    if (!f) {
+        fprintf(stderr, "pray: error: cannot read '%s': %s\n", pt->name, strerror(errno));
+        return 3;
+    }
+    size_t size = 0, cap = 0;
+    unsigned char *buf = NULL;
+    for (;;) {
+        if (size == cap) {
+            cap = cap ? cap * 2 : 65536;
+            unsigned char *nb = (unsigned char *)realloc(buf, cap);
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                fprintf(stderr, "pray: error: out of memory reading '%s'\n", pt->name);
+                return 1;
+            }
+            buf = nb;
+        }
+        size_t n = fread(buf + size, 1, cap - size, f);
+        if (n == 0) break;
+        size += n;
+    }
+    int bad = ferror(f);
+    fclose(f);
+    pt->file = buf;
+    if (bad) {
+        fprintf(stderr, "pray: error: cannot read '%s'\n", pt->name);
+        return 3;
+    }
+    char note[PRAY_NOTE_MAX + 1] = "";
+    size_t data = 0;
+    int maxval = 0;
+    if (size >= 8 && memcmp(buf, "II*\0", 4) == 0) {  // TIFF: the tags pray writes
+        unsigned long ifd = rd32(buf + 4), tiff_data = 0, bytes = 0, desc = 0, desc_n = 0, bps_at = 0;
+        unsigned comp = 0, photo = 0, spp = 0;
+        if (ifd > size || size - ifd < 2) goto not_pray;
+        unsigned nt = rd16(buf + ifd);
+        if ((size - ifd - 2) / 12 < nt + 1UL) goto not_pray;  // the entries and the next offset
+        for (unsigned i = 0; i < nt; i++) {
+            const unsigned char *e = buf + ifd + 2 + 12 * i;
+            unsigned tag = rd16(e), type = rd16(e + 2);
+            unsigned long count = rd32(e + 4), v = type == 3 && count == 1 ? rd16(e + 8) : rd32(e + 8);
+            switch (tag) {
+            case 256: pt->width = v > 65536 ? 0 : (int)v; break;
+            case 257: pt->rows = v > 65536 ? 0 : (int)v; break;
+            case 258: bps_at = count == 3 ? v : 0; break;
+            case 259: comp = (unsigned)v; break;
+            case 262: photo = (unsigned)v; break;
+            case 270: desc = v, desc_n = type == 2 ? count : 0; break;
+            case 273: tiff_data = v; break;
+            case 277: spp = (unsigned)v; break;
+            case 279: bytes = v; break;
+            }
+        }
+        if (comp != 1 || photo != 2 || spp != 3 || !bps_at || bps_at > size || size - bps_at < 6) goto not_pray;
+        pt->bits = (int)rd16(buf + bps_at);
+        if (rd16(buf + bps_at + 2) != (unsigned)pt->bits || rd16(buf + bps_at + 4) != (unsigned)pt->bits) goto not_pray;
+        if (desc_n > 1 && desc_n <= PRAY_NOTE_MAX + 1 && desc <= size && desc_n <= size - desc &&
+            buf[desc + desc_n - 1] == 0)
+            memcpy(note, buf + desc, desc_n);
+        data = tiff_data;
+        if (pt->width < 1 || pt->rows < 1 || pt->width > 65536 || pt->rows > 65536 ||
+            (pt->bits != 8 && pt->bits != 16) || (double)bytes != (double)pt->width * pt->rows * 3 * (pt->bits / 8))
+            goto not_pray;
+    } else if (size >= 3 && memcmp(buf, "P6\n", 3) == 0) {  // PPM: "P6\n# NOTE\nW H\nMAX\n"
+        size_t i = 3;
+        if (i + 2 <= size && buf[i] == '#' && buf[i + 1] == ' ') {
+            size_t j = i + 2;
+            while (j < size && buf[j] != '\n' && j - i - 2 < PRAY_NOTE_MAX) j++;
+            if (j >= size || buf[j] != '\n') goto not_pray;
+            memcpy(note, buf + i + 2, j - i - 2);
+            note[j - i - 2] = 0;
+            i = j + 1;
+        }
+        int head = 0;
+        char text[64];
+        size_t k = 0;
+        while (i + k < size && k < sizeof text - 1 && head < 2) {
+            text[k] = (char)buf[i + k];
+            if (text[k++] == '\n') head++;
+        }
+        text[k] = 0;
+        int used = 0;
+        if (head != 2 || sscanf(text, "%d %d\n%d\n%n", &pt->width, &pt->rows, &maxval, &used) != 3 ||
+            used != (int)k || (maxval != 255 && maxval != 65535) || pt->width < 1 || pt->rows < 1)
+            goto not_pray;
+        pt->bits = maxval == 255 ? 8 : 16;
+        pt->big_endian = 1;
+        data = i + k;
+    } else
+        goto not_pray;
+    if (data > size || (size - data) / 3 / (size_t)(pt->bits / 8) / (size_t)pt->width < (size_t)pt->rows)
+        goto not_pray;
+    pt->samples = buf + data;
+    {
+        int used = 0;
+        if (!note[0]) {
+            fprintf(stderr, "pray: error: '%s' is not a row part: it has no note of its rows (pray --rows or --part "
+                    "writes them)\n", pt->name);
+            return 1;
+        }
+        for (char *ch = note; *ch; ch++)
+            if (*ch < 32 || *ch > 126) *ch = '?';  // shown in the message below
+        if (sscanf(note, PART_NOTE "%n", &pt->row0, &pt->row1, &pt->height, &pt->frame, pt->id, &used) != 5 ||
+            used != (int)strlen(note) || strlen(pt->id) != 16 || pt->row0 < 0 || pt->row1 <= pt->row0 ||
+            pt->row1 > pt->height || pt->frame < 0) {
+            fprintf(stderr, "pray: error: '%s' is not a row part: its note is '%s'\n", pt->name, note);
+            return 1;
+        }
+        if (pt->rows != pt->row1 - pt->row0) {
+            fprintf(stderr, "pray: error: '%s' holds %d rows, but its note says rows %d:%d\n", pt->name, pt->rows,
+                    pt->row0, pt->row1);
+            return 1;
+        }
+    }
+    return 0;
+not_pray:
+    fprintf(stderr, "pray: error: '%s' is not a TIFF or PPM file as pray writes them\n", pt->name);
+    return 1;
+}
+
+// Stack the parts into one image and write it to `out` (through pray_write_image: a temporary
+// file renamed when complete). Every check comes before anything is written.
+int join_parts(pray_ctx *c, const char *out, char **names, int n) {
+    Part *p = (Part *)calloc((size_t)n, sizeof(Part));
+    int *order = (int *)malloc(sizeof(int) * (size_t)n);
+    int rc = 0;
+    if (!p || !order) {
+        fprintf(stderr, "pray: error: out of memory\n");
+        rc = 1;
+    }
+    for (int i = 0; i < n && rc == 0; i++) {
+        p[i].name = names[i];
+        rc = read_part(&p[i]);
+    }
+    for (int i = 1; i < n && rc == 0; i++) {
+        const Part &a = p[0], &b = p[i];
+        if (b.width != a.width || b.bits != a.bits || b.height != a.height || b.frame != a.frame ||
+            strcmp(b.id, a.id) != 0) {
+            fprintf(stderr, "pray: error: '%s' and '%s' are parts of different images: ", a.name, b.name);
+            if (b.width != a.width) fprintf(stderr, "%d and %d pixels wide\n", a.width, b.width);
+            else if (b.bits != a.bits) fprintf(stderr, "%d and %d bits\n", a.bits, b.bits);
+            else if (b.height != a.height) fprintf(stderr, "of %d and %d rows\n", a.height, b.height);
+            else if (b.frame != a.frame) fprintf(stderr, "frames %d and %d\n", a.frame, b.frame);
+            else fprintf(stderr, "renders %s and %s (another program or other options)\n", a.id, b.id);
+            rc = 1;
+        }
+    }
+    if (rc == 0) {  // in order of their first rows; then no gap, no overlap, all rows
+        for (int i = 0; i < n; i++) {
+            int j = i;
+            while (j > 0 && p[order[j - 1]].row0 > p[i].row0) {
+                order[j] = order[j - 1];
+                j--;
+            }
+            order[j] = i;
+        }
+        int next = 0;
+        for (int i = 0; i < n && rc == 0; i++) {
+            const Part &q = p[order[i]];
+            if (q.row0 > next) {
+                fprintf(stderr, "pray: error: rows %d:%d of the image are missing (no part holds them)\n", next, q.row0);
+                rc = 1;
+            } else if (q.row0 < next) {
+                const Part &prev = p[order[i - 1]];
+                fprintf(stderr, "pray: error: '%s' (rows %d:%d) and '%s' (rows %d:%d) overlap\n", prev.name, prev.row0,
+                        prev.row1, q.name, q.row0, q.row1);
+                rc = 1;
+            }
+            next = q.row1;
+        }
+        if (rc == 0 && next < p[0].height) {
+            fprintf(stderr, "pray: error: rows %d:%d of the image are missing (no part holds them)\n", next,
+                    p[0].height);
+            rc = 1;
+        }
+    }
+    pray_image img = {0, 0, NULL};
+    if (rc == 0) {
+        size_t n_out = strlen(out);
+        if (p[0].bits != 8 && n_out >= 4 && (strcmp(out + n_out - 4, ".png") == 0 || strcmp(out + n_out - 4, ".PNG") == 0)) {
+            fprintf(stderr, "pray: error: the parts have 16 bits per sample and PNG holds 8: join them into a .tif or "
+                    ".ppm\n");
+            rc = 1;
+        }
+    }
+    if (rc == 0 && pray_image_new(c, p[0].width, p[0].height, &img) != PRAY_OK) {
+        fprintf(stderr, "pray: %s\n", pray_error(c));
+        rc = 1;
+    }
+    for (int i = 0; i < n && rc == 0; i++) {
+        const Part &q = p[i];
+        float *px = img.pixels + (size_t)q.row0 * (size_t)q.width * 3;
+        size_t m = (size_t)q.rows * (size_t)q.width * 3;
+        for (size_t k = 0; k < m; k++) {
+            unsigned v;
+            if (q.bits == 8) v = q.samples[k];
+            else if (q.big_endian) v = (unsigned)q.samples[2 * k] << 8 | q.samples[2 * k + 1];
+            else v = rd16(q.samples + 2 * k);
+            // the sample's value, which the writers quantise back to the same sample
+            px[k] = (float)(v / (q.bits == 8 ? 255.0 : 65535.0));
+        }
+    }
+    if (rc == 0) {
+        pray_status st = pray_write_image(c, &img, out, p[0].bits);
+        if (st != PRAY_OK) {
+            fprintf(stderr, "pray: %s\n", pray_error(c));
+            rc = exit_code(st);
+        }
+    }
+    pray_image_free(c, &img);
+    for (int i = 0; p && i < n; i++) free(p[i].file);
+    free(p);
+    free(order);
+    return rc;
+}
+
 // SIGINT and SIGTERM while an image is written: remove its temporary file, then die of the
 // signal as the default would. Only async-signal-safe calls.
 pray_ctx *volatile the_ctx;
@@ -10866,6 +11329,25 @@ int main(int argc, char **argv) {
     }
     const char *program = NULL;
     int stats = 0, quiet = 0, rc = 0;
+    Split sp;
+    memset(&sp, 0, sizeof sp);
+    sp.c = c;
+    if (argc > 1 && strcmp(argv[1], "--join") == 0) {
+        if (argc < 4) rc = usage_error("--join takes the output file and the parts: --join OUT PART...%s", "");
+        else {
+            for (int i = 3; i < argc && rc == 0; i++)
+                if (argv[i][0] == '-' && argv[i][1]) rc = usage_error("--join takes file names only, not '%s'", argv[i]);
+            the_ctx = c;
+            signal(SIGINT, on_signal);
+            signal(SIGTERM, on_signal);
+            if (rc == 0) rc = join_parts(c, argv[2], argv + 3, argc - 3);
+            signal(SIGINT, SIG_DFL);
+            signal(SIGTERM, SIG_DFL);
+            the_ctx = NULL;
+        }
+        pray_free(c);
+        return rc;
+    }
     for (int i = 1; i < argc && rc == 0; i++) {
         const char *a = argv[i];
         const char *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -10882,6 +11364,36 @@ int main(int argc, char **argv) {
         else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) quiet = 1;
         else if (strcmp(a, "--brute") == 0) st = pray_option_fix(c, "brute", "1");
         else if (strcmp(a, "--untrusted") == 0) pray_set_untrusted(c);
+        else if (strcmp(a, "--join") == 0) {
+            rc = usage_error("--join comes first: pray --join OUT PART...%s", "");
+            break;
+        } else if (strcmp(a, "--rows") == 0 || strcmp(a, "--part") == 0 || strcmp(a, "--frames") == 0) {
+            if (!next) {
+                rc = usage_error("option %s needs a value", a);
+                break;
+            }
+            i++;
+            int x = 0, y = 0;
+            if (a[2] == 'p') {
+                if (!parse_pair(next, '/', &x, &y) || x < 1 || y < 1 || x > y) {
+                    rc = usage_error("--part takes K/N, the K-th of N bands of rows with K from 1 to N, as in --part 1/4, "
+                                     "not '%s'", next);
+                    break;
+                }
+                sp.k = x, sp.n = y;
+            } else if (!parse_pair(next, ':', &x, &y) || x >= y) {
+                rc = usage_error(a[2] == 'r' ? "--rows takes A:B, rows A to B-1 with A < B counted from 0, as in "
+                                               "--rows 0:64, not '%s'"
+                                             : "--frames takes A:B, frames A to B-1 with A < B counted from 0, as in "
+                                               "--frames 0:10, not '%s'", next);
+                break;
+            } else if (a[2] == 'r') sp.row0 = x, sp.row1 = y;
+            else sp.frame0 = x, sp.frame1 = y;
+            if (sp.row1 && sp.n) {
+                rc = usage_error("give --rows or --part, not both%s", "");
+                break;
+            }
+        }
         else if (strcmp(a, "-o") == 0 || strcmp(a, "--threads") == 0 || strcmp(a, "-s") == 0 ||
                  strcmp(a, "-D") == 0) {
             if (!next) {
@@ -10940,6 +11452,11 @@ int main(int argc, char **argv) {
     }
     if (!quiet && stderr_is_terminal()) pray_set_progress(c, progress_bar, NULL);
     pray_set_warning(c, to_stderr, NULL);
+    if (sp.row1 || sp.n || sp.frame1) pray_set_render(c, render_part, &sp);
+    if (sp.row1 || sp.n) {
+        render_id(sp.id, program, argc, argv);
+        pray_set_frame(c, write_part, &sp);
+    }
     the_ctx = c;
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
@@ -10953,6 +11470,14 @@ int main(int argc, char **argv) {
         else fprintf(stderr, "%s\n", m);
         rc = exit_code(st);
         if (st == PRAY_ERR_ARG) rc = 1;  // a bad option value inside the program
+    } else if (sp.frame1 && !sp.rendered) {
+        if (pray_frames(c) == 0)
+            fprintf(stderr, "pray: error: --frames %d:%d selects no frame: the program renders none\n", sp.frame0,
+                    sp.frame1);
+        else
+            fprintf(stderr, "pray: error: --frames %d:%d selects no frame: the program renders frames 0:%d\n", sp.frame0,
+                    sp.frame1, pray_frames(c));
+        rc = 1;
     } else if (stats)
         print_stats(c);
     fflush(stdout);

@@ -152,14 +152,15 @@ void pray_set_warning(pray_ctx *ctx, pray_write_fn fn, void *ud);
 /* Progress callback for renders (default none). */
 void pray_set_progress(pray_ctx *ctx, pray_progress_fn fn, void *ud);
 /* Frame callback for `rendertiff` (default none: frames are written to files). The image passed
-   to it is freed when it returns. */
+   to it is freed when it returns. pray_frames(ctx) is the frame's number in the run (from 0).
+   With a render function (pray_set_render) it gets what that function made of the frame. */
 void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
 /* The temporary file an image is being written to now (see pray_write_image), else NULL. For a
    signal handler that removes it before the program dies: reading it is async-signal-safe. */
 const char *pray_temp_file(const pray_ctx *ctx);
 /* Stop the call running on the context: pray_run_string, pray_run_file, pray_render,
-   pray_render_into, pray_prepare, pray_write_image, pray_write_tiff, pray_write_ppm or
-   pray_write_png. Safe from any thread and from a signal handler: it only sets a flag. The call stops at its next check (each statement
+   pray_render_into, pray_prepare, pray_write_image, pray_write_image_note, pray_write_tiff,
+   pray_write_ppm or pray_write_png. Safe from any thread and from a signal handler: it only sets a flag. The call stops at its next check (each statement
    of a program; each row of voxels while a scene is prepared; each row of an image rendered or
    written) with PRAY_ERR_CANCELLED, "error: cancelled" (with the place in a program). It leaves
    no file behind and no image; a byte sink has got part of one, to be thrown away. One of those
@@ -217,7 +218,9 @@ pray_status pray_run_string(pray_ctx *ctx, const char *name, const char *text, s
    option maxline and holds to the memory cap, so an endless input ends in an error. Its images
    never replace it: an output naming the program file itself fails with PRAY_ERR_IO. */
 pray_status pray_run_file(pray_ctx *ctx, const char *path);
-/* The number of frames the last run rendered (0 for a NULL context). */
+/* The number of frames the last run rendered (0 for a NULL context); while a program runs, the
+   frames it has rendered so far (so in a frame callback, the number of the frame, from 0). Frames
+   a render function skipped count too. */
 int pray_frames(const pray_ctx *ctx);
 
 /* ---------------------------------------------------------------------------------------------
@@ -351,7 +354,9 @@ typedef struct pray_stats {
 
 /* Render `root` lit by `lights` (NULL = no light) with the context's camera, background and
    options into `out`. *out is always set: the image, or 0 x 0 and NULL pixels on failure (an
-   image it held before is not freed). The image belongs to the context (pray_image_free). */
+   image it held before is not freed). The image belongs to the context (pray_image_free).
+   Called by a running program's rendertiff while a render function is set (pray_set_render),
+   it calls that function instead, and gives what it made (0 x 0 for a skipped frame). */
 pray_status pray_render(pray_ctx *ctx, pray_object *root, pray_light *lights, pray_image *out);
 /* The statistics (all zero for a NULL context; nothing for a NULL out). */
 void pray_stats_get(const pray_ctx *ctx, pray_stats *out);
@@ -404,6 +409,48 @@ pray_status pray_write_png(pray_ctx *ctx, const pray_image *img, pray_write_fn f
    its own; the message (or "") is copied into `message` (may be NULL) of message_size bytes. */
 pray_status pray_render_file(const char *program, const char *const *options, int noptions,
                              char *message, size_t message_size);
+
+/* A note recorded in an image file: printable ASCII (32 to 126), at most PRAY_NOTE_MAX
+   characters. TIFF keeps it as the ImageDescription (tag 270), PPM as a comment line after the
+   magic number ("P6\n# NOTE\n..."); PNG files take none (PRAY_ERR_ARG). Otherwise as
+   pray_write_image; the pixels are the same bytes. pray --rows writes its parts so
+   (docs/distributed.md). */
+#define PRAY_NOTE_MAX 1000
+pray_status pray_write_image_note(pray_ctx *ctx, const pray_image *img, const char *path, int bits,
+                                  const char *note);
+/* A new image of width x height pixels, all black, that belongs to the context like one
+   pray_render made (pray_image_free, pray_free). *out is always set (0 x 0 and NULL on failure).
+   PRAY_ERR_ARG for a size pray cannot render (sides 1 to 65536, at most 2^28 pixels);
+   PRAY_ERR_NOMEM over the context's memory cap. */
+pray_status pray_image_new(pray_ctx *ctx, int width, int height, pray_image *out);
+/* Record an error as pray's own calls do: status `status`, message "error: " + message (NULL:
+   the status's text); returns status. For callbacks (render, frame) that fail with a message of
+   their own. PRAY_OK clears the error (pray_clear_error); a status that is not one of the codes
+   above becomes PRAY_ERR_ARG. */
+pray_status pray_set_error(pray_ctx *ctx, pray_status status, const char *message);
+
+/* ---------------------------------------------------------------------------------------------
+   Parts of a render, for spreading one over processes or machines (docs/distributed.md).
+   A rectangle of rows rendered with pray_render_into below is bit for bit those rows of the
+   whole image, whatever antialias, adaptive and the threads do; stacking the parts of every
+   process in order gives the bytes of one process rendering all. For a program, the host renders
+   the frames itself: every statement runs as usual, and each rendertiff calls the host, which
+   renders what it wants of the frame (rows, or nothing) and says what becomes of it.
+   ------------------------------------------------------------------------------------------- */
+/* Called by each `rendertiff` of a program run on the context, instead of rendering the frame;
+   `frame` is its number in the run from 0 (frames the host skipped count too, so numbers and
+   file names are those of the whole run). It renders with the calls above on ctx (pray_render,
+   pray_render_into: inside the function they render as without it; the frame's width and
+   height are pray_option_get(ctx, "width") and "height") and sets *out (0 x 0 when called):
+   - to an image of the context (pray_render, pray_image_new; any size): the frame, handed to
+     the frame callback, or without one written to its file as pray would (option bits);
+   - or leaves it 0 x 0: the frame is skipped, nothing is written and no frame callback called.
+   Return PRAY_OK, or a failure's status: the program stops there, with the context's message
+   (pray_set_error) or "the render function failed". */
+typedef pray_status (*pray_render_fn)(void *ud, pray_ctx *ctx, pray_object *root, pray_light *lights,
+                                      int frame, pray_image *out);
+/* Set the render function of programs run on the context (NULL: pray renders, the default). */
+void pray_set_render(pray_ctx *ctx, pray_render_fn fn, void *ud);
 
 /* ---------------------------------------------------------------------------------------------
    Rendering into your own buffers, per-pixel outputs, host textures.

@@ -98,7 +98,13 @@ TEST_CASE("api: every function takes a NULL context and returns its error value"
     CHECK(pray_camera_ray(nullptr, 0.5, 0.5, &ro, &rd) == PRAY_ERR_ARG);
     CHECK(pray_texture_rgb(nullptr, 1, 1, rgb, "t") == nullptr);
     CHECK(pray_texture_register(nullptr, "t", nullptr) == PRAY_ERR_ARG);
+    CHECK(pray_write_image_note(nullptr, &img, "a.tif", 8, "n") == PRAY_ERR_ARG);
+    pray_image made = {3, 4, (float *)&img};
+    CHECK(pray_image_new(nullptr, 2, 2, &made) == PRAY_ERR_ARG);
+    CHECK((made.width == 0 && made.height == 0 && made.pixels == nullptr));  // out is always emptied
+    CHECK(pray_set_error(nullptr, PRAY_ERR_IO, "x") == PRAY_ERR_ARG);
     // the void ones do nothing
+    pray_set_render(nullptr, nullptr, nullptr);
     pray_set_warning(nullptr, nullptr, nullptr);
     pray_free(nullptr);
     pray_clear_error(nullptr);
