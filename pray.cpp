@@ -4261,8 +4261,8 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         }
         want = want > 1 ? (int)(want * 0.8) : 0;
     }
-    if (want <= 0) a->g.n[0] = a->g.n[1] = a->g.n[2] = 0;
-    if (want > 0) {
+    if (want <= 0 || st != PRAY_OK) a->g.n[0] = a->g.n[1] = a->g.n[2] = 0;
+    if (want > 0 && st == PRAY_OK) {
         for (int l = 0; l < 3; l++) a->g.top[l] = (real)((double)a->g.org[l] + a->g.n[l] * (double)a->g.h);
         a->g.voxel = (int *)mem_zalloc(c, sizeof(int) * (size_t)nv);
         // nested grids take what the budget leaves, and no more voxels than the image has rays
