@@ -10360,10 +10360,11 @@ pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
     warn_aspect(I, s);
     pray_image img;
     // this reference to the object is given up once the scene is flattened: when no variable
-    // holds it any more, its tree is freed before the rest of the scene is built
-    c->drop = (pray_object *)a[0].ref;
+    // holds it any more, its tree is freed before the rest of the scene is built (not when the
+    // host renders the frame: it may render the tree more than once, a band at a time)
+    c->drop = c->render_fn ? NULL : (pray_object *)a[0].ref;
     pray_status st = pray_render(c, (pray_object *)a[0].ref, all, &img);
-    if (c->drop == NULL) a[0].ref = NULL, a[0].t = V_NONE;
+    if (c->drop == NULL && !c->render_fn) a[0].ref = NULL, a[0].t = V_NONE;
     c->drop = NULL;
     release_handle(c, all);
     if (st) {

@@ -128,7 +128,8 @@ std::vector<testkit::Frame> whole_run() {
     return cap.frames;
 }
 
-// A render function that keeps frame `only` (-1: all) and of it rows y0 .. y1-1.
+// A render function that keeps frame `only` (-1: all) and of it rows y0 .. y1-1, rendered as two
+// bands, as pray-mpi does: the program's tree stays whole for the second.
 struct Rows {
     int only, y0, y1;
     std::vector<int> seen;
@@ -140,9 +141,13 @@ pray_status render_rows(void *ud, pray_ctx *c, pray_object *root, pray_light *li
     int w = (int)pray_option_get(c, "width");
     pray_status st = pray_image_new(c, w, r->y1 - r->y0, out);
     if (st != PRAY_OK) return st;
-    pray_rect rect = {0, r->y0, w, r->y1 - r->y0};
+    int mid = (r->y0 + r->y1 + 1) / 2;
+    pray_rect top = {0, r->y0, w, mid - r->y0}, rest = {0, mid, w, r->y1 - mid};
     pray_buffers b = {out->pixels, NULL, NULL, NULL, 0};
-    return pray_render_into(c, root, lights, &rect, &b);
+    st = pray_render_into(c, root, lights, &top, &b);
+    if (st != PRAY_OK || rest.height == 0) return st;
+    b.rgb = out->pixels + (size_t)3 * w * top.height;
+    return pray_render_into(c, root, lights, &rest, &b);
 }
 
 } // namespace
