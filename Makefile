@@ -7,7 +7,8 @@
 #   make matrix     compile pray.cpp under every configuration macro and language level, g++ and clang++
 #   make bench      the acceleration benchmarks (bench/run.sh), results in docs/benchmarks.md
 #   make pov        pray against POV-Ray 3.7 (bench/pov.sh; installs povray)
-#   make suite      the benchmark suite against POV-Ray (bench/suite/run.sh; ARGS=--quick: default == --brute)
+#   make suite      the benchmark suite against POV-Ray (bench/suite/run.sh; ARGS=--quick: default == --brute;
+#                   ARGS=--scaling: time and memory against 10^3 .. 10^6 primitives)
 #   make charts     speed against accuracy and the benchmarks, drawn (bench/charts.sh), docs/images/bench-*.png
 #   make ports      build, run and compare every port (ports/check; installs cross compilers, qemu, wine)
 #   make check-bad  the catalogue of bad inputs (tests/bad/run.sh); the last step of check

@@ -5,7 +5,7 @@
 # too, POV-Ray only where bench/pov/ has a twin. Prints a table of CPU times (user + system of
 # the whole process, best of RUNS, default 1) and the ratio POV-Ray / pray, with its geometric
 # mean.
-# Usage: bench/suite/run.sh [--size N] [--quick] [--compare REF] [--only PATTERN] [--instructions]
+# Usage: bench/suite/run.sh [--size N] [--quick] [--compare REF] [--only PATTERN] [--instructions] [--scaling]
 #   --size N        image size N x N (default 512)
 #   --quick         size 64, no POV-Ray; checks that every scene renders byte for byte the same
 #                   with pray's default options and with --brute (exits 1 on any difference);
@@ -15,10 +15,12 @@
 #   --instructions  count pray's instructions (millions, under valgrind's callgrind) instead of
 #                   timing it, and leave POV-Ray out: exact figures for deciding small
 #                   differences with --compare on a machine whose timings are noisy
+#   --scaling       instead of the suite: time and peak memory against 10^3 to 10^6 balls, pray and
+#                   POV-Ray (bench/suite/scaling.py), drawn into docs/images/bench-scaling-pov.png
 # Installs povray with apt-get when it is missing (not for --quick); builds ./pray if needed.
 set -e
 usage() { sed -n 's/^# Usage: //p' "$0" >&2; exit 2; }
-SIZE= QUICK= REF= ONLY='*' INSTR=
+SIZE= QUICK= REF= ONLY='*' INSTR= SCALING=
 while [ $# -gt 0 ]; do
   case $1 in
     --size) [ $# -ge 2 ] || usage; SIZE=$2; shift 2 ;;
@@ -26,6 +28,7 @@ while [ $# -gt 0 ]; do
     --compare) [ $# -ge 2 ] || usage; REF=$2; shift 2 ;;
     --only) [ $# -ge 2 ] || usage; ONLY=$2; shift 2 ;;
     --instructions) INSTR=1; shift ;;
+    --scaling) SCALING=1; shift ;;
     *) usage ;;
   esac
 done
@@ -43,13 +46,23 @@ PY=/usr/bin/python3
 if [ -n "$INSTR" ] && ! command -v valgrind >/dev/null 2>&1; then
   echo "run.sh: --instructions needs valgrind (apt-get install valgrind)" >&2; exit 2
 fi
-if [ -z "$QUICK" ] && [ -z "$INSTR" ] && ! command -v povray >/dev/null 2>&1; then
-  echo "installing: povray" >&2
+missing=
+if [ -z "$QUICK" ] && [ -z "$INSTR" ] && ! command -v povray >/dev/null 2>&1; then missing=povray; fi
+if [ -n "$SCALING" ]; then
+  [ -x /usr/bin/time ] || missing="$missing time"
+  $PY -c 'import matplotlib' 2>/dev/null || missing="$missing python3-matplotlib"
+fi
+if [ -n "$missing" ]; then
+  echo "installing:$missing" >&2
   if [ "$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi
   $SUDO apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq povray >/dev/null
+  # shellcheck disable=SC2086
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing >/dev/null
 fi
 make -s pray textures >/dev/null
+if [ -n "$SCALING" ]; then
+  exec $PY bench/suite/scaling.py --size "$SIZE" --runs "$RUNS" --chart docs/images/bench-scaling-pov.png
+fi
 PRAY=$(pwd)/pray
 
 OUT=$(mktemp -d)
