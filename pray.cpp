@@ -2877,6 +2877,7 @@ struct Grid {
     real inv_h;        // 1 / h
     int *voxel;        // per voxel, x fastest: its list; -1 - g: the nested grid g
     unsigned char *reach;  // per voxel: how far around it every voxel has its list (see reach_build)
+    int rest;          // a nested grid: the list of its voxel outside the grid's box
 };
 
 struct Accel {
@@ -3534,39 +3535,82 @@ struct GridPlan {
 };
 
 // A voxel with more primitives to check than this gets a grid of its own (option nest: how many
-// levels deep), with about 4 voxels per primitive to check (as auto_grid), 2 to 32 a side.
+// levels deep). The nested grid covers the box that holds those primitives within the voxel,
+// with about 4 voxels per primitive to check (as auto_grid), at most 32 a side; the rest of the
+// voxel has the voxel's list without them (Grid::rest).
 const int NEST_CHECKS = 32;
 
 bool grid_lists(ListBuilder &b, Grid &G, GridPlan &gp, const Array<int> &cand, const Array<int> &start, double margin,
                 int steps, int depth);
 
 // A grid of its own for voxel ix of G, whose candidates are ids[0 .. n) and which has `checks`
-// primitives to check: its index in Accel::nested; -1 when it is not worth it or does not fit
-// the budget; -2 on failure.
+// primitives to check (classed in the voxel: b.rprims, b.rcls): its index in Accel::nested; -1
+// when it is not worth it or does not fit the budget; -2 on failure.
 int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const int *ids, int n, int checks, int steps,
                int depth) {
-    int m = (int)ceil(cbrt_pos(4.0 * checks));
-    m = m < 2 ? 2 : m > 32 ? 32 : m;
+    pray_ctx *c = b.c;
+    // the box of the primitives to check, widened by the most a nested grid's margin can be
+    // (m <= 32 below), within the voxel
+    double wid = (double)G.h * 1e-6 + gp.round * (steps + 36), lo[3], hi[3], ext = 0, vol = 1;
+    for (int l = 0; l < 3; l++) lo[l] = HUGE_VAL, hi[l] = -HUGE_VAL;
+    for (int i = 0; i < b.rprims.n; i++)
+        for (int l = 0; b.rcls[i] == CL_BD && l < 3; l++) {
+            const Box &bx = gp.eff[b.rprims[i]];
+            lo[l] = (double)bx.lo[l] - wid < lo[l] ? (double)bx.lo[l] - wid : lo[l];
+            hi[l] = (double)bx.hi[l] + wid > hi[l] ? (double)bx.hi[l] + wid : hi[l];
+        }
+    for (int l = 0; l < 3; l++) {
+        double v0 = (double)G.org[l] + ix[l] * (double)G.h, v1 = v0 + (double)G.h;
+        lo[l] = lo[l] > v0 ? lo[l] : v0;
+        hi[l] = hi[l] < v1 ? hi[l] : v1;
+        if (!(hi[l] > lo[l])) return -1;
+        ext = hi[l] - lo[l] > ext ? hi[l] - lo[l] : ext;
+    }
+    for (int l = 0; l < 3; l++) vol *= hi[l] - lo[l] > ext / 16 ? hi[l] - lo[l] : ext / 16;
+    // cubic voxels, about 4 per primitive to check, fewer while the budget is short
     Grid S;
     memset(&S, 0, sizeof S);
-    S.h = G.h / (real)m;
+    double h = cbrt_pos(vol / (4.0 * checks)), nv = 0;
+    h = h > ext / 32 ? h : ext / 32;
+    for (;;) {
+        nv = 1;
+        for (int l = 0; l < 3; l++) {
+            double k = ceil((hi[l] - lo[l]) / h);
+            S.n[l] = k < 1 ? 1 : (int)k;
+            nv *= S.n[l];
+        }
+        if (nv <= gp.budget || nv < 8) break;
+        h *= 1.25;
+    }
+    if (nv < 8 || nv > gp.budget) return -1;
+    S.h = (real)h;
     S.inv_h = (real)1 / S.h;
     for (int l = 0; l < 3; l++) {
-        S.n[l] = m;
-        S.org[l] = (real)((double)G.org[l] + ix[l] * (double)G.h);
-        S.top[l] = (real)((double)G.org[l] + (ix[l] + 1) * (double)G.h);
+        S.org[l] = (real)((lo[l] + hi[l]) / 2 - S.n[l] * h / 2);
+        S.top[l] = (real)((double)S.org[l] + S.n[l] * h);
     }
-    steps += m + 4;
-    double margin = (double)S.h * 1e-6 + gp.round * steps, nv = (double)m * m * m;
-    if (margin > (double)S.h / 4 || nv > gp.budget) return -1;  // (b.rprims and b.rcls left as they are)
-    gp.budget -= nv;
-    pray_ctx *c = b.c;
-    Array<int> cand, start;
+    int m = S.n[0] > S.n[1] ? S.n[0] : S.n[1];
+    steps += (m > S.n[2] ? m : S.n[2]) + 4;
+    double margin = (double)S.h * 1e-6 + gp.round * steps;
+    if (margin > (double)S.h / 4) return -1;  // (b.rprims and b.rcls left as they are)
+    // the rest of the voxel: what is inside it all, without the primitives to check
+    Array<int> rp, cand, start;
+    Array<unsigned char> rc;
+    rp.init();
+    rc.init();
     cand.init();
     start.init();
-    S.voxel = (int *)mem_zalloc(c, sizeof(int) * (size_t)nv);
-    bool ok = S.voxel && grid_bucket(c, S, gp.eff, ids, n, margin, cand, start) &&
-              grid_lists(b, S, gp, cand, start, margin, steps, depth) && b.a->nested.push(c, S);
+    bool ok = rp.reserve(c, b.rprims.n + 1) && rc.reserve(c, b.rprims.n + 1);
+    for (int i = 0; ok && i < b.rprims.n; i++)
+        if (b.rcls[i] != CL_BD) rp.p[rp.n++] = b.rprims[i], rc.p[rc.n++] = b.rcls[i];
+    S.rest = ok ? lb_list(b, rp.p, rc.p, rp.n) : -1;
+    ok = S.rest >= 0;
+    gp.budget -= nv;
+    S.voxel = ok ? (int *)mem_zalloc(c, sizeof(int) * (size_t)nv) : NULL;
+    ok = S.voxel && grid_bucket(c, S, gp.eff, ids, n, margin, cand, start) &&
+         grid_lists(b, S, gp, cand, start, margin, steps, depth) && b.a->nested.push(c, S);
+    rp.release(c);
+    rc.release(c);
     cand.release(c);
     start.release(c);
     if (ok) return b.a->nested.n - 1;
@@ -4845,6 +4889,14 @@ struct GridSource {
     bool walk(Out &out, real t, real tend) const;
 };
 
+// A stretch of one list, the empty list passed over.
+template <class Out>
+inline bool rest_stretch(Out &out, int L, real a, real b) {
+    if (L > 0) return out(L, a, b);
+    out.pass(a, b);
+    return false;
+}
+
 // The boundaries of the three axes come at regular intervals along the ray; the next voxel is
 // across the nearest one. Distances are kept as ray parameters (the leading-axis distance over
 // the leading component of the direction), so a step is two comparisons and one addition. With
@@ -4885,11 +4937,18 @@ bool GridSource::walk(Out &out, real t, real tend) const {
                 stopped = true;
                 break;
             }
+            // (before and after its box, the rest of the voxel)
             int ax;
-            real near = nearest(next, &ax), exit = near < tend ? near : tend;
+            real near = nearest(next, &ax), exit = near < tend ? near : tend, ta, tb;
             exit = exit > t ? exit : t;
-            GridSource sub(A, A->nested[-1 - L], ray, inv);
-            if (sub.walk(out, t, exit)) {
+            const Grid &N = A->nested[-1 - L];
+            if (!ray_box(ray, inv, N.org, N.top, &ta, &tb)) ta = tb = exit;
+            ta = ta > t ? ta : t;
+            tb = tb < exit ? tb : exit;
+            if (!(ta < tb)) ta = tb = exit;
+            GridSource sub(A, N, ray, inv);
+            if ((ta > t && rest_stretch(out, N.rest, t, ta)) || (ta < tb && sub.walk(out, ta, tb)) ||
+                (tb < exit && rest_stretch(out, N.rest, tb, exit))) {
                 stopped = true;
                 break;
             }
