@@ -494,6 +494,9 @@ struct Setup {
     Options opt;
     int parallel;
     pray_vec cam_x, cam_y, cam_eye, cam_point;
+    int lookat;  // cam_x and cam_y follow from these for the image's size (camera_axes)
+    pray_vec cam_up;
+    double cam_angle;
     pray_rgb bg_top, bg_bottom;
 };
 
@@ -6425,18 +6428,37 @@ void ray_most(const pray_ctx *c, Scene *s) {
     s->maxrays = (long)c->cur.opt.v[OPT_MAXRAYS];
 }
 
+// The camera's X and Y. Those of `lookat` follow from the image's size (options width and
+// height), so that its pixels are square: right = (P - E) % U, down = (P - E) % right, |X| =
+// |P - E| tan(a / 2) for the horizontal angle a, |Y| = |X| height / width.
+void camera_axes(const pray_ctx *c, pray_vec *x, pray_vec *y) {
+    const Setup &u = c->cur;
+    if (!u.lookat) {
+        *x = u.cam_x;
+        *y = u.cam_y;
+        return;
+    }
+    pray_vec d = vsub(u.cam_point, u.cam_eye), ahead = vunit(d);
+    pray_vec right = vunit(vcross(ahead, vunit(u.cam_up))), down = vunit(vcross(ahead, right));
+    double half = vlen(d) * tan(u.cam_angle * (3.14159265358979323846 / 360));
+    *x = vmul(right, half);
+    *y = vmul(down, half * u.opt.v[OPT_HEIGHT] / u.opt.v[OPT_WIDTH]);
+}
+
 // The camera and the image's size (options width and height) as the renderer sees them.
 void scene_camera(const pray_ctx *c, Scene *s) {
+    pray_vec cam_x, cam_y;
+    camera_axes(c, &cam_x, &cam_y);
     s->parallel = c->cur.parallel;
     s->eye = r3of(c->cur.cam_eye);
     s->point = r3of(c->cur.cam_point);
-    s->cx = r3of(c->cur.cam_x);
-    s->cy = r3of(c->cur.cam_y);
+    s->cx = r3of(cam_x);
+    s->cy = r3of(cam_y);
     s->dir = r3of(vunit(vsub(c->cur.cam_point, c->cur.cam_eye)));
     // Directions are the same for the camera scaled by any factor; a power of two keeps them
     // exact, and brings vectors of 1e-200 or 1e200 into range (of floats, too).
     double big = vmaxabs(c->cur.cam_point);
-    const pray_vec *cv[3] = {&c->cur.cam_eye, &c->cur.cam_x, &c->cur.cam_y};
+    const pray_vec *cv[3] = {&c->cur.cam_eye, &cam_x, &cam_y};
     for (int i = 0; i < 3; i++)
         if (vmaxabs(*cv[i]) > big) big = vmaxabs(*cv[i]);
     int e = 0;
@@ -6444,8 +6466,8 @@ void scene_camera(const pray_ctx *c, Scene *s) {
     double k = ldexp(1.0, -e);
     s->keye = r3of(vmul(c->cur.cam_eye, k));
     s->kpoint = r3of(vmul(c->cur.cam_point, k));
-    s->kcx = r3of(vmul(c->cur.cam_x, k));
-    s->kcy = r3of(vmul(c->cur.cam_y, k));
+    s->kcx = r3of(vmul(cam_x, k));
+    s->kcy = r3of(vmul(cam_y, k));
     s->width = opt_int(c, OPT_WIDTH);
     s->height = opt_int(c, OPT_HEIGHT);
 }
@@ -8034,6 +8056,7 @@ pray_status set_camera(pray_ctx *c, int parallel, pray_vec x, pray_vec y, pray_v
     const char *why = camera_problem(parallel != 0, x, y, e, p);
     if (why) return fail(c, PRAY_ERR_ARG, "%s: %s", parallel ? "parallel" : "perspective", why);
     c->cur.parallel = parallel;
+    c->cur.lookat = 0;
     c->cur.cam_x = x;
     c->cur.cam_y = y;
     c->cur.cam_eye = e;
@@ -8042,6 +8065,28 @@ pray_status set_camera(pray_ctx *c, int parallel, pray_vec x, pray_vec y, pray_v
     return PRAY_OK;
 }
 } // namespace
+
+pray_status pray_lookat(pray_ctx *c, pray_vec e, pray_vec p, pray_vec up, double angle) {
+    if (!c) return PRAY_ERR_ARG;
+    const char *why = NULL;
+    pray_vec d = vsub(p, e);
+    if (!vfinite(e) || !vfinite(p) || !vfinite(up) || !vfinite(d) || !finite_num(angle))
+        why = "coordinates are not finite";
+    else if (vmaxabs(d) == 0) why = "the eye and the point looked at must differ";
+    else if (vmaxabs(up) == 0) why = "the up direction U must not be a zero vector";
+    else if (vlen(vcross(vunit(d), vunit(up))) <= 1e-12) why = "the up direction U must not be parallel to P - E";
+    else if (!(angle > 0 && angle < 180)) return fail(c, PRAY_ERR_ARG, "lookat: the angle %g must lie between 0 and 180 degrees", angle);
+    if (why) return fail(c, PRAY_ERR_ARG, "lookat: %s", why);
+    c->cur.parallel = 0;
+    c->cur.lookat = 1;
+    c->cur.cam_eye = e;
+    c->cur.cam_point = p;
+    c->cur.cam_up = up;
+    c->cur.cam_angle = angle;
+    camera_axes(c, &c->cur.cam_x, &c->cur.cam_y);  // (for the size in force now; a render sizes them again)
+    if (!c->running) c->base = c->cur;
+    return PRAY_OK;
+}
 
 pray_status pray_perspective(pray_ctx *c, pray_vec x, pray_vec y, pray_vec e, pray_vec p) {
     if (!c) return PRAY_ERR_ARG;
@@ -8830,7 +8875,7 @@ struct Expr {
 
 enum {
     ST_ASSIGN, ST_DELETE, ST_PRINT, ST_IF, ST_WHILE, ST_QUIT, ST_BACKGROUND, ST_PERSPECTIVE,
-    ST_PARALLEL, ST_OPTION, ST_RENDER
+    ST_PARALLEL, ST_OPTION, ST_RENDER, ST_LOOKAT, ST_INCLUDE
 };
 
 struct Stmt {
@@ -8851,8 +8896,18 @@ const char *builtin_name(int i);
 int builtin_count();
 
 const char *const KEYWORDS[] = {"if", "then", "else", "endif", "while", "endwhile", "background",
-                                "delete", "option", "parallel", "perspective", "print", "quit",
-                                "rendertiff", "true", "false", "nothing", "none", "pi"};
+                                "delete", "include", "lookat", "option", "parallel", "perspective",
+                                "print", "quit", "rendertiff", "true", "false", "nothing", "none", "pi"};
+
+// The words version 2 of the language added: a program of version 1 may have used them as
+// names, so its error says why the name is refused now.
+const char *version2_note(const char *s) {
+    static const char *const words[] = {"box", "ceil", "cone", "floor", "include", "lookat", "max",
+                                        "min", "rod", "round", "stretch", "torus"};
+    for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
+        if (strcmp(words[i], s) == 0) return " (a word of version 2 of the language: rename the variable)";
+    return "";
+}
 
 // Variable names are interned at parse time; a variable is a slot.
 struct Var {
@@ -9089,7 +9144,7 @@ Expr *parse_primary(Parser &P) {
         const Builtin *b = may_be_predefined(t.s) ? builtin_find(t.s) : NULL;
         if (b) {
             if (!is_op(cur(P), '(')) {
-                syn(P, t, "'%s' is a function: write it with its arguments in parentheses", t.s);
+                syn(P, t, "'%s' is a function: write it with its arguments in parentheses%s", t.s, version2_note(t.s));
                 return NULL;
             }
             if (!enter(P, &t)) return NULL;
@@ -9123,7 +9178,7 @@ Expr *parse_primary(Parser &P) {
             return ok ? e : NULL;
         }
         if (is_reserved(t.s)) {
-            syn(P, t, "'%s' is a reserved word and cannot be used here", t.s);
+            syn(P, t, "'%s' is a reserved word and cannot be used here%s", t.s, version2_note(t.s));
             return NULL;
         }
         if (is_op(cur(P), '(')) {
@@ -9349,7 +9404,7 @@ Stmt *parse_statement(Parser &P) {
     Stmt *s = NULL;
     if (is_op(P.t[P.pos + 1], '=')) {
         if (is_reserved(t.s)) {
-            syn(P, t, "'%s' is a reserved word and cannot be assigned to", t.s);
+            syn(P, t, "'%s' is a reserved word and cannot be assigned to%s", t.s, version2_note(t.s));
             return NULL;
         }
         s = new_stmt(P, ST_ASSIGN, t);
@@ -9370,6 +9425,7 @@ Stmt *parse_statement(Parser &P) {
     };
     static const Word words[] = {
         {"background", ST_BACKGROUND, 1, 2}, {"delete", ST_DELETE, 1, 1 << 20},
+        {"lookat", ST_LOOKAT, 4, 4},
         {"option", ST_OPTION, 2, 2},         {"parallel", ST_PARALLEL, 4, 4},
         {"perspective", ST_PERSPECTIVE, 4, 4}, {"print", ST_PRINT, 0, 1 << 20},
         {"quit", ST_QUIT, 0, 0},             {"rendertiff", ST_RENDER, 1, 1 << 20},
@@ -9483,8 +9539,8 @@ Stmt *parse_statement(Parser &P) {
     }
     Suggest sg;
     sg.init(t.s);
-    static const char *const stmts[] = {"background", "delete", "option", "parallel", "perspective",
-                                        "print", "quit", "rendertiff", "if", "while"};
+    static const char *const stmts[] = {"background", "delete", "include", "lookat", "option", "parallel",
+                                        "perspective", "print", "quit", "rendertiff", "if", "while"};
     for (size_t i = 0; i < sizeof stmts / sizeof stmts[0]; i++) sg.offer(stmts[i]);
     char msg[200];
     if (sg.best) snprintf(msg, sizeof msg, "unknown statement '%s'; did you mean '%s'?", t.s, sg.best);
@@ -9799,6 +9855,27 @@ pray_status bi_sqrt(Interp &I, const Expr *call, Value *a, Value *out) {
     return math1(I, call, a, out, sqrt);
 }
 pray_status bi_tan(Interp &I, const Expr *call, Value *a, Value *out) { return math1(I, call, a, out, tan); }
+// Halves away from zero (C99's round, which C++98 lacks): x - floor(x) is exact.
+double round_half_away(double x) {
+    if (x < 0) return -round_half_away(-x);
+    double f = floor(x);
+    return x - f >= 0.5 ? f + 1 : f;
+}
+pray_status bi_floor(Interp &I, const Expr *call, Value *a, Value *out) { return math1(I, call, a, out, floor); }
+pray_status bi_ceil(Interp &I, const Expr *call, Value *a, Value *out) { return math1(I, call, a, out, ceil); }
+pray_status bi_round(Interp &I, const Expr *call, Value *a, Value *out) {
+    return math1(I, call, a, out, round_half_away);
+}
+pray_status bi_min(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_NUM) || want(I, call, a, 1, V_NUM)) return I.c->status;
+    *out = vnum(a[1].v[0] < a[0].v[0] ? a[1].v[0] : a[0].v[0]);
+    return PRAY_OK;
+}
+pray_status bi_max(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_NUM) || want(I, call, a, 1, V_NUM)) return I.c->status;
+    *out = vnum(a[1].v[0] > a[0].v[0] ? a[1].v[0] : a[0].v[0]);
+    return PRAY_OK;
+}
 pray_status bi_transparent(Interp &I, const Expr *call, Value *a, Value *out) {
     if (want(I, call, a, 0, V_INTENS) || want(I, call, a, 1, V_NUM)) return I.c->status;
     return made(I, call, V_MODEL, pray_transparent(I.c, rgb_of(a[0]), a[1].v[0]), out);
@@ -9881,14 +9958,18 @@ pray_status bi_text(Interp &I, const Expr *call, Value *a, Value *out) {
 const Builtin BUILTINS[] = {
     {"abs", 1, 1, bi_abs},           {"arccos", 1, 1, bi_arccos},
     {"arcsin", 1, 1, bi_arcsin},     {"arctan", 1, 1, bi_arctan},
-    {"arctan2", 2, 2, bi_arctan2},   {"color", 1, 1, bi_color},
+    {"arctan2", 2, 2, bi_arctan2},   {"ceil", 1, 1, bi_ceil},
+    {"color", 1, 1, bi_color},
     {"cos", 1, 1, bi_cos},           {"cylinder", 4, 4, bi_cylinder},
     {"directionlight", 2, 2, bi_dirlight}, {"dirlight", 2, 2, bi_dirlight},
-    {"exp", 1, 1, bi_exp},           {"log", 1, 1, bi_log},
+    {"exp", 1, 1, bi_exp},           {"floor", 1, 1, bi_floor},
+    {"log", 1, 1, bi_log},           {"max", 2, 2, bi_max},
+    {"min", 2, 2, bi_min},
     {"mirror", 1, 1, bi_mirror},     {"move", 3, 3, bi_move},
     {"norm", 1, 1, bi_norm},         {"one", 1, 1, bi_one},
     {"phong", 3, 4, bi_phong},       {"plane", 3, 3, bi_plane},
     {"planemap", 5, 5, bi_planemap}, {"pointlight", 2, 2, bi_pointlight},
+    {"round", 1, 1, bi_round},
     {"sin", 1, 1, bi_sin},           {"sphere", 3, 3, bi_sphere},
     {"spheremap", 5, 5, bi_spheremap}, {"sqrt", 1, 1, bi_sqrt},
     {"tan", 1, 1, bi_tan},           {"text", 8, 8, bi_text},
@@ -10290,12 +10371,13 @@ void frame_name(char *out, size_t n, const char *base, int frame) {
 }
 
 // Once a run: the camera's |X| : |Y| is not the image's width : height, so its pixels are not
-// square and the picture comes out stretched (more than 1 % either way).
+// square and the picture comes out stretched (more than 1 % either way). Never for `lookat`,
+// whose pixels are square for every size.
 void warn_aspect(Interp &I, const Stmt *s) {
     pray_ctx *c = I.c;
     double w = c->cur.opt.v[OPT_WIDTH], h = c->cur.opt.v[OPT_HEIGHT];
     double stretch = vlen(c->cur.cam_x) / vlen(c->cur.cam_y) * h / w;
-    if (!c->warn_fn || I.warned_aspect || (stretch < 1.01 && stretch > 1 / 1.01)) return;
+    if (!c->warn_fn || I.warned_aspect || c->cur.lookat || (stretch < 1.01 && stretch > 1 / 1.01)) return;
     I.warned_aspect = 1;
     char line[400];
     int n = snprintf(line, sizeof line,
@@ -10500,6 +10582,18 @@ pray_status exec(Interp &I, const Stmt *s) {
                               args[i].t == V_INTENS || args[i].t == V_OBJECT ? "an" : "a", TYPE_NAMES[args[i].t]);
             if (st == PRAY_OK &&
                 set_camera(c, s->kind == ST_PARALLEL, vec_of(args[0]), vec_of(args[1]), vec_of(args[2]), vec_of(args[3])))
+                st = api_err(I, s->line, s->col);
+            break;
+        }
+        case ST_LOOKAT: {
+            static const int types[4] = {V_POINT, V_POINT, V_VECTOR, V_NUM};
+            static const char *const what[4] = {"E", "P", "U", "a"};
+            for (int i = 0; i < 4 && st == PRAY_OK; i++)
+                if (args[i].t != types[i])
+                    st = rerr(I, s->args[i], PRAY_ERR_RUNTIME, "lookat: %s must be a %s, not %s %s", what[i],
+                              TYPE_NAMES[types[i]], args[i].t == V_INTENS || args[i].t == V_OBJECT ? "an" : "a",
+                              TYPE_NAMES[args[i].t]);
+            if (st == PRAY_OK && pray_lookat(c, vec_of(args[0]), vec_of(args[1]), vec_of(args[2]), args[3].v[0]))
                 st = api_err(I, s->line, s->col);
             break;
         }

@@ -311,9 +311,13 @@ void pray_light_release(pray_ctx *ctx, pray_light *light);
 void pray_texture_release(pray_ctx *ctx, pray_texture *tex);
 void pray_release(pray_ctx *ctx, void *handle);
 
-/* Camera and background, as the statements of the same names. */
+/* Camera and background, as the statements of the same names. pray_lookat: a perspective
+   camera at `eye` looking at `point`, `up` (not parallel to point - eye) the image's up, `angle`
+   the horizontal field of view in degrees (0 < angle < 180); its X and Y follow from the width
+   and height in force when a frame is rendered, so its pixels are always square. */
 pray_status pray_perspective(pray_ctx *ctx, pray_vec x, pray_vec y, pray_vec eye, pray_vec point);
 pray_status pray_parallel(pray_ctx *ctx, pray_vec x, pray_vec y, pray_vec eye, pray_vec point);
+pray_status pray_lookat(pray_ctx *ctx, pray_vec eye, pray_vec point, pray_vec up, double angle);
 pray_status pray_background(pray_ctx *ctx, pray_rgb top, pray_rgb bottom);
 
 /* ---------------------------------------------------------------------------------------------
