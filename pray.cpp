@@ -540,6 +540,7 @@ struct pray_ctx {
     unsigned temp_serial;    // makes temporary names unique
     double written;          // bytes of image files written by this run (option maxoutput)
     pray_object *drop;       // given up by a program's rendertiff: released once flattened (scene_build)
+    int eye_inside;          // the camera's eye is inside the solid last rendered (render_scene)
     volatile sig_atomic_t cancel;  // pray_cancel: the running call stops at its next check
     int calls;               // cancellable public calls running (a run renders and writes)
 };
@@ -2708,11 +2709,10 @@ struct Hit {
     int root_enter;  // the ray enters the whole solid there
 };
 
-// Visit the visible surfaces along the ray in (0, tmax) in order; `visit` returns false to stop.
-// Returns the number of hits visited.
-template <class Visit>
-int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
-    if (s->root < 0) return 0;
+// The start of a sweep: the status of every primitive and node at the start of the ray (just
+// after it, for a start on a surface) into w, and the crossings in (0, tmax) into w->cross
+// (*ncross of them, unsorted). Returns the root's status. The root must be an element.
+bool sweep_start(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int *ncross) {
     int nc = 0;
     int np = s->prims.n;
     for (int j = 0; j < s->nodes.n; j++) {
@@ -2756,7 +2756,23 @@ int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit
             else w->cnt[nd.parent]++;
         }
     }
-    bool root = e_is_node(s->root) ? w->nstat[e_index(s->root)] != 0 : w->pstat[e_index(s->root)] != 0;
+    *ncross = nc;
+    return e_is_node(s->root) ? w->nstat[e_index(s->root)] != 0 : w->pstat[e_index(s->root)] != 0;
+}
+
+// Is the start of the ray inside the solid? Exact, as every sweep begins: one test per primitive.
+bool starts_inside(const Scene *s, Scratch *w, const Ray &ray) {
+    int nc;
+    return s->root < 0 ? s->root == E_ALL : sweep_start(s, w, ray, 0, -1, &nc);
+}
+
+// Visit the visible surfaces along the ray in (0, tmax) in order; `visit` returns false to stop.
+// Returns the number of hits visited.
+template <class Visit>
+int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
+    if (s->root < 0) return 0;
+    int nc = 0;
+    bool root = sweep_start(s, w, ray, tmax, self, &nc);
     if (nc > 1) sort_crossings(w->cross, nc);
     int hits = 0;
     for (int i = 0; i < nc;) {
@@ -6933,6 +6949,15 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
     void **args = (void **)mem_zalloc(c, sizeof(void *) * (size_t)nt);
     void *starts = mem_zalloc(c, 64 * sizeof(void *) * 2);
     pray_status st = wbuf && args && starts ? PRAY_OK : c->status;
+    if (st == PRAY_OK) {  // where the eye is (a frame warns when it is inside the solid)
+        Scratch w;
+        Ray eye;
+        eye.o = s->eye;
+        eye.d = s->dir;
+        if (scratch_init(c, &w, s)) c->eye_inside = starts_inside(s, &w, eye);
+        else st = c->status;
+        scratch_release(c, &w);
+    }
     int made = 0;
     for (; st == PRAY_OK && made < nt; made++) {
         Worker &k = worker_at(wbuf, stride, made);
@@ -8926,7 +8951,8 @@ struct Parser {
     Arena *arena;    // the syntax tree of the statement being read
     Arena *names;    // the names of variables, for the whole run
     Array<Var> *vars;
-    Array<int> hash;  // open addressing: slot + 1, 0 = empty; size a power of two
+    Array<int> *hash;  // open addressing: slot + 1, 0 = empty; size a power of two
+    int included;      // reading a file that `include` named (the variables are the program's)
 };
 
 // Past the T_NL at the current position: the tokens of the next line, when it takes them.
@@ -9002,7 +9028,7 @@ unsigned name_hash(const char *s) {
 // The slot of a variable name, made on first sight. Programs written by generators may have
 // many thousands of names, so they are hashed.
 int var_slot(Parser &P, const char *name) {
-    Array<int> &h = P.hash;
+    Array<int> &h = *P.hash;
     if (2 * (P.vars->n + 1) > h.n) {  // grow and rehash
         int size = h.n ? 2 * h.n : 64;
         Array<int> nh;
@@ -9457,6 +9483,28 @@ Stmt *parse_statement(Parser &P) {
                 }
         return end_of_line(P) ? NULL : s;
     }
+    if (is_word(t, "include")) {  // include "F", alone on its line
+        const Tok &f = P.t[P.pos + 1];
+        if (f.kind != T_STR || f.line != t.line) {
+            syn(P, f.kind == T_NL ? t : f, "'include' takes a file name in double quotes: include \"F\"");
+            return NULL;
+        }
+        s = new_stmt(P, ST_INCLUDE, t);
+        if (!s) return NULL;
+        P.pos++;
+        Expr *e = parse_primary(P);
+        s->args = e ? (Expr **)P.arena->get(P.c, sizeof(Expr *)) : NULL;
+        if (!s->args) return NULL;
+        s->args[0] = e;
+        s->nargs = 1;
+        if (cur(P).kind != T_NL) {
+            char buf[80];
+            syn(P, cur(P), "'include' stands alone on its line: expected end of line after the file name, found '%s'",
+                tok_text(cur(P), buf, sizeof buf));
+            return NULL;
+        }
+        return next_line(P) ? NULL : s;
+    }
     if (is_word(t, "if") || is_word(t, "while")) {
         bool is_if = is_word(t, "if");
         Tok word = t;  // (the block takes the lines after this one's)
@@ -9601,9 +9649,21 @@ struct NameCount {
     int frames;
 };
 
+// A file being read: the program, or a file an `include` named.
+struct IncFile {
+    char *name;  // (owned, except the program's)
+    FileId id;
+    int line;    // the line of the include statement reading the next file
+};
+
 struct Interp {
     pray_ctx *c;
-    const char *name;
+    const char *name;  // the file being read: the program, or an included file
+    const char *prog;  // the program's name (its frames are named after it)
+    Parser *parser;    // the program's: names of variables and their hash, maxnest, maxstring
+    Array<IncFile> files;  // the files being read: [0] the program, then each included one
+    int include_last;  // the last statement of the top level with an include in it, -1: none
+    int chained;       // the error's message has the places of the includes that led to it
     Array<Var> vars;
     Array<Value> vals;  // by variable slot
     // Values no statement after will use are released (release_dead): last[slot] is the last
@@ -10370,6 +10430,15 @@ void frame_name(char *out, size_t n, const char *base, int frame) {
     else snprintf(out, n, "%.*s_%04d", keep, base, frame);
 }
 
+// A warning at statement s: "name:line:col: warning: text".
+void warn(Interp &I, const Stmt *s, const char *text) {
+    pray_ctx *c = I.c;
+    if (!c->warn_fn) return;
+    char line[400];
+    int n = snprintf(line, sizeof line, "%s:%d:%d: warning: %s\n", *ShownPath(I.name), s->line, s->col, text);
+    if (n > 0) c->warn_fn(c->warn_ud, line, (size_t)n < sizeof line ? (size_t)n : sizeof line - 1);
+}
+
 // Once a run: the camera's |X| : |Y| is not the image's width : height, so its pixels are not
 // square and the picture comes out stretched (more than 1 % either way). Never for `lookat`,
 // whose pixels are square for every size.
@@ -10413,8 +10482,8 @@ pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
         return api_err(I, s->line, s->col);
     }
     // the output option, else the program's name with .tif; the frame's name adds _NNNN
-    const char *ext = file_ext(I.name);
-    size_t keep = c->cur.opt.output[0] ? strlen(c->cur.opt.output) : ext ? (size_t)(ext - 1 - I.name) : strlen(I.name);
+    const char *ext = file_ext(I.prog);
+    size_t keep = c->cur.opt.output[0] ? strlen(c->cur.opt.output) : ext ? (size_t)(ext - 1 - I.prog) : strlen(I.prog);
     char *base = (char *)mem_alloc(c, keep + 5), *name = base ? (char *)mem_alloc(c, keep + 40) : NULL;
     if (!name) {
         mem_free(c, base);
@@ -10422,7 +10491,7 @@ pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
         return api_err(I, s->line, s->col);
     }
     if (c->cur.opt.output[0]) memcpy(base, c->cur.opt.output, keep + 1);
-    else snprintf(base, keep + 5, "%.*s.tif", (int)keep, I.name);
+    else snprintf(base, keep + 5, "%.*s.tif", (int)keep, I.prog);
     // frames are numbered per output name: a program that names each image gets those names
     int slot = 0;
     while (slot < I.names.n && strcmp(I.names[slot].name, base) != 0) slot++;
@@ -10445,7 +10514,9 @@ pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
     // holds it any more, its tree is freed before the rest of the scene is built (not when the
     // host renders the frame: it may render the tree more than once, a band at a time)
     c->drop = c->render_fn ? NULL : (pray_object *)a[0].ref;
+    c->eye_inside = 0;
     pray_status st = pray_render(c, (pray_object *)a[0].ref, all, &img);
+    if (st == PRAY_OK && c->eye_inside) warn(I, s, "the eye is inside the rendered solid");
     if (c->drop == NULL && !c->render_fn) a[0].ref = NULL, a[0].t = V_NONE;
     c->drop = NULL;
     release_handle(c, all);
@@ -10504,10 +10575,126 @@ pray_status step(Interp &I, const Stmt *s) {
     return PRAY_OK;
 }
 
+pray_status read_statements(Parser &P, const char *text, size_t len, Interp *I, bool run, double *parse_time);
+#if PRAY_HAS_STDIO
+bool read_program(pray_ctx *c, FILE *f, Text *t);
+#endif
+
+// An error inside an included file: its message gets the place of each include that led there,
+// the innermost first: "b.ray:3:1: error: ... (included from a.ray:2, included from main.ray:7)".
+void include_chain(Interp &I) {
+    if (I.chained) return;
+    I.chained = 1;
+    char *m = I.c->msg;
+    size_t n = strlen(m), size = sizeof I.c->msg;
+    for (int i = I.files.n - 2; i >= 0 && n + 1 < size; i--)
+        n += (size_t)snprintf(m + n, size - n, "%sincluded from %s:%d%s", i == I.files.n - 2 ? " (" : ", ",
+                              *ShownPath(I.files[i].name), I.files[i].line, i == 0 ? ")" : "");
+}
+
+// include "F": the statements of file F, read beside the file that names it, run here as the
+// program's own are (checked whole first, then read and run a statement at a time).
+pray_status exec_include(Interp &I, const Stmt *s) {
+    pray_ctx *c = I.c;
+    const Expr *f = s->args[0];
+#if !PRAY_HAS_STDIO
+    (void)c;
+    return rerr(I, f, PRAY_ERR_RUNTIME, "include: this build has no file access");
+#else
+    double most = I.parser->maxnest;
+    if (I.files.n > most)
+        return perr(c, I.name, s->line, s->col, PRAY_ERR_LIMIT, "includes nested deeper than %.0f level%s (option maxnest)",
+                    most, most == 1 ? "" : "s");
+    const char *why = c->untrusted ? untrusted_path_problem(f->s) : NULL;
+    if (why)
+        return rerr(I, f, PRAY_ERR_RUNTIME, "untrusted program: '%s' is %s; files are read from the program's "
+                    "directory only", *Shown(f->s), why);
+    // the name beside the including file; an untrusted program's, from the program's directory
+    size_t dlen = 0, from = c->untrusted ? c->run_dir_len : 0;
+    for (size_t i = 0; I.name[i]; i++)
+        if (I.name[i] == '/' || I.name[i] == '\\' || I.name[i] == ':') dlen = i + 1;
+    bool relative = f->s[0] && f->s[0] != '/' && f->s[0] != '\\' && f->s[1] != ':';
+    if (!relative || from > dlen) dlen = from = 0;
+    size_t n = strlen(f->s);
+    char *rel = (char *)mem_alloc(c, dlen - from + n + 1);
+    if (!rel) return api_err(I, f->line, f->col);
+    memcpy(rel, I.name + from, dlen - from);
+    memcpy(rel + dlen - from, f->s, n + 1);
+    char *path = NULL;
+    FileId id;
+    id.valid = 0;
+    FILE *in = c->untrusted ? open_read(c, c->run_dir, c->run_dir_len, rel, FIND_CONFINED, &path, &id)
+                            : open_read(c, "", 0, rel, FIND_AS_NAMED, &path, &id);
+    mem_free(c, rel);
+    int loop = -1;
+    for (int i = 0; in && i < I.files.n && loop < 0; i++)
+        if (same_id(id, I.files[i].id) || strcmp(path, I.files[i].name) == 0) loop = i;
+    Text t;
+    t.init();
+    pray_status st = PRAY_OK;
+    if (!in) st = c->status;
+    else if (loop >= 0)
+        st = fail(c, PRAY_ERR_RUNTIME, "'%s' includes itself%s%s%s", *ShownPath(path), loop < I.files.n - 1 ? " through '" : "",
+                  loop < I.files.n - 1 ? *ShownPath(I.files[loop + 1].name) : "", loop < I.files.n - 1 ? "'" : "");
+    else if (!read_program(c, in, &t)) st = c->status;
+    else if (ferror(in)) st = fail(c, PRAY_ERR_IO, "cannot read '%s'", *ShownPath(path));
+    if (in) fclose(in);
+    IncFile nf;
+    nf.name = path;
+    nf.id = id;
+    nf.line = 0;
+    if (st == PRAY_OK && !I.files.push(c, nf)) st = c->status;
+    if (st) {
+        mem_free(c, path);
+        t.a.release(c);
+        if (api_err(I, f->line, f->col) == PRAY_ERR_IO) c->status = PRAY_ERR_RUNTIME;
+        return c->status;
+    }
+    I.files[I.files.n - 2].line = s->line;
+    // a parser of its own, on the program's variables
+    Arena tree, words;
+    tree.init();
+    words.init();
+    Lexer L;
+    memset(&L, 0, sizeof L);
+    L.c = c;
+    L.name = path;
+    L.text = &words;
+    L.toks.init();
+    L.maxstring = I.parser->L->maxstring;
+    Parser Q = *I.parser;
+    Q.name = path;
+    Q.L = &L;
+    Q.arena = &tree;
+    Q.included = 1;
+    const char *outer = I.name;
+    I.name = path;
+    double parse_time = 0;
+    st = read_statements(Q, t.str(), (size_t)t.a.n, &I, false, &parse_time);
+    if (st == PRAY_OK) {
+        tree.reset(c);
+        st = read_statements(Q, t.str(), (size_t)t.a.n, &I, true, &parse_time);
+    }
+    c->stats.time_parse += parse_time;
+    I.name = outer;
+    if (st) include_chain(I);
+    I.files.n--;
+    mem_free(c, path);
+    L.toks.release(c);
+    tree.release(c);
+    words.release(c);
+    t.a.release(c);
+    return st;
+#endif
+}
+
 pray_status exec(Interp &I, const Stmt *s) {
     if (step(I, s)) return I.c->status;
     pray_ctx *c = I.c;
     switch (s->kind) {
+    case ST_INCLUDE:
+        if (exec_include(I, s)) include_chain(I);
+        return c->status;
     case ST_ASSIGN: {
         Value v;
         if (eval(I, s->args[0], &v)) return c->status;
@@ -10644,6 +10831,7 @@ bool note_uses(Interp &I, const Expr *e, int k) {
 }
 bool note_uses(Interp &I, const Stmt *s, int k) {
     if (s->kind == ST_ASSIGN && !note_slot(I, s->slot, k)) return false;
+    if (s->kind == ST_INCLUDE) I.include_last = k;  // an included file may name any variable
     for (int i = 0; i < s->nargs; i++)
         if (!note_uses(I, s->args[i], k)) return false;
     for (int i = 0; i < s->nbody; i++)
@@ -10673,6 +10861,7 @@ bool order_slots(Interp &I) {
         return false;
     }
     for (int i = 0; i < n; i++) {
+        if (I.last[i] < I.include_last) I.last[i] = I.include_last;
         sl[i].last = I.last[i];
         sl[i].slot = i;
     }
@@ -10715,7 +10904,7 @@ pray_status read_statements(Parser &P, const char *text, size_t len, Interp *I, 
             st = c->status;
             break;
         }
-        if (!run && !note_uses(*I, s, k)) {
+        if (!run && !P.included && !note_uses(*I, s, k)) {
             st = c->status;
             break;
         }
@@ -10730,10 +10919,12 @@ pray_status read_statements(Parser &P, const char *text, size_t len, Interp *I, 
             }
             double t1 = clock_seconds();
             *parse_time += t1 - t0;
-            I->top = s;
-            I->top_index = k;
+            if (!P.included) {  // (an included file's values are the program's: they live on)
+                I->top = s;
+                I->top_index = k;
+            }
             st = exec(*I, s);
-            if (st == PRAY_OK) release_dead(*I, k);
+            if (st == PRAY_OK && !P.included) release_dead(*I, k);
             t0 = clock_seconds();
             if (I->quit) break;
         }
@@ -10771,9 +10962,11 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
     Interp I;
     memset(&I, 0, sizeof I);
     I.c = c;
-    I.name = name;
+    I.name = I.prog = name;
     I.vars.init();
     I.vals.init();
+    I.files.init();
+    I.include_last = -1;
     Parser P;
     memset(&P, 0, sizeof P);
     P.c = c;
@@ -10783,13 +10976,21 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
     P.arena = &tree;
     P.names = &names;
     P.vars = &I.vars;
-    P.hash.init();
+    Array<int> hash;
+    hash.init();
+    P.hash = &hash;
+    I.parser = &P;
+    IncFile prog;
+    prog.name = (char *)name;
+    prog.id = c->prog_id;
+    prog.line = 0;
+    pray_status st = I.files.push(c, prog) ? PRAY_OK : c->status;
     // first the whole program is checked, then it is read again and run statement by statement
     double parse_time = 0;
     I.last.init();
     I.order.init();
     I.dropped.init();
-    pray_status st = read_statements(P, text, len, &I, false, &parse_time);
+    if (st == PRAY_OK) st = read_statements(P, text, len, &I, false, &parse_time);
     if (st == PRAY_OK && I.vars.n && (!I.vals.reserve(c, I.vars.n) || !order_slots(I))) st = c->status;
     mem_phase(c, MEM_PARSE);
     if (st == PRAY_OK) {
@@ -10808,7 +11009,8 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
     for (int i = 0; i < I.names.n; i++) mem_free(c, I.names[i].name);
     I.names.release(c);
     I.vars.release(c);
-    P.hash.release(c);
+    hash.release(c);
+    I.files.release(c);
     L.toks.release(c);
     tree.release(c);
     words.release(c);
