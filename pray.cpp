@@ -9485,8 +9485,13 @@ Stmt *parse_statement(Parser &P) {
     }
     if (is_word(t, "include")) {  // include "F", alone on its line
         const Tok &f = P.t[P.pos + 1];
-        if (f.kind != T_STR || f.line != t.line) {
+        if (f.kind != T_STR) {
             syn(P, f.kind == T_NL ? t : f, "'include' takes a file name in double quotes: include \"F\"");
+            return NULL;
+        }
+        if (f.line != t.line || f.n == 0) {
+            syn(P, f, f.n ? "'include' stands alone on its line: the file name must be on the line of 'include'"
+                          : "'include' takes a file name, not an empty string");
             return NULL;
         }
         s = new_stmt(P, ST_INCLUDE, t);

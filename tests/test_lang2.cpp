@@ -433,7 +433,8 @@ TEST_CASE("include: loops, missing files, nesting deeper than maxnest, bad state
     CHECK(testkit::error_of("include \"a\", \"b\"\n") ==
           "test.ray:1:12: error: 'include' stands alone on its line: expected end of line after the file name, found ','");
     CHECK(testkit::error_of("include \\\n \"a.ray\"\n") ==
-          "test.ray:2:2: error: 'include' takes a file name in double quotes: include \"F\"");
+          "test.ray:2:2: error: 'include' stands alone on its line: the file name must be on the line of 'include'");
+    CHECK(testkit::error_of("print 1\ninclude \"\"\n") == "test.ray:2:9: error: 'include' takes a file name, not an empty string");
     CHECK(testkit::error_of("x = 1 include \"a.ray\"\n") == "test.ray:1:7: error: expected end of line, found 'include'");
     CHECK(testkit::error_of("include = 2\n").find("'include' is a reserved word") != std::string::npos);
 }
