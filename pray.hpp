@@ -147,7 +147,9 @@ void pray_set_untrusted(pray_ctx *ctx);
 void pray_set_print(pray_ctx *ctx, pray_write_fn fn, void *ud);
 /* Where warnings go (default: nowhere; the command-line program writes them to standard error):
    one line each, "name:line:col: warning: message\n". A run warns once when the camera's
-   |X| : |Y| differs from width : height by more than 1 % (the picture would come out stretched). */
+   |X| : |Y| differs from width : height by more than 1 % (the picture would come out stretched),
+   and at every frame whose eye point is inside the object rendered ("the eye is inside the
+   rendered solid"). */
 void pray_set_warning(pray_ctx *ctx, pray_write_fn fn, void *ud);
 /* Progress callback for renders (default none). */
 void pray_set_progress(pray_ctx *ctx, pray_progress_fn fn, void *ud);
@@ -208,10 +210,12 @@ double pray_option_get(const pray_ctx *ctx, const char *name);
    Running PRAY programs.
    ------------------------------------------------------------------------------------------- */
 /* Run a program held in memory. `name` is used in messages, for the default output name (name
-   with its extension replaced by .tif) and as the place beside which texture files are looked for
-   (its directory). `text` need not be NUL-terminated. The whole program is checked before its
-   first statement runs, so a malformed one runs none; it is then read again and run a statement
-   at a time, holding only the current line's tokens and the current statement's tree. */
+   with its extension replaced by .tif) and as the place beside which texture files and the files
+   of `include` are looked for (its directory). `text` need not be NUL-terminated. The whole
+   program is checked before its first statement runs, so a malformed one runs none; it is then
+   read again and run a statement at a time, holding only the current line's tokens and the
+   current statement's tree. A file that `include` names is read whole when the statement runs,
+   checked, and run the same way; without file access (PRAY_NO_STDIO) `include` is an error. */
 pray_status pray_run_string(pray_ctx *ctx, const char *name, const char *text, size_t len);
 /* Run a program file (a regular file; a FIFO, directory or device is refused); "-" reads
    standard input (named "stdin.ray" in messages). Reading stops at the first line longer than
