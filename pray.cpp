@@ -176,6 +176,14 @@ typedef PRAY_REAL real;
 #else
 #define PRAY_PRINTF(f, a)
 #endif
+// A function that a recursion passes through but seldom runs keeps its stack frame to itself.
+#if defined(__GNUC__)
+#define PRAY_NOINLINE __attribute__((noinline))
+#elif defined(_MSC_VER)
+#define PRAY_NOINLINE __declspec(noinline)
+#else
+#define PRAY_NOINLINE
+#endif
 #define PRAY_STRINGIFY2(x) #x
 #define PRAY_STRINGIFY(x) PRAY_STRINGIFY2(x)
 
@@ -9728,7 +9736,7 @@ pray_status rerr(Interp &I, const Expr *e, pray_status s, const char *fmt, ...) 
 }
 
 // An API call failed: put the place in front of its message.
-pray_status api_err(Interp &I, int line, int col) {
+PRAY_NOINLINE pray_status api_err(Interp &I, int line, int col) {
     pray_ctx *c = I.c;
     char tmp[1024];
     const char *m = c->msg;
@@ -10462,7 +10470,7 @@ void warn_aspect(Interp &I, const Stmt *s) {
     if (n > 0) c->warn_fn(c->warn_ud, line, (size_t)n < sizeof line ? (size_t)n : sizeof line - 1);
 }
 
-pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
+PRAY_NOINLINE pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
     pray_ctx *c = I.c;
     if (a[0].t != V_OBJECT)
         return rerr(I, s->args[0], PRAY_ERR_RUNTIME, "rendertiff: the first argument must be an object, not %s %s",
@@ -10587,7 +10595,7 @@ bool read_program(pray_ctx *c, FILE *f, Text *t);
 
 // An error inside an included file: its message gets the place of each include that led there,
 // the innermost first: "b.ray:3:1: error: ... (included from a.ray:2, included from main.ray:7)".
-void include_chain(Interp &I) {
+PRAY_NOINLINE void include_chain(Interp &I) {
     if (I.chained) return;
     I.chained = 1;
     char *m = I.c->msg;
@@ -10597,9 +10605,18 @@ void include_chain(Interp &I) {
                               *ShownPath(I.files[i].name), I.files[i].line, i == 0 ? ")" : "");
 }
 
+#if PRAY_HAS_STDIO
+// File `path` is being read already, as I.files[loop]: a file that includes itself.
+PRAY_NOINLINE pray_status include_loop(Interp &I, const char *path, int loop) {
+    bool through = loop < I.files.n - 1;
+    return fail(I.c, PRAY_ERR_RUNTIME, "'%s' includes itself%s%s%s", *ShownPath(path), through ? " through '" : "",
+                through ? *ShownPath(I.files[loop + 1].name) : "", through ? "'" : "");
+}
+#endif
+
 // include "F": the statements of file F, read beside the file that names it, run here as the
 // program's own are (checked whole first, then read and run a statement at a time).
-pray_status exec_include(Interp &I, const Stmt *s) {
+PRAY_NOINLINE pray_status exec_include(Interp &I, const Stmt *s) {
     pray_ctx *c = I.c;
     const Expr *f = s->args[0];
 #if !PRAY_HAS_STDIO
@@ -10639,8 +10656,7 @@ pray_status exec_include(Interp &I, const Stmt *s) {
     pray_status st = PRAY_OK;
     if (!in) st = c->status;
     else if (loop >= 0)
-        st = fail(c, PRAY_ERR_RUNTIME, "'%s' includes itself%s%s%s", *ShownPath(path), loop < I.files.n - 1 ? " through '" : "",
-                  loop < I.files.n - 1 ? *ShownPath(I.files[loop + 1].name) : "", loop < I.files.n - 1 ? "'" : "");
+        st = include_loop(I, path, loop);
     else if (!read_program(c, in, &t)) st = c->status;
     else if (ferror(in)) st = fail(c, PRAY_ERR_IO, "cannot read '%s'", *ShownPath(path));
     if (in) fclose(in);
@@ -10656,38 +10672,44 @@ pray_status exec_include(Interp &I, const Stmt *s) {
         return c->status;
     }
     I.files[I.files.n - 2].line = s->line;
-    // a parser of its own, on the program's variables
-    Arena tree, words;
-    tree.init();
-    words.init();
-    Lexer L;
-    memset(&L, 0, sizeof L);
-    L.c = c;
-    L.name = path;
-    L.text = &words;
-    L.toks.init();
-    L.maxstring = I.parser->L->maxstring;
-    Parser Q = *I.parser;
-    Q.name = path;
-    Q.L = &L;
-    Q.arena = &tree;
-    Q.included = 1;
-    const char *outer = I.name;
-    I.name = path;
-    double parse_time = 0;
-    st = read_statements(Q, t.str(), (size_t)t.a.n, &I, false, &parse_time);
-    if (st == PRAY_OK) {
-        tree.reset(c);
-        st = read_statements(Q, t.str(), (size_t)t.a.n, &I, true, &parse_time);
-    }
-    c->stats.time_parse += parse_time;
-    I.name = outer;
+    // a parser of its own, on the program's variables (on the heap: includes nest this function)
+    struct Reader {
+        Arena tree, words;
+        Lexer L;
+        Parser Q;
+    } *r = (Reader *)mem_zalloc(c, sizeof(Reader));
+    if (r) {
+        r->tree.init();
+        r->words.init();
+        r->L.c = c;
+        r->L.name = path;
+        r->L.text = &r->words;
+        r->L.toks.init();
+        r->L.maxstring = I.parser->L->maxstring;
+        r->Q = *I.parser;
+        r->Q.name = path;
+        r->Q.L = &r->L;
+        r->Q.arena = &r->tree;
+        r->Q.included = 1;
+        const char *outer = I.name;
+        I.name = path;
+        double parse_time = 0;
+        st = read_statements(r->Q, t.str(), (size_t)t.a.n, &I, false, &parse_time);
+        if (st == PRAY_OK) {
+            r->tree.reset(c);
+            st = read_statements(r->Q, t.str(), (size_t)t.a.n, &I, true, &parse_time);
+        }
+        c->stats.time_parse += parse_time;
+        I.name = outer;
+        r->L.toks.release(c);
+        r->tree.release(c);
+        r->words.release(c);
+        mem_free(c, r);
+    } else
+        st = api_err(I, f->line, f->col);
     if (st) include_chain(I);
     I.files.n--;
     mem_free(c, path);
-    L.toks.release(c);
-    tree.release(c);
-    words.release(c);
     t.a.release(c);
     return st;
 #endif
@@ -10885,7 +10907,8 @@ bool order_slots(Interp &I) {
 // statement names are noted; with it each statement runs as soon as it is read, and the values
 // of variables that no statement after it names are released. *parse_time: seconds spent
 // reading.
-pray_status read_statements(Parser &P, const char *text, size_t len, Interp *I, bool run, double *parse_time) {
+PRAY_NOINLINE pray_status read_statements(Parser &P, const char *text, size_t len, Interp *I, bool run,
+                                         double *parse_time) {
     pray_ctx *c = P.c;
     int k = 0;  // statements of the top level read so far
     double t0 = clock_seconds();
@@ -10940,14 +10963,18 @@ pray_status read_statements(Parser &P, const char *text, size_t len, Interp *I, 
     if (st && !run && !P.L->failed) {
         // the program is wrong: an error of its characters, anywhere, is the one to report
         // (as when the whole text is lexed first); else this one
+        // (the message is kept off the stack: included files nest this function)
         pray_status first = st;
-        char msg[sizeof c->msg];
-        memcpy(msg, c->msg, sizeof msg);
+        char *msg = mem_strdup(c, c->msg, strlen(c->msg));
         while (!P.L->at_end && lex_line(*P.L) == PRAY_OK) {
         }
-        if (P.L->failed) return c->status;
+        if (P.L->failed) {
+            mem_free(c, msg);
+            return c->status;
+        }
         c->status = first;
-        memcpy(c->msg, msg, sizeof msg);
+        if (msg) snprintf(c->msg, sizeof c->msg, "%s", msg);
+        mem_free(c, msg);
     }
     return st;
 }
