@@ -137,10 +137,10 @@ void pray_set_memory_limit(pray_ctx *ctx, size_t bytes);
    ceiling (lowered to it now; a higher value, or 0 where 0 means "no limit", is refused later):
    depth 16, gridmem 64, maxframes 1000, maxline 4096, maxmem 1024, maxnest 64, maxoutput 1024,
    maxpixels 16777216, maxprims 1048576, maxsteps 1000000, maxstring 4096, texmem 64. Texture and
-   font files named by a program are read only from the program's directory (relative names
-   without "..", opened one directory at a time without following any symbolic link; on Windows
-   and DOS links inside the directory are followed); an `output` set by a program must be a plain
-   file name. */
+   font files, and the files of `include`, named by a program are read only from the program's
+   directory (relative names without "..", opened one directory at a time without following any
+   symbolic link; on Windows and DOS links inside the directory are followed); an `output` set by
+   a program must be a plain file name. */
 void pray_set_untrusted(pray_ctx *ctx);
 /* Where `print` writes (default: standard output; NULL fn discards). Called on the calling
    thread, during pray_run_*. */
