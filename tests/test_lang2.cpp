@@ -260,6 +260,20 @@ TEST_CASE("lookat: square pixels at every image size, so -s never stretches, and
         if (diameter == 0) diameter = share;
         CHECK(share == doctest::Approx(diameter).epsilon(0.05));
     }
+    // -s W x H fixes the size over the program's own (pray_option_fix, as the command line does)
+    const std::string sized = "option \"width\", 64\noption \"height\", 64\n" + prog;
+    for (const char *wh : {"64x64", "120x40", "40x120"}) {
+        int w = 0, h = 0;
+        std::sscanf(wh, "%dx%d", &w, &h);
+        testkit::Result r = testkit::run(sized, {"width=" + std::to_string(w), "height=" + std::to_string(h)});
+        REQUIRE_MESSAGE(r.status == PRAY_OK, r.error);
+        REQUIRE(r.frames.size() == 1);
+        CHECK(r.frames[0].width == w);
+        Blob b = blob(r.frames[0], 0);
+        INFO(wh);
+        CHECK(std::abs(b.w() - b.h()) <= 1);
+        CHECK((double)b.w() / w == doctest::Approx(diameter).epsilon(0.05));
+    }
     // the size may change between frames: each frame is square in its own size
     Run two = run_warned("lookat [0, -10, 0], [0, 0, 0], <0, 0, 1>, 30\nS = sphere(color({1}), [0, 0, 0], 0.6)\n"
                          "rendertiff S, none\noption \"width\", 80\nrendertiff S, none\n");
