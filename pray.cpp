@@ -176,6 +176,14 @@ typedef PRAY_REAL real;
 #else
 #define PRAY_PRINTF(f, a)
 #endif
+// A function that a recursion passes through but seldom runs keeps its stack frame to itself.
+#if defined(__GNUC__)
+#define PRAY_NOINLINE __attribute__((noinline))
+#elif defined(_MSC_VER)
+#define PRAY_NOINLINE __declspec(noinline)
+#else
+#define PRAY_NOINLINE
+#endif
 #define PRAY_STRINGIFY2(x) #x
 #define PRAY_STRINGIFY(x) PRAY_STRINGIFY2(x)
 
@@ -494,6 +502,9 @@ struct Setup {
     Options opt;
     int parallel;
     pray_vec cam_x, cam_y, cam_eye, cam_point;
+    int lookat;  // cam_x and cam_y follow from these for the image's size (camera_axes)
+    pray_vec cam_up;
+    double cam_angle;
     pray_rgb bg_top, bg_bottom;
 };
 
@@ -537,6 +548,7 @@ struct pray_ctx {
     unsigned temp_serial;    // makes temporary names unique
     double written;          // bytes of image files written by this run (option maxoutput)
     pray_object *drop;       // given up by a program's rendertiff: released once flattened (scene_build)
+    int eye_inside;          // the camera's eye is inside the solid last rendered (render_scene)
     volatile sig_atomic_t cancel;  // pray_cancel: the running call stops at its next check
     int calls;               // cancellable public calls running (a run renders and writes)
 };
@@ -2705,11 +2717,10 @@ struct Hit {
     int root_enter;  // the ray enters the whole solid there
 };
 
-// Visit the visible surfaces along the ray in (0, tmax) in order; `visit` returns false to stop.
-// Returns the number of hits visited.
-template <class Visit>
-int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
-    if (s->root < 0) return 0;
+// The start of a sweep: the status of every primitive and node at the start of the ray (just
+// after it, for a start on a surface) into w, and the crossings in (0, tmax) into w->cross
+// (*ncross of them, unsorted). Returns the root's status. The root must be an element.
+bool sweep_start(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int *ncross) {
     int nc = 0;
     int np = s->prims.n;
     for (int j = 0; j < s->nodes.n; j++) {
@@ -2753,7 +2764,23 @@ int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit
             else w->cnt[nd.parent]++;
         }
     }
-    bool root = e_is_node(s->root) ? w->nstat[e_index(s->root)] != 0 : w->pstat[e_index(s->root)] != 0;
+    *ncross = nc;
+    return e_is_node(s->root) ? w->nstat[e_index(s->root)] != 0 : w->pstat[e_index(s->root)] != 0;
+}
+
+// Is the start of the ray inside the solid? Exact, as every sweep begins: one test per primitive.
+bool starts_inside(const Scene *s, Scratch *w, const Ray &ray) {
+    int nc;
+    return s->root < 0 ? s->root == E_ALL : sweep_start(s, w, ray, 0, -1, &nc);
+}
+
+// Visit the visible surfaces along the ray in (0, tmax) in order; `visit` returns false to stop.
+// Returns the number of hits visited.
+template <class Visit>
+int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
+    if (s->root < 0) return 0;
+    int nc = 0;
+    bool root = sweep_start(s, w, ray, tmax, self, &nc);
     if (nc > 1) sort_crossings(w->cross, nc);
     int hits = 0;
     for (int i = 0; i < nc;) {
@@ -6484,18 +6511,37 @@ void ray_most(const pray_ctx *c, Scene *s) {
     s->maxrays = (long)c->cur.opt.v[OPT_MAXRAYS];
 }
 
+// The camera's X and Y. Those of `lookat` follow from the image's size (options width and
+// height), so that its pixels are square: right = (P - E) % U, down = (P - E) % right, |X| =
+// |P - E| tan(a / 2) for the horizontal angle a, |Y| = |X| height / width.
+void camera_axes(const pray_ctx *c, pray_vec *x, pray_vec *y) {
+    const Setup &u = c->cur;
+    if (!u.lookat) {
+        *x = u.cam_x;
+        *y = u.cam_y;
+        return;
+    }
+    pray_vec d = vsub(u.cam_point, u.cam_eye), ahead = vunit(d);
+    pray_vec right = vunit(vcross(ahead, vunit(u.cam_up))), down = vunit(vcross(ahead, right));
+    double half = vlen(d) * tan(u.cam_angle * (3.14159265358979323846 / 360));
+    *x = vmul(right, half);
+    *y = vmul(down, half * u.opt.v[OPT_HEIGHT] / u.opt.v[OPT_WIDTH]);
+}
+
 // The camera and the image's size (options width and height) as the renderer sees them.
 void scene_camera(const pray_ctx *c, Scene *s) {
+    pray_vec cam_x, cam_y;
+    camera_axes(c, &cam_x, &cam_y);
     s->parallel = c->cur.parallel;
     s->eye = r3of(c->cur.cam_eye);
     s->point = r3of(c->cur.cam_point);
-    s->cx = r3of(c->cur.cam_x);
-    s->cy = r3of(c->cur.cam_y);
+    s->cx = r3of(cam_x);
+    s->cy = r3of(cam_y);
     s->dir = r3of(vunit(vsub(c->cur.cam_point, c->cur.cam_eye)));
     // Directions are the same for the camera scaled by any factor; a power of two keeps them
     // exact, and brings vectors of 1e-200 or 1e200 into range (of floats, too).
     double big = vmaxabs(c->cur.cam_point);
-    const pray_vec *cv[3] = {&c->cur.cam_eye, &c->cur.cam_x, &c->cur.cam_y};
+    const pray_vec *cv[3] = {&c->cur.cam_eye, &cam_x, &cam_y};
     for (int i = 0; i < 3; i++)
         if (vmaxabs(*cv[i]) > big) big = vmaxabs(*cv[i]);
     int e = 0;
@@ -6503,8 +6549,8 @@ void scene_camera(const pray_ctx *c, Scene *s) {
     double k = ldexp(1.0, -e);
     s->keye = r3of(vmul(c->cur.cam_eye, k));
     s->kpoint = r3of(vmul(c->cur.cam_point, k));
-    s->kcx = r3of(vmul(c->cur.cam_x, k));
-    s->kcy = r3of(vmul(c->cur.cam_y, k));
+    s->kcx = r3of(vmul(cam_x, k));
+    s->kcy = r3of(vmul(cam_y, k));
     s->width = opt_int(c, OPT_WIDTH);
     s->height = opt_int(c, OPT_HEIGHT);
 }
@@ -6970,6 +7016,15 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
     void **args = (void **)mem_zalloc(c, sizeof(void *) * (size_t)nt);
     void *starts = mem_zalloc(c, 64 * sizeof(void *) * 2);
     pray_status st = wbuf && args && starts ? PRAY_OK : c->status;
+    if (st == PRAY_OK) {  // where the eye is (a frame warns when it is inside the solid)
+        Scratch w;
+        Ray eye;
+        eye.o = s->eye;
+        eye.d = s->dir;
+        if (scratch_init(c, &w, s)) c->eye_inside = starts_inside(s, &w, eye);
+        else st = c->status;
+        scratch_release(c, &w);
+    }
     int made = 0;
     for (; st == PRAY_OK && made < nt; made++) {
         Worker &k = worker_at(wbuf, stride, made);
@@ -8093,6 +8148,7 @@ pray_status set_camera(pray_ctx *c, int parallel, pray_vec x, pray_vec y, pray_v
     const char *why = camera_problem(parallel != 0, x, y, e, p);
     if (why) return fail(c, PRAY_ERR_ARG, "%s: %s", parallel ? "parallel" : "perspective", why);
     c->cur.parallel = parallel;
+    c->cur.lookat = 0;
     c->cur.cam_x = x;
     c->cur.cam_y = y;
     c->cur.cam_eye = e;
@@ -8101,6 +8157,28 @@ pray_status set_camera(pray_ctx *c, int parallel, pray_vec x, pray_vec y, pray_v
     return PRAY_OK;
 }
 } // namespace
+
+pray_status pray_lookat(pray_ctx *c, pray_vec e, pray_vec p, pray_vec up, double angle) {
+    if (!c) return PRAY_ERR_ARG;
+    const char *why = NULL;
+    pray_vec d = vsub(p, e);
+    if (!vfinite(e) || !vfinite(p) || !vfinite(up) || !vfinite(d) || !finite_num(angle))
+        why = "coordinates are not finite";
+    else if (vmaxabs(d) == 0) why = "the eye and the point looked at must differ";
+    else if (vmaxabs(up) == 0) why = "the up direction U must not be a zero vector";
+    else if (vlen(vcross(vunit(d), vunit(up))) <= 1e-12) why = "the up direction U must not be parallel to P - E";
+    else if (!(angle > 0 && angle < 180)) return fail(c, PRAY_ERR_ARG, "lookat: the angle %g must lie between 0 and 180 degrees", angle);
+    if (why) return fail(c, PRAY_ERR_ARG, "lookat: %s", why);
+    c->cur.parallel = 0;
+    c->cur.lookat = 1;
+    c->cur.cam_eye = e;
+    c->cur.cam_point = p;
+    c->cur.cam_up = up;
+    c->cur.cam_angle = angle;
+    camera_axes(c, &c->cur.cam_x, &c->cur.cam_y);  // (for the size in force now; a render sizes them again)
+    if (!c->running) c->base = c->cur;
+    return PRAY_OK;
+}
 
 pray_status pray_perspective(pray_ctx *c, pray_vec x, pray_vec y, pray_vec e, pray_vec p) {
     if (!c) return PRAY_ERR_ARG;
@@ -8889,7 +8967,7 @@ struct Expr {
 
 enum {
     ST_ASSIGN, ST_DELETE, ST_PRINT, ST_IF, ST_WHILE, ST_QUIT, ST_BACKGROUND, ST_PERSPECTIVE,
-    ST_PARALLEL, ST_OPTION, ST_RENDER
+    ST_PARALLEL, ST_OPTION, ST_RENDER, ST_LOOKAT, ST_INCLUDE
 };
 
 struct Stmt {
@@ -8910,8 +8988,18 @@ const char *builtin_name(int i);
 int builtin_count();
 
 const char *const KEYWORDS[] = {"if", "then", "else", "endif", "while", "endwhile", "background",
-                                "delete", "option", "parallel", "perspective", "print", "quit",
-                                "rendertiff", "true", "false", "nothing", "none", "pi"};
+                                "delete", "include", "lookat", "option", "parallel", "perspective",
+                                "print", "quit", "rendertiff", "true", "false", "nothing", "none", "pi"};
+
+// The words version 2 of the language added: a program of version 1 may have used them as
+// names, so its error says why the name is refused now.
+const char *version2_note(const char *s) {
+    static const char *const words[] = {"box", "ceil", "cone", "floor", "include", "lookat", "max",
+                                        "min", "rod", "round", "stretch", "torus"};
+    for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
+        if (strcmp(words[i], s) == 0) return " (a word of version 2 of the language: rename the variable)";
+    return "";
+}
 
 // Variable names are interned at parse time; a variable is a slot.
 struct Var {
@@ -8930,7 +9018,8 @@ struct Parser {
     Arena *arena;    // the syntax tree of the statement being read
     Arena *names;    // the names of variables, for the whole run
     Array<Var> *vars;
-    Array<int> hash;  // open addressing: slot + 1, 0 = empty; size a power of two
+    Array<int> *hash;  // open addressing: slot + 1, 0 = empty; size a power of two
+    int included;      // reading a file that `include` named (the variables are the program's)
 };
 
 // Past the T_NL at the current position: the tokens of the next line, when it takes them.
@@ -9006,7 +9095,7 @@ unsigned name_hash(const char *s) {
 // The slot of a variable name, made on first sight. Programs written by generators may have
 // many thousands of names, so they are hashed.
 int var_slot(Parser &P, const char *name) {
-    Array<int> &h = P.hash;
+    Array<int> &h = *P.hash;
     if (2 * (P.vars->n + 1) > h.n) {  // grow and rehash
         int size = h.n ? 2 * h.n : 64;
         Array<int> nh;
@@ -9148,7 +9237,7 @@ Expr *parse_primary(Parser &P) {
         const Builtin *b = may_be_predefined(t.s) ? builtin_find(t.s) : NULL;
         if (b) {
             if (!is_op(cur(P), '(')) {
-                syn(P, t, "'%s' is a function: write it with its arguments in parentheses", t.s);
+                syn(P, t, "'%s' is a function: write it with its arguments in parentheses%s", t.s, version2_note(t.s));
                 return NULL;
             }
             if (!enter(P, &t)) return NULL;
@@ -9182,7 +9271,7 @@ Expr *parse_primary(Parser &P) {
             return ok ? e : NULL;
         }
         if (is_reserved(t.s)) {
-            syn(P, t, "'%s' is a reserved word and cannot be used here", t.s);
+            syn(P, t, "'%s' is a reserved word and cannot be used here%s", t.s, version2_note(t.s));
             return NULL;
         }
         if (is_op(cur(P), '(')) {
@@ -9408,7 +9497,7 @@ Stmt *parse_statement(Parser &P) {
     Stmt *s = NULL;
     if (is_op(P.t[P.pos + 1], '=')) {
         if (is_reserved(t.s)) {
-            syn(P, t, "'%s' is a reserved word and cannot be assigned to", t.s);
+            syn(P, t, "'%s' is a reserved word and cannot be assigned to%s", t.s, version2_note(t.s));
             return NULL;
         }
         s = new_stmt(P, ST_ASSIGN, t);
@@ -9429,6 +9518,7 @@ Stmt *parse_statement(Parser &P) {
     };
     static const Word words[] = {
         {"background", ST_BACKGROUND, 1, 2}, {"delete", ST_DELETE, 1, 1 << 20},
+        {"lookat", ST_LOOKAT, 4, 4},
         {"option", ST_OPTION, 2, 2},         {"parallel", ST_PARALLEL, 4, 4},
         {"perspective", ST_PERSPECTIVE, 4, 4}, {"print", ST_PRINT, 0, 1 << 20},
         {"quit", ST_QUIT, 0, 0},             {"rendertiff", ST_RENDER, 1, 1 << 20},
@@ -9459,6 +9549,33 @@ Stmt *parse_statement(Parser &P) {
                     return NULL;
                 }
         return end_of_line(P) ? NULL : s;
+    }
+    if (is_word(t, "include")) {  // include "F", alone on its line
+        const Tok &f = P.t[P.pos + 1];
+        if (f.kind != T_STR) {
+            syn(P, f.kind == T_NL ? t : f, "'include' takes a file name in double quotes: include \"F\"");
+            return NULL;
+        }
+        if (f.line != t.line || f.n == 0) {
+            syn(P, f, f.n ? "'include' stands alone on its line: the file name must be on the line of 'include'"
+                          : "'include' takes a file name, not an empty string");
+            return NULL;
+        }
+        s = new_stmt(P, ST_INCLUDE, t);
+        if (!s) return NULL;
+        P.pos++;
+        Expr *e = parse_primary(P);
+        s->args = e ? (Expr **)P.arena->get(P.c, sizeof(Expr *)) : NULL;
+        if (!s->args) return NULL;
+        s->args[0] = e;
+        s->nargs = 1;
+        if (cur(P).kind != T_NL) {
+            char buf[80];
+            syn(P, cur(P), "'include' stands alone on its line: expected end of line after the file name, found '%s'",
+                tok_text(cur(P), buf, sizeof buf));
+            return NULL;
+        }
+        return next_line(P) ? NULL : s;
     }
     if (is_word(t, "if") || is_word(t, "while")) {
         bool is_if = is_word(t, "if");
@@ -9542,8 +9659,8 @@ Stmt *parse_statement(Parser &P) {
     }
     Suggest sg;
     sg.init(t.s);
-    static const char *const stmts[] = {"background", "delete", "option", "parallel", "perspective",
-                                        "print", "quit", "rendertiff", "if", "while"};
+    static const char *const stmts[] = {"background", "delete", "include", "lookat", "option", "parallel",
+                                        "perspective", "print", "quit", "rendertiff", "if", "while"};
     for (size_t i = 0; i < sizeof stmts / sizeof stmts[0]; i++) sg.offer(stmts[i]);
     char msg[200];
     if (sg.best) snprintf(msg, sizeof msg, "unknown statement '%s'; did you mean '%s'?", t.s, sg.best);
@@ -9604,9 +9721,21 @@ struct NameCount {
     int frames;
 };
 
+// A file being read: the program, or a file an `include` named.
+struct IncFile {
+    char *name;  // (owned, except the program's)
+    FileId id;
+    int line;    // the line of the include statement reading the next file
+};
+
 struct Interp {
     pray_ctx *c;
-    const char *name;
+    const char *name;  // the file being read: the program, or an included file
+    const char *prog;  // the program's name (its frames are named after it)
+    Parser *parser;    // the program's: names of variables and their hash, maxnest, maxstring
+    Array<IncFile> files;  // the files being read: [0] the program, then each included one
+    int include_last;  // the last statement of the top level with an include in it, -1: none
+    int chained;       // the error's message has the places of the includes that led to it
     Array<Var> vars;
     Array<Value> vals;  // by variable slot
     // Values no statement after will use are released (release_dead): last[slot] is the last
@@ -9666,7 +9795,7 @@ pray_status rerr(Interp &I, const Expr *e, pray_status s, const char *fmt, ...) 
 }
 
 // An API call failed: put the place in front of its message.
-pray_status api_err(Interp &I, int line, int col) {
+PRAY_NOINLINE pray_status api_err(Interp &I, int line, int col) {
     pray_ctx *c = I.c;
     char tmp[1024];
     const char *m = c->msg;
@@ -9858,6 +9987,27 @@ pray_status bi_sqrt(Interp &I, const Expr *call, Value *a, Value *out) {
     return math1(I, call, a, out, sqrt);
 }
 pray_status bi_tan(Interp &I, const Expr *call, Value *a, Value *out) { return math1(I, call, a, out, tan); }
+// Halves away from zero (C99's round, which C++98 lacks): x - floor(x) is exact.
+double round_half_away(double x) {
+    if (x < 0) return -round_half_away(-x);
+    double f = floor(x);
+    return x - f >= 0.5 ? f + 1 : f;
+}
+pray_status bi_floor(Interp &I, const Expr *call, Value *a, Value *out) { return math1(I, call, a, out, floor); }
+pray_status bi_ceil(Interp &I, const Expr *call, Value *a, Value *out) { return math1(I, call, a, out, ceil); }
+pray_status bi_round(Interp &I, const Expr *call, Value *a, Value *out) {
+    return math1(I, call, a, out, round_half_away);
+}
+pray_status bi_min(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_NUM) || want(I, call, a, 1, V_NUM)) return I.c->status;
+    *out = vnum(a[1].v[0] < a[0].v[0] ? a[1].v[0] : a[0].v[0]);
+    return PRAY_OK;
+}
+pray_status bi_max(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_NUM) || want(I, call, a, 1, V_NUM)) return I.c->status;
+    *out = vnum(a[1].v[0] > a[0].v[0] ? a[1].v[0] : a[0].v[0]);
+    return PRAY_OK;
+}
 pray_status bi_transparent(Interp &I, const Expr *call, Value *a, Value *out) {
     if (want(I, call, a, 0, V_INTENS) || want(I, call, a, 1, V_NUM)) return I.c->status;
     return made(I, call, V_MODEL, pray_transparent(I.c, rgb_of(a[0]), a[1].v[0]), out);
@@ -9940,14 +10090,18 @@ pray_status bi_text(Interp &I, const Expr *call, Value *a, Value *out) {
 const Builtin BUILTINS[] = {
     {"abs", 1, 1, bi_abs},           {"arccos", 1, 1, bi_arccos},
     {"arcsin", 1, 1, bi_arcsin},     {"arctan", 1, 1, bi_arctan},
-    {"arctan2", 2, 2, bi_arctan2},   {"color", 1, 1, bi_color},
+    {"arctan2", 2, 2, bi_arctan2},   {"ceil", 1, 1, bi_ceil},
+    {"color", 1, 1, bi_color},
     {"cos", 1, 1, bi_cos},           {"cylinder", 4, 4, bi_cylinder},
     {"directionlight", 2, 2, bi_dirlight}, {"dirlight", 2, 2, bi_dirlight},
-    {"exp", 1, 1, bi_exp},           {"log", 1, 1, bi_log},
+    {"exp", 1, 1, bi_exp},           {"floor", 1, 1, bi_floor},
+    {"log", 1, 1, bi_log},           {"max", 2, 2, bi_max},
+    {"min", 2, 2, bi_min},
     {"mirror", 1, 1, bi_mirror},     {"move", 3, 3, bi_move},
     {"norm", 1, 1, bi_norm},         {"one", 1, 1, bi_one},
     {"phong", 3, 4, bi_phong},       {"plane", 3, 3, bi_plane},
     {"planemap", 5, 5, bi_planemap}, {"pointlight", 2, 2, bi_pointlight},
+    {"round", 1, 1, bi_round},
     {"sin", 1, 1, bi_sin},           {"sphere", 3, 3, bi_sphere},
     {"spheremap", 5, 5, bi_spheremap}, {"sqrt", 1, 1, bi_sqrt},
     {"tan", 1, 1, bi_tan},           {"text", 8, 8, bi_text},
@@ -10348,13 +10502,23 @@ void frame_name(char *out, size_t n, const char *base, int frame) {
     else snprintf(out, n, "%.*s_%04d", keep, base, frame);
 }
 
+// A warning at statement s: "name:line:col: warning: text".
+void warn(Interp &I, const Stmt *s, const char *text) {
+    pray_ctx *c = I.c;
+    if (!c->warn_fn) return;
+    char line[400];
+    int n = snprintf(line, sizeof line, "%s:%d:%d: warning: %s\n", *ShownPath(I.name), s->line, s->col, text);
+    if (n > 0) c->warn_fn(c->warn_ud, line, (size_t)n < sizeof line ? (size_t)n : sizeof line - 1);
+}
+
 // Once a run: the camera's |X| : |Y| is not the image's width : height, so its pixels are not
-// square and the picture comes out stretched (more than 1 % either way).
+// square and the picture comes out stretched (more than 1 % either way). Never for `lookat`,
+// whose pixels are square for every size.
 void warn_aspect(Interp &I, const Stmt *s) {
     pray_ctx *c = I.c;
     double w = c->cur.opt.v[OPT_WIDTH], h = c->cur.opt.v[OPT_HEIGHT];
     double stretch = vlen(c->cur.cam_x) / vlen(c->cur.cam_y) * h / w;
-    if (!c->warn_fn || I.warned_aspect || (stretch < 1.01 && stretch > 1 / 1.01)) return;
+    if (!c->warn_fn || I.warned_aspect || c->cur.lookat || (stretch < 1.01 && stretch > 1 / 1.01)) return;
     I.warned_aspect = 1;
     char line[400];
     int n = snprintf(line, sizeof line,
@@ -10365,7 +10529,7 @@ void warn_aspect(Interp &I, const Stmt *s) {
     if (n > 0) c->warn_fn(c->warn_ud, line, (size_t)n < sizeof line ? (size_t)n : sizeof line - 1);
 }
 
-pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
+PRAY_NOINLINE pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
     pray_ctx *c = I.c;
     if (a[0].t != V_OBJECT)
         return rerr(I, s->args[0], PRAY_ERR_RUNTIME, "rendertiff: the first argument must be an object, not %s %s",
@@ -10390,8 +10554,8 @@ pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
         return api_err(I, s->line, s->col);
     }
     // the output option, else the program's name with .tif; the frame's name adds _NNNN
-    const char *ext = file_ext(I.name);
-    size_t keep = c->cur.opt.output[0] ? strlen(c->cur.opt.output) : ext ? (size_t)(ext - 1 - I.name) : strlen(I.name);
+    const char *ext = file_ext(I.prog);
+    size_t keep = c->cur.opt.output[0] ? strlen(c->cur.opt.output) : ext ? (size_t)(ext - 1 - I.prog) : strlen(I.prog);
     char *base = (char *)mem_alloc(c, keep + 5), *name = base ? (char *)mem_alloc(c, keep + 40) : NULL;
     if (!name) {
         mem_free(c, base);
@@ -10399,7 +10563,7 @@ pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
         return api_err(I, s->line, s->col);
     }
     if (c->cur.opt.output[0]) memcpy(base, c->cur.opt.output, keep + 1);
-    else snprintf(base, keep + 5, "%.*s.tif", (int)keep, I.name);
+    else snprintf(base, keep + 5, "%.*s.tif", (int)keep, I.prog);
     // frames are numbered per output name: a program that names each image gets those names
     int slot = 0;
     while (slot < I.names.n && strcmp(I.names[slot].name, base) != 0) slot++;
@@ -10422,7 +10586,9 @@ pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
     // holds it any more, its tree is freed before the rest of the scene is built (not when the
     // host renders the frame: it may render the tree more than once, a band at a time)
     c->drop = c->render_fn ? NULL : (pray_object *)a[0].ref;
+    c->eye_inside = 0;
     pray_status st = pray_render(c, (pray_object *)a[0].ref, all, &img);
+    if (st == PRAY_OK && c->eye_inside) warn(I, s, "the eye is inside the rendered solid");
     if (c->drop == NULL && !c->render_fn) a[0].ref = NULL, a[0].t = V_NONE;
     c->drop = NULL;
     release_handle(c, all);
@@ -10481,10 +10647,140 @@ pray_status step(Interp &I, const Stmt *s) {
     return PRAY_OK;
 }
 
+pray_status read_statements(Parser &P, const char *text, size_t len, Interp *I, bool run, double *parse_time);
+#if PRAY_HAS_STDIO
+bool read_program(pray_ctx *c, FILE *f, Text *t);
+#endif
+
+// An error inside an included file: its message gets the place of each include that led there,
+// the innermost first: "b.ray:3:1: error: ... (included from a.ray:2, included from main.ray:7)".
+PRAY_NOINLINE void include_chain(Interp &I) {
+    if (I.chained) return;
+    I.chained = 1;
+    char *m = I.c->msg;
+    size_t n = strlen(m), size = sizeof I.c->msg;
+    for (int i = I.files.n - 2; i >= 0 && n + 1 < size; i--)
+        n += (size_t)snprintf(m + n, size - n, "%sincluded from %s:%d%s", i == I.files.n - 2 ? " (" : ", ",
+                              *ShownPath(I.files[i].name), I.files[i].line, i == 0 ? ")" : "");
+}
+
+#if PRAY_HAS_STDIO
+// File `path` is being read already, as I.files[loop]: a file that includes itself.
+PRAY_NOINLINE pray_status include_loop(Interp &I, const char *path, int loop) {
+    bool through = loop < I.files.n - 1;
+    return fail(I.c, PRAY_ERR_RUNTIME, "'%s' includes itself%s%s%s", *ShownPath(path), through ? " through '" : "",
+                through ? *ShownPath(I.files[loop + 1].name) : "", through ? "'" : "");
+}
+#endif
+
+// include "F": the statements of file F, read beside the file that names it, run here as the
+// program's own are (checked whole first, then read and run a statement at a time).
+PRAY_NOINLINE pray_status exec_include(Interp &I, const Stmt *s) {
+    pray_ctx *c = I.c;
+    const Expr *f = s->args[0];
+#if !PRAY_HAS_STDIO
+    (void)c;
+    return rerr(I, f, PRAY_ERR_RUNTIME, "include: this build has no file access");
+#else
+    double most = I.parser->maxnest;
+    if (I.files.n > most)
+        return perr(c, I.name, s->line, s->col, PRAY_ERR_LIMIT, "includes nested deeper than %.0f level%s (option maxnest)",
+                    most, most == 1 ? "" : "s");
+    const char *why = c->untrusted ? untrusted_path_problem(f->s) : NULL;
+    if (why)
+        return rerr(I, f, PRAY_ERR_RUNTIME, "untrusted program: '%s' is %s; files are read from the program's "
+                    "directory only", *Shown(f->s), why);
+    // the name beside the including file; an untrusted program's, from the program's directory
+    size_t dlen = 0, from = c->untrusted ? c->run_dir_len : 0;
+    for (size_t i = 0; I.name[i]; i++)
+        if (I.name[i] == '/' || I.name[i] == '\\' || I.name[i] == ':') dlen = i + 1;
+    bool relative = f->s[0] && f->s[0] != '/' && f->s[0] != '\\' && f->s[1] != ':';
+    if (!relative || from > dlen) dlen = from = 0;
+    size_t n = strlen(f->s);
+    char *rel = (char *)mem_alloc(c, dlen - from + n + 1);
+    if (!rel) return api_err(I, f->line, f->col);
+    memcpy(rel, I.name + from, dlen - from);
+    memcpy(rel + dlen - from, f->s, n + 1);
+    char *path = NULL;
+    FileId id;
+    id.valid = 0;
+    FILE *in = c->untrusted ? open_read(c, c->run_dir, c->run_dir_len, rel, FIND_CONFINED, &path, &id)
+                            : open_read(c, "", 0, rel, FIND_AS_NAMED, &path, &id);
+    mem_free(c, rel);
+    int loop = -1;
+    for (int i = 0; in && i < I.files.n && loop < 0; i++)
+        if (same_id(id, I.files[i].id) || strcmp(path, I.files[i].name) == 0) loop = i;
+    Text t;
+    t.init();
+    pray_status st = PRAY_OK;
+    if (!in) st = c->status;
+    else if (loop >= 0)
+        st = include_loop(I, path, loop);
+    else if (!read_program(c, in, &t)) st = c->status;
+    else if (ferror(in)) st = fail(c, PRAY_ERR_IO, "cannot read '%s'", *ShownPath(path));
+    if (in) fclose(in);
+    IncFile nf;
+    nf.name = path;
+    nf.id = id;
+    nf.line = 0;
+    if (st == PRAY_OK && !I.files.push(c, nf)) st = c->status;
+    if (st) {
+        mem_free(c, path);
+        t.a.release(c);
+        if (api_err(I, f->line, f->col) == PRAY_ERR_IO) c->status = PRAY_ERR_RUNTIME;
+        return c->status;
+    }
+    I.files[I.files.n - 2].line = s->line;
+    // a parser of its own, on the program's variables (on the heap: includes nest this function)
+    struct Reader {
+        Arena tree, words;
+        Lexer L;
+        Parser Q;
+    } *r = (Reader *)mem_zalloc(c, sizeof(Reader));
+    if (r) {
+        r->tree.init();
+        r->words.init();
+        r->L.c = c;
+        r->L.name = path;
+        r->L.text = &r->words;
+        r->L.toks.init();
+        r->L.maxstring = I.parser->L->maxstring;
+        r->Q = *I.parser;
+        r->Q.name = path;
+        r->Q.L = &r->L;
+        r->Q.arena = &r->tree;
+        r->Q.included = 1;
+        const char *outer = I.name;
+        I.name = path;
+        double parse_time = 0;
+        st = read_statements(r->Q, t.str(), (size_t)t.a.n, &I, false, &parse_time);
+        if (st == PRAY_OK) {
+            r->tree.reset(c);
+            st = read_statements(r->Q, t.str(), (size_t)t.a.n, &I, true, &parse_time);
+        }
+        c->stats.time_parse += parse_time;
+        I.name = outer;
+        r->L.toks.release(c);
+        r->tree.release(c);
+        r->words.release(c);
+        mem_free(c, r);
+    } else
+        st = api_err(I, f->line, f->col);
+    if (st) include_chain(I);
+    I.files.n--;
+    mem_free(c, path);
+    t.a.release(c);
+    return st;
+#endif
+}
+
 pray_status exec(Interp &I, const Stmt *s) {
     if (step(I, s)) return I.c->status;
     pray_ctx *c = I.c;
     switch (s->kind) {
+    case ST_INCLUDE:
+        if (exec_include(I, s)) include_chain(I);
+        return c->status;
     case ST_ASSIGN: {
         Value v;
         if (eval(I, s->args[0], &v)) return c->status;
@@ -10562,6 +10858,18 @@ pray_status exec(Interp &I, const Stmt *s) {
                 st = api_err(I, s->line, s->col);
             break;
         }
+        case ST_LOOKAT: {
+            static const int types[4] = {V_POINT, V_POINT, V_VECTOR, V_NUM};
+            static const char *const what[4] = {"E", "P", "U", "a"};
+            for (int i = 0; i < 4 && st == PRAY_OK; i++)
+                if (args[i].t != types[i])
+                    st = rerr(I, s->args[i], PRAY_ERR_RUNTIME, "lookat: %s must be a %s, not %s %s", what[i],
+                              TYPE_NAMES[types[i]], args[i].t == V_INTENS || args[i].t == V_OBJECT ? "an" : "a",
+                              TYPE_NAMES[args[i].t]);
+            if (st == PRAY_OK && pray_lookat(c, vec_of(args[0]), vec_of(args[1]), vec_of(args[2]), args[3].v[0]))
+                st = api_err(I, s->line, s->col);
+            break;
+        }
         case ST_OPTION:
             if (args[0].t != V_STRING)
                 st = rerr(I, s->args[0], PRAY_ERR_RUNTIME, "option: the name must be a string, as in option \"width\", 640");
@@ -10609,6 +10917,7 @@ bool note_uses(Interp &I, const Expr *e, int k) {
 }
 bool note_uses(Interp &I, const Stmt *s, int k) {
     if (s->kind == ST_ASSIGN && !note_slot(I, s->slot, k)) return false;
+    if (s->kind == ST_INCLUDE) I.include_last = k;  // an included file may name any variable
     for (int i = 0; i < s->nargs; i++)
         if (!note_uses(I, s->args[i], k)) return false;
     for (int i = 0; i < s->nbody; i++)
@@ -10638,6 +10947,7 @@ bool order_slots(Interp &I) {
         return false;
     }
     for (int i = 0; i < n; i++) {
+        if (I.last[i] < I.include_last) I.last[i] = I.include_last;
         sl[i].last = I.last[i];
         sl[i].slot = i;
     }
@@ -10656,7 +10966,8 @@ bool order_slots(Interp &I) {
 // statement names are noted; with it each statement runs as soon as it is read, and the values
 // of variables that no statement after it names are released. *parse_time: seconds spent
 // reading.
-pray_status read_statements(Parser &P, const char *text, size_t len, Interp *I, bool run, double *parse_time) {
+PRAY_NOINLINE pray_status read_statements(Parser &P, const char *text, size_t len, Interp *I, bool run,
+                                         double *parse_time) {
     pray_ctx *c = P.c;
     int k = 0;  // statements of the top level read so far
     double t0 = clock_seconds();
@@ -10680,7 +10991,7 @@ pray_status read_statements(Parser &P, const char *text, size_t len, Interp *I, 
             st = c->status;
             break;
         }
-        if (!run && !note_uses(*I, s, k)) {
+        if (!run && !P.included && !note_uses(*I, s, k)) {
             st = c->status;
             break;
         }
@@ -10695,10 +11006,12 @@ pray_status read_statements(Parser &P, const char *text, size_t len, Interp *I, 
             }
             double t1 = clock_seconds();
             *parse_time += t1 - t0;
-            I->top = s;
-            I->top_index = k;
+            if (!P.included) {  // (an included file's values are the program's: they live on)
+                I->top = s;
+                I->top_index = k;
+            }
             st = exec(*I, s);
-            if (st == PRAY_OK) release_dead(*I, k);
+            if (st == PRAY_OK && !P.included) release_dead(*I, k);
             t0 = clock_seconds();
             if (I->quit) break;
         }
@@ -10709,14 +11022,18 @@ pray_status read_statements(Parser &P, const char *text, size_t len, Interp *I, 
     if (st && !run && !P.L->failed) {
         // the program is wrong: an error of its characters, anywhere, is the one to report
         // (as when the whole text is lexed first); else this one
+        // (the message is kept off the stack: included files nest this function)
         pray_status first = st;
-        char msg[sizeof c->msg];
-        memcpy(msg, c->msg, sizeof msg);
+        char *msg = mem_strdup(c, c->msg, strlen(c->msg));
         while (!P.L->at_end && lex_line(*P.L) == PRAY_OK) {
         }
-        if (P.L->failed) return c->status;
+        if (P.L->failed) {
+            mem_free(c, msg);
+            return c->status;
+        }
         c->status = first;
-        memcpy(c->msg, msg, sizeof msg);
+        if (msg) snprintf(c->msg, sizeof c->msg, "%s", msg);
+        mem_free(c, msg);
     }
     return st;
 }
@@ -10736,9 +11053,11 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
     Interp I;
     memset(&I, 0, sizeof I);
     I.c = c;
-    I.name = name;
+    I.name = I.prog = name;
     I.vars.init();
     I.vals.init();
+    I.files.init();
+    I.include_last = -1;
     Parser P;
     memset(&P, 0, sizeof P);
     P.c = c;
@@ -10748,13 +11067,21 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
     P.arena = &tree;
     P.names = &names;
     P.vars = &I.vars;
-    P.hash.init();
+    Array<int> hash;
+    hash.init();
+    P.hash = &hash;
+    I.parser = &P;
+    IncFile prog;
+    prog.name = (char *)name;
+    prog.id = c->prog_id;
+    prog.line = 0;
+    pray_status st = I.files.push(c, prog) ? PRAY_OK : c->status;
     // first the whole program is checked, then it is read again and run statement by statement
     double parse_time = 0;
     I.last.init();
     I.order.init();
     I.dropped.init();
-    pray_status st = read_statements(P, text, len, &I, false, &parse_time);
+    if (st == PRAY_OK) st = read_statements(P, text, len, &I, false, &parse_time);
     if (st == PRAY_OK && I.vars.n && (!I.vals.reserve(c, I.vars.n) || !order_slots(I))) st = c->status;
     mem_phase(c, MEM_PARSE);
     if (st == PRAY_OK) {
@@ -10773,7 +11100,8 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
     for (int i = 0; i < I.names.n; i++) mem_free(c, I.names[i].name);
     I.names.release(c);
     I.vars.release(c);
-    P.hash.release(c);
+    hash.release(c);
+    I.files.release(c);
     L.toks.release(c);
     tree.release(c);
     words.release(c);

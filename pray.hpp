@@ -137,17 +137,19 @@ void pray_set_memory_limit(pray_ctx *ctx, size_t bytes);
    ceiling (lowered to it now; a higher value, or 0 where 0 means "no limit", is refused later):
    depth 16, gridmem 64, maxframes 1000, maxline 4096, maxmem 1024, maxnest 64, maxoutput 1024,
    maxpixels 16777216, maxprims 1048576, maxsteps 1000000, maxstring 4096, texmem 64. Texture and
-   font files named by a program are read only from the program's directory (relative names
-   without "..", opened one directory at a time without following any symbolic link; on Windows
-   and DOS links inside the directory are followed); an `output` set by a program must be a plain
-   file name. */
+   font files, and the files of `include`, named by a program are read only from the program's
+   directory (relative names without "..", opened one directory at a time without following any
+   symbolic link; on Windows and DOS links inside the directory are followed); an `output` set by
+   a program must be a plain file name. */
 void pray_set_untrusted(pray_ctx *ctx);
 /* Where `print` writes (default: standard output; NULL fn discards). Called on the calling
    thread, during pray_run_*. */
 void pray_set_print(pray_ctx *ctx, pray_write_fn fn, void *ud);
 /* Where warnings go (default: nowhere; the command-line program writes them to standard error):
    one line each, "name:line:col: warning: message\n". A run warns once when the camera's
-   |X| : |Y| differs from width : height by more than 1 % (the picture would come out stretched). */
+   |X| : |Y| differs from width : height by more than 1 % (the picture would come out stretched),
+   and at every frame whose eye point is inside the object rendered ("the eye is inside the
+   rendered solid"). */
 void pray_set_warning(pray_ctx *ctx, pray_write_fn fn, void *ud);
 /* Progress callback for renders (default none). */
 void pray_set_progress(pray_ctx *ctx, pray_progress_fn fn, void *ud);
@@ -208,10 +210,12 @@ double pray_option_get(const pray_ctx *ctx, const char *name);
    Running PRAY programs.
    ------------------------------------------------------------------------------------------- */
 /* Run a program held in memory. `name` is used in messages, for the default output name (name
-   with its extension replaced by .tif) and as the place beside which texture files are looked for
-   (its directory). `text` need not be NUL-terminated. The whole program is checked before its
-   first statement runs, so a malformed one runs none; it is then read again and run a statement
-   at a time, holding only the current line's tokens and the current statement's tree. */
+   with its extension replaced by .tif) and as the place beside which texture files and the files
+   of `include` are looked for (its directory). `text` need not be NUL-terminated. The whole
+   program is checked before its first statement runs, so a malformed one runs none; it is then
+   read again and run a statement at a time, holding only the current line's tokens and the
+   current statement's tree. A file that `include` names is read whole when the statement runs,
+   checked, and run the same way; without file access (PRAY_NO_STDIO) `include` is an error. */
 pray_status pray_run_string(pray_ctx *ctx, const char *name, const char *text, size_t len);
 /* Run a program file (a regular file; a FIFO, directory or device is refused); "-" reads
    standard input (named "stdin.ray" in messages). Reading stops at the first line longer than
@@ -311,9 +315,13 @@ void pray_light_release(pray_ctx *ctx, pray_light *light);
 void pray_texture_release(pray_ctx *ctx, pray_texture *tex);
 void pray_release(pray_ctx *ctx, void *handle);
 
-/* Camera and background, as the statements of the same names. */
+/* Camera and background, as the statements of the same names. pray_lookat: a perspective
+   camera at `eye` looking at `point`, `up` (not parallel to point - eye) the image's up, `angle`
+   the horizontal field of view in degrees (0 < angle < 180); its X and Y follow from the width
+   and height in force when a frame is rendered, so its pixels are always square. */
 pray_status pray_perspective(pray_ctx *ctx, pray_vec x, pray_vec y, pray_vec eye, pray_vec point);
 pray_status pray_parallel(pray_ctx *ctx, pray_vec x, pray_vec y, pray_vec eye, pray_vec point);
+pray_status pray_lookat(pray_ctx *ctx, pray_vec eye, pray_vec point, pray_vec up, double angle);
 pray_status pray_background(pray_ctx *ctx, pray_rgb top, pray_rgb bottom);
 
 /* ---------------------------------------------------------------------------------------------

@@ -79,6 +79,7 @@ TEST_CASE("api: every function takes a NULL context and returns its error value"
     CHECK(pray_pointlight(nullptr, WHITE, ONE) == nullptr);
     CHECK(pray_perspective(nullptr, ONE, UP, ONE, ORIGIN) == PRAY_ERR_ARG);
     CHECK(pray_parallel(nullptr, ONE, UP, ONE, ORIGIN) == PRAY_ERR_ARG);
+    CHECK(pray_lookat(nullptr, ONE, ORIGIN, UP, 40) == PRAY_ERR_ARG);
     CHECK(pray_background(nullptr, GREY, GREY) == PRAY_ERR_ARG);
     CHECK(pray_render(nullptr, nullptr, nullptr, &img) == PRAY_ERR_ARG);
     CHECK((img.width == 0 && img.height == 0 && img.pixels == nullptr));  // out is always emptied

@@ -561,5 +561,9 @@ TEST_CASE("PRAY_NO_STDIO: registered textures work without file access") {
     testkit::Result r2 = run_in(c, texture_program("unregistered.tif"));
     CHECK(r2.status == PRAY_ERR_RUNTIME);
     CHECK(contains(r2.error, "this build has no file access"));
+    // include reads a file: an error at the statement, after what ran before it
+    testkit::Result r3 = run_in(c, "x = 1\ninclude \"part.ray\"\n");
+    CHECK(r3.status == PRAY_ERR_RUNTIME);
+    CHECK(r3.error == "scene.ray:2:9: error: include: this build has no file access");
 }
 #endif

@@ -85,6 +85,7 @@ examples/maketex.ray|The textures
 examples/glass.ray|Glass
 examples/mirror.ray|Mirror
 examples/parallel.ray|Parallel camera
+examples/street.ray|A street (lookat, include)
 examples/holes.ray|Holes
 examples/loop.ray|Loops
 examples/models.ray|Lighting models

@@ -10,10 +10,11 @@
 #                                     does now (never overwrites; read every new file before
 #                                     committing it: a wrong message is a defect, not a result)
 #
-# Each case runs in an empty temporary directory holding only a copy of its .ray file, with that
-# file on standard input and the arguments `-s 8x8 -o out.ppm NNN-name.ray`, or those of
-# NNN-name.args (one line of words; @RAY@ stands for the case's file name). Messages therefore
-# name the file as `NNN-name.ray`. Standard output is ignored.
+# Each case runs in an empty temporary directory holding only a copy of its .ray file (and of its
+# files NNN-name.*.inc, which it may include), with that file on standard input and the arguments
+# `-s 8x8 -o out.ppm NNN-name.ray`, or those of NNN-name.args (one line of words; @RAY@ stands
+# for the case's file name). Messages therefore name the file as `NNN-name.ray`. Standard output
+# is ignored.
 # Needs only a POSIX shell; `timeout` is used when present (a case may take TIMEOUT seconds).
 
 here=$(cd "$(dirname "$0")" && pwd)
@@ -51,6 +52,9 @@ for ray in [0-9]*.ray; do
     rm -rf "$tmp/run"
     mkdir "$tmp/run"
     cp "$here/$ray" "$tmp/run/$ray"
+    for inc in "$here/$case".*.inc; do
+        [ -f "$inc" ] && cp "$inc" "$tmp/run/"
+    done
     # The arguments are plain words: split them, without globbing.
     set -f
     (cd "$tmp/run" && $limit "$PRAY" $args <"$ray" >/dev/null 2>"$tmp/stderr")
@@ -79,7 +83,7 @@ for ray in [0-9]*.ray; do
         why="${why:+$why; }standard error differs"
     fi
     if [ "$exp_rc" != 0 ]; then
-        left=$(cd "$tmp/run" && ls -A | grep -v -x -F "$ray")
+        left=$(cd "$tmp/run" && ls -A | grep -v -x -F "$ray" | grep -v -x "$case\..*\.inc")
         [ -n "$left" ] && why="${why:+$why; }left files behind: $(echo $left)"
     fi
     if [ -z "$why" ]; then

@@ -87,11 +87,22 @@ void broken(const char *what, pray_status st, const char *msg) {
     abort();
 }
 
-// "DIR/fuzz.ray:" digits ":" digits ": error: "
+// "DIR/fuzz.ray:" digits ":" digits ": error: ", or the same with the name of a file the program
+// included (any name: an include may name an absolute path)
 bool has_place(const char *m) {
     std::string p = program + ":";
-    if (strncmp(m, p.c_str(), p.size()) != 0) return false;
-    m += p.size();
+    if (strncmp(m, p.c_str(), p.size()) == 0) m += p.size();
+    else {
+        const char *e = strstr(m, ": error: ");
+        if (!e || e == m) return false;
+        const char *q = e;  // back over ":digits:digits"
+        for (int part = 0; part < 2; part++) {
+            while (q > m && q[-1] >= '0' && q[-1] <= '9') q--;
+            if (q == m || *--q != ':') return false;
+        }
+        if (q == m) return false;
+        m = q + 1;
+    }
     for (int part = 0; part < 2; part++) {
         if (*m < '0' || *m > '9') return false;
         while (*m >= '0' && *m <= '9') m++;
@@ -135,7 +146,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         if (!strstr(msg, "error: ")) broken("a message without 'error: '", st, msg);
         // Syntax and runtime errors are errors of the program: they name the place.
         if ((st == PRAY_ERR_SYNTAX || st == PRAY_ERR_RUNTIME) && !has_place(msg))
-            broken("a program error without DIR/fuzz.ray:line:col", st, msg);
+            broken("a program error without NAME:line:col", st, msg);
     }
     if (pray_frames(c) < 0) broken("negative frame count", st, msg);
     pray_free(c);
