@@ -2558,12 +2558,15 @@ struct Cross {
 };
 
 // Image sequences (10b): while a pixel is traced, the regions of space its rays cross are set in
-// its record, bits over a coarse grid of cells in a box of the world; bit 0 stands for all
-// that lies outside the box.
-struct Regions {
+// its record: bits over the cells of a grid over the scene's finite parts, then over the cells
+// of a coarse grid around it, for what lies outside the first, and bit 0 for all beyond both.
+struct RegionGrid {
     double lo[3], hi[3], h[3];  // the box, and the sides of a cell
-    int n;                      // cells along each axis
-    int words;                  // unsigned words of a record (1 + n^3 bits)
+    int n, base;                // cells along each axis; the bit of the first
+};
+struct Regions {
+    RegionGrid g[2];  // the fine grid, and the coarse one around it
+    int words;        // unsigned words of a record
 };
 
 struct Counters {
@@ -5124,19 +5127,11 @@ bool drive_lists(const Scene *s, Scratch *w, const Ray &ray, real tmax, const So
     return tb < tmax && out(A->outer, tb, tmax);
 }
 
-// Image sequences (10b): set in the record of the pixel being traced the regions that the
-// part (0, end] of the ray crosses, cell by cell (Amanatides and Woo's walk), and bit 0 when
-// some of it lies outside the regions' box. A walk rounded past a corner of cells misses a
-// sliver of a cell there; the boxes of what changed are widened by more than that (coh_mark).
-void region_note(Scratch *w, const Ray &ray, real end) {
-    const Regions &g = *w->rg;
-    unsigned *bits = w->rbits;
-    double o[3] = {(double)ray.o.x, (double)ray.o.y, (double)ray.o.z};
-    double d[3] = {(double)ray.d.x, (double)ray.d.y, (double)ray.d.z};
-    double ta = 0, tb = (double)end;
+// The part [*ta, *tb] of the ray inside the grid's box; false when none.
+bool region_clip(const RegionGrid &g, const double *o, const double *d, double *ta, double *tb) {
     for (int a = 0; a < 3; a++) {
         if (d[a] == 0) {
-            if (o[a] < g.lo[a] || o[a] > g.hi[a]) ta = HUGE_VAL;
+            if (o[a] < g.lo[a] || o[a] > g.hi[a]) return false;
             continue;
         }
         double t0 = (g.lo[a] - o[a]) / d[a], t1 = (g.hi[a] - o[a]) / d[a];
@@ -5145,11 +5140,15 @@ void region_note(Scratch *w, const Ray &ray, real end) {
             t0 = t1;
             t1 = x;
         }
-        if (t0 > ta) ta = t0;
-        if (t1 < tb) tb = t1;
+        if (t0 > *ta) *ta = t0;
+        if (t1 < *tb) *tb = t1;
     }
-    if (ta > 0 || tb < (double)end) bits[0] |= 1u;  // (also when the ray misses the box)
-    if (!(ta <= tb)) return;
+    return *ta <= *tb;
+}
+
+// Set the bits of the grid's cells that the part [ta, tb] (inside its box) of the ray crosses,
+// cell by cell (Amanatides and Woo's walk).
+void region_walk(const RegionGrid &g, const double *o, const double *d, double ta, double tb, unsigned *bits) {
     int n = g.n, c[3], step[3];
     double next[3], delta[3];
     for (int a = 0; a < 3; a++) {
@@ -5160,7 +5159,7 @@ void region_note(Scratch *w, const Ray &ray, real end) {
         delta[a] = step[a] ? g.h[a] / fabs(d[a]) : 0;
     }
     for (;;) {
-        int id = 1 + c[0] + n * (c[1] + n * c[2]);
+        int id = g.base + c[0] + n * (c[1] + n * c[2]);
         bits[id >> 5] |= 1u << (id & 31);
         int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
         if (!(next[a] <= tb)) break;
@@ -5168,6 +5167,31 @@ void region_note(Scratch *w, const Ray &ray, real end) {
         if (c[a] < 0 || c[a] >= n) break;
         next[a] += delta[a];
     }
+}
+
+// Image sequences (10b): set in the record of the pixel being traced the regions that the
+// part (0, end] of the ray crosses: the fine grid's cells where it is in the fine grid's box,
+// the coarse grid's cells where it is in the coarse grid's box only, and bit 0 where it is
+// outside both. A walk rounded past a corner of cells misses a sliver of a cell there; the boxes
+// of what changed are widened by more than that (coh_mark).
+void region_note(Scratch *w, const Ray &ray, real end) {
+    const Regions &R = *w->rg;
+    unsigned *bits = w->rbits;
+    double o[3] = {(double)ray.o.x, (double)ray.o.y, (double)ray.o.z};
+    double d[3] = {(double)ray.d.x, (double)ray.d.y, (double)ray.d.z};
+    double a1 = 0, b1 = (double)end, a0, b0;
+    bool in1 = region_clip(R.g[1], o, d, &a1, &b1);
+    if (!in1 || a1 > 0 || b1 < (double)end) bits[0] |= 1u;
+    if (!in1) return;
+    a0 = a1;
+    b0 = b1;
+    if (!region_clip(R.g[0], o, d, &a0, &b0)) {
+        region_walk(R.g[1], o, d, a1, b1, bits);
+        return;
+    }
+    region_walk(R.g[0], o, d, a0, b0, bits);
+    if (a1 < a0) region_walk(R.g[1], o, d, a1, a0, bits);
+    if (b0 < b1) region_walk(R.g[1], o, d, b0, b1, bits);
 }
 
 // The one way a ray reaches the accelerated scene (drive_lists); a pixel being traced for an
@@ -7279,31 +7303,39 @@ bool elem_same(pray_ctx *c, CohDiff &d, int a, int b) {
     return true;
 }
 
-// The cells of the regions that box b within box `clip`, widened by an eighth of a cell and by
-// rounding, reaches; bit 0 when it reaches out of the regions' box. An empty box is nothing.
-void coh_mark(const Regions &g, unsigned *dirty, const Box &box, const Box &clip) {
-    Box b = box;
-    box_clip(&b, clip);
-    if (box_empty(b)) return;
+// The cells of grid g that box b (widened by eps) reaches, set in `dirty`; false when b
+// reaches out of the grid's box.
+bool grid_mark(const RegionGrid &g, unsigned *dirty, const Box &b, const double *eps) {
     int lo[3], hi[3];
-    bool out = false, none = false;
+    bool inside = true, none = false;
     for (int a = 0; a < 3; a++) {
-        double eps = g.h[a] / 8 + 1024 * REAL_EPS * (fabs(g.lo[a]) + fabs(g.hi[a]));
-        double l = (double)b.lo[a] - eps, u = (double)b.hi[a] + eps;
-        if (l < g.lo[a] || u > g.hi[a]) out = true;
+        double l = (double)b.lo[a] - eps[a], u = (double)b.hi[a] + eps[a];
+        if (l < g.lo[a] || u > g.hi[a]) inside = false;
         if (u < g.lo[a] || l > g.hi[a]) none = true;
         double fl = floor((l - g.lo[a]) / g.h[a]), fu = floor((u - g.lo[a]) / g.h[a]);
         lo[a] = fl < 0 ? 0 : fl >= g.n ? g.n - 1 : (int)fl;
         hi[a] = fu < 0 ? 0 : fu >= g.n ? g.n - 1 : (int)fu;
     }
-    if (out) dirty[0] |= 1u;
-    if (none) return;
-    for (int z = lo[2]; z <= hi[2]; z++)
+    for (int z = lo[2]; z <= hi[2] && !none; z++)
         for (int y = lo[1]; y <= hi[1]; y++)
             for (int x = lo[0]; x <= hi[0]; x++) {
-                int id = 1 + x + g.n * (y + g.n * z);
+                int id = g.base + x + g.n * (y + g.n * z);
                 dirty[id >> 5] |= 1u << (id & 31);
             }
+    return inside;
+}
+
+// Mark the regions that box b within box `clip` reaches (an empty box is nothing): the fine
+// grid's cells, the coarse grid's when it reaches out of the fine grid's box, and bit 0 when
+// out of the coarse grid's box. The box is widened by an eighth of a fine cell and by rounding.
+void coh_mark(const Regions &R, unsigned *dirty, const Box &box, const Box &clip) {
+    Box b = box;
+    box_clip(&b, clip);
+    if (box_empty(b)) return;
+    double eps[3];
+    for (int a = 0; a < 3; a++)
+        eps[a] = R.g[0].h[a] / 8 + 1024 * REAL_EPS * (fabs(R.g[1].lo[a]) + fabs(R.g[1].hi[a]));
+    if (!grid_mark(R.g[0], dirty, b, eps) && !grid_mark(R.g[1], dirty, b, eps)) dirty[0] |= 1u;
 }
 
 inline const Box *elem_box_or_all(const Scene *s, int e, Box *all) {
@@ -7426,25 +7458,32 @@ Box finite_hull(const Scene *s) {
     return h;
 }
 
-// Regions over box b grown on every side by its size (by half the largest side at least), as
-// many cells as the budget COH_BYTES gives `units` records; false when fewer than 4 a side.
-bool coh_regions(Regions *g, Box b, size_t units) {
+// Regions around box b: the fine grid over b (grown by a thirty-second of its largest side),
+// as many cells as the budget COH_BYTES gives `units` records (false when fewer than 4 a
+// side); the coarse grid of 4 cells a side over b grown on every side by its size (by half its
+// largest side at least).
+bool coh_regions(Regions *R, Box b, size_t units) {
     if (box_empty(b))
         for (int l = 0; l < 3; l++) b.lo[l] = -1, b.hi[l] = 1;
     double m = 0;
     for (int l = 0; l < 3; l++) m = (double)b.hi[l] - b.lo[l] > m ? (double)b.hi[l] - b.lo[l] : m;
     if (!(m > 0)) m = 1;
+    const int COARSE = 4, BASE = 1 + COARSE * COARSE * COARSE;
     int n = COH_CELLS;
-    while (n >= 4 && (double)units * ((1 + n * n * n + 31) / 32) * sizeof(unsigned) > COH_BYTES) n--;
+    while (n >= 4 && (double)units * ((BASE + n * n * n + 31) / 32) * sizeof(unsigned) > COH_BYTES) n--;
     if (n < 4) return false;
-    g->n = n;
-    g->words = (1 + n * n * n + 31) / 32;
-    for (int l = 0; l < 3; l++) {
-        double e = (double)b.hi[l] - b.lo[l], grow = e > m / 2 ? e : m / 2;
-        g->lo[l] = (double)b.lo[l] - grow;
-        g->hi[l] = (double)b.hi[l] + grow;
-        g->h[l] = (g->hi[l] - g->lo[l]) / n;
-        if (!(g->h[l] > 0) || !finite_num(g->h[l])) return false;
+    R->words = (BASE + n * n * n + 31) / 32;
+    for (int k = 0; k < 2; k++) {
+        RegionGrid &g = R->g[k];
+        g.n = k ? COARSE : n;
+        g.base = k ? 1 : BASE;
+        for (int l = 0; l < 3; l++) {
+            double e = (double)b.hi[l] - b.lo[l], grow = k ? (e > m / 2 ? e : m / 2) : m / 32;
+            g.lo[l] = (double)b.lo[l] - grow;
+            g.hi[l] = (double)b.hi[l] + grow;
+            g.h[l] = (g.hi[l] - g.lo[l]) / g.n;
+            if (!(g.h[l] > 0) || !finite_num(g.h[l])) return false;
+        }
     }
     return true;
 }
@@ -7497,9 +7536,17 @@ void coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
         }
     }
     mem_free(c, dirty);
-    if (h && !plan->redo) {  // traced in full: the cells chosen for this frame and the one before
-        Box b = finite_hull(s);
-        if (h->valid) box_hull(&b, h->hull);
+    if (h && !plan->redo) {  // traced in full: cells for this frame, the one before and the next
+        Box b = finite_hull(s), cur = b;
+        if (h->valid && !box_empty(h->hull) && !box_empty(cur)) {  // (where things go on moving)
+            Box next;
+            for (int l = 0; l < 3; l++) {
+                next.lo[l] = 2 * cur.lo[l] - h->hull.lo[l];
+                next.hi[l] = 2 * cur.hi[l] - h->hull.hi[l];
+            }
+            box_hull(&b, h->hull);
+            if (!box_empty(next) && box_finite(next)) box_hull(&b, next);
+        }
         Regions g;
         bool ok = coh_regions(&g, b, units);
         if (ok && (!h->rec || h->units != units || g.words != h->rg.words)) {
