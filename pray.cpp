@@ -7150,14 +7150,17 @@ const double COH_BYTES = 64.0 * 1048576;  // the records of a frame at most
 const int COH_CELLS = 16;                 // cells along an axis at most (4 at least)
 
 struct Coherence {
-    int valid;        // `prev`, `rec` and `img` are the last frame's
+    int valid;        // `prev`, `opt` and `hull` are the last frame's
     Scene prev;       // its prepared scene, without the acceleration structure
     Options opt;      // its options
+    Box hull;         // the box of its finite parts
+    int recorded;     // `rec` and `img` are the last frame's too
     Regions rg;       // the cells its records are made of
     unsigned *rec;    // units x rg.words
     size_t units;     // pixels, or with undersampling bands
     float *img;       // its pixels, RGB
-    Box hull;         // the box of its finite parts
+    size_t imgsize;   // floats at img
+    int misses, wait; // frames in a row traced in vain; frames not to record yet (coh_plan)
 };
 
 void coh_release(pray_ctx *c) {
@@ -7488,9 +7491,16 @@ bool coh_regions(Regions *R, Box b, size_t units) {
     return true;
 }
 
-// The plan of a program's frame (CohPlan) with the frame before, when there is one; the cells
-// are chosen anew for a frame traced in full. Never fails: what cannot be had (memory within
-// the caps, a budget the image is too large for) is a frame traced in full, or not recorded.
+// The plan of a program's frame (CohPlan). A frame like the one before in all but its scene
+// takes over from it when that one was recorded and no more than half of its units must be
+// traced again; else it is traced in full, and recorded when the frame before was like it, so
+// that a program's single frame, and frames whose camera moves, are never recorded. When
+// most of a frame had to be traced again, the next 1, 3, 7 or 15 frames are not recorded (the
+// more, the more often that happened in a row), so that an animation in which everything moves
+// pays for a recording now and then only. A recorded frame traced in full gets new cells, over
+// this frame, the one before and where things go on moving. Never fails: what cannot be had
+// (memory within the caps, a budget the image is too large for) is a frame traced in full and
+// not recorded.
 void coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
     memset(plan, 0, sizeof *plan);
     pray_status st0 = c->status;
@@ -7498,16 +7508,22 @@ void coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
     memcpy(msg0, c->msg, sizeof msg0);
     Coherence *h = c->coh;
     if (!h) h = c->coh = (Coherence *)mem_zalloc(c, sizeof(Coherence));
+    if (!h) {
+        c->status = st0;
+        memcpy(c->msg, msg0, sizeof msg0);
+        return;
+    }
     size_t units = (size_t)s->width * s->height;
     if (c->cur.opt.v[OPT_ADAPTIVE] > 0) {
         int rows = band_rows_of(c, s, true);
         units = (size_t)((s->height + rows - 1) / rows);
     }
     Options o = c->cur.opt;
-    if (h) o.v[OPT_THREADS] = h->opt.v[OPT_THREADS];  // (the image does not depend on them)
-    bool reuse = h && h->valid && h->units == units && same_bytes(o.v, h->opt.v, sizeof o.v) &&
-                 coh_same_view(&h->prev, s);
-    unsigned *dirty = reuse ? (unsigned *)mem_zalloc(c, sizeof(unsigned) * (size_t)h->rg.words) : NULL;
+    o.v[OPT_THREADS] = h->opt.v[OPT_THREADS];  // (the image does not depend on them)
+    bool same = h->valid && same_bytes(o.v, h->opt.v, sizeof o.v) && coh_same_view(&h->prev, s);
+    bool tried = same && h->recorded && h->units == units;
+    unsigned *dirty = tried ? (unsigned *)mem_zalloc(c, sizeof(unsigned) * 2 * (size_t)h->rg.words) : NULL;
+    bool reuse = false;
     if (dirty) {
         CohDiff d;
         d.s[0] = &h->prev;
@@ -7518,27 +7534,38 @@ void coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
         if (ix0) scene_ix_free(c, &d.x[0]);
         if (ix1) scene_ix_free(c, &d.x[1]);
         d.pairs.release(c);
-    } else reuse = false;
+    }
     if (reuse) plan->redo = (unsigned char *)mem_alloc(c, units);
     if (plan->redo) {  // a unit is traced again when its record meets a cell marked
         size_t again = 0;
-        int nw = h->rg.words;
+        int nw = h->rg.words, nd = 0;
+        for (int k = 0; k < nw; k++)  // (the words marked, in place at the front)
+            if (dirty[k]) dirty[nd] = dirty[k], dirty[nw + nd++] = (unsigned)k;
         for (size_t u = 0; u < units; u++) {
             const unsigned *r = h->rec + u * (size_t)nw;
             unsigned any = 0;
-            for (int k = 0; k < nw; k++) any |= r[k] & dirty[k];
+            for (int k = 0; k < nd && !any; k++) any = r[dirty[nw + k]] & dirty[k];
             plan->redo[u] = any != 0;
             again += any != 0;
         }
-        if (2 * again > units) {  // most of it: traced in full, and the cells chosen anew
+        if (2 * again > units) {  // most of it: traced in full
             mem_free(c, plan->redo);
             plan->redo = NULL;
         }
     }
     mem_free(c, dirty);
-    if (h && !plan->redo) {  // traced in full: cells for this frame, the one before and the next
+    bool record = plan->redo != NULL;
+    if (plan->redo) h->misses = 0;
+    else if (tried) {  // in vain: not recorded for a while
+        h->misses = h->misses < 4 ? h->misses + 1 : 4;
+        h->wait = (1 << h->misses) - 1;
+    } else if (same) {
+        record = h->wait == 0;
+        h->wait -= h->wait > 0;
+    } else h->wait = 0;
+    if (record && !plan->redo) {  // new cells: this frame, the one before and the next
         Box b = finite_hull(s), cur = b;
-        if (h->valid && !box_empty(h->hull) && !box_empty(cur)) {  // (where things go on moving)
+        if (h->valid && !box_empty(h->hull) && !box_empty(cur)) {
             Box next;
             for (int l = 0; l < 3; l++) {
                 next.lo[l] = 2 * cur.lo[l] - h->hull.lo[l];
@@ -7548,52 +7575,49 @@ void coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
             if (!box_empty(next) && box_finite(next)) box_hull(&b, next);
         }
         Regions g;
-        bool ok = coh_regions(&g, b, units);
-        if (ok && (!h->rec || h->units != units || g.words != h->rg.words)) {
+        record = coh_regions(&g, b, units);
+        if (record && (!h->rec || h->units != units || g.words != h->rg.words)) {
             mem_free(c, h->rec);
             h->rec = (unsigned *)mem_alloc(c, sizeof(unsigned) * (size_t)g.words * units);
         }
         h->rg = g;
         h->units = units;
-        if (!ok || !h->rec) {
-            mem_free(c, h->rec);
-            h->rec = NULL;
-        }
+        record = record && h->rec;
     }
     if (c->status != st0) {  // out of memory somewhere: traced in full, not recorded
         c->status = st0;
         memcpy(c->msg, msg0, sizeof msg0);
         mem_free(c, plan->redo);
         memset(plan, 0, sizeof *plan);
-        coh_release(c);
-        return;
+        record = false;
     }
-    if (!h || !h->rec) return;
+    h->recorded = 0;  // (until coh_keep)
+    if (!record) return;
     plan->rec = h->rec;
     plan->rg = &h->rg;
     plan->prev = plan->redo ? h->img : NULL;
 }
 
-// After a frame rendered with records: keep its scene (taken from *s, without its acceleration
-// structure), options and pixels for the next.
-void coh_keep(pray_ctx *c, Scene *s, const float *img) {
+// After a program's frame: keep its scene (taken from *s, without its acceleration structure)
+// and options for the next, and its pixels when it was recorded.
+void coh_keep(pray_ctx *c, Scene *s, const float *img, bool recorded) {
     Coherence *h = c->coh;
-    if (!h || !h->rec) return;
+    if (!h) return;
     size_t n = (size_t)s->width * s->height * 3;
-    if (!h->img || !h->valid || h->prev.width != s->width || h->prev.height != s->height) {
+    if (recorded && (!h->img || h->imgsize != n)) {
         pray_status st0 = c->status;
         char msg0[sizeof c->msg];
         memcpy(msg0, c->msg, sizeof msg0);
         mem_free(c, h->img);
         h->img = (float *)mem_alloc(c, sizeof(float) * n);
+        h->imgsize = h->img ? n : 0;
         if (!h->img) {  // the next frame is traced in full
             c->status = st0;
             memcpy(c->msg, msg0, sizeof msg0);
-            coh_release(c);
-            return;
+            recorded = false;
         }
     }
-    memcpy(h->img, img, sizeof(float) * n);
+    if (recorded) memcpy(h->img, img, sizeof(float) * n);
     if (h->valid) scene_release(c, &h->prev);
     h->hull = finite_hull(s);
     accel_release(c, s->accel);
@@ -7607,8 +7631,8 @@ void coh_keep(pray_ctx *c, Scene *s, const float *img) {
     s->kids.init();
     h->opt = c->cur.opt;
     h->valid = 1;
+    h->recorded = recorded;
 }
-
 } // namespace
 
 // =============================================================================================
@@ -8748,7 +8772,7 @@ pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, cons
         else coh_release(c);
         st = render_scene(c, &s, r, out, &plan);
         mem_free(c, plan.redo);
-        if (st == PRAY_OK && plan.rec) coh_keep(c, &s, out.rgb);
+        if (st == PRAY_OK && coh) coh_keep(c, &s, out.rgb, plan.rec != NULL);
         else coh_release(c);
     }
     c->stats.time_prepare += t1 - t0;
@@ -11617,6 +11641,23 @@ void print_stats(pray_ctx *c) {
                 s.frames_coherent, pray_frames(c), s.pixels_reused, s.pixels_retraced);
 }
 
+// --stats: a line per frame of a program, before it is written: its time and the pixels it took
+// over from the frame before (option coherence).
+struct FrameLog {
+    pray_ctx *c;
+    pray_stats last;
+};
+pray_status log_frame(void *ud, const pray_image *img, const char *name) {
+    FrameLog *g = (FrameLog *)ud;
+    pray_stats s;
+    pray_stats_get(g->c, &s);
+    fprintf(stderr, "frame %s: prepare %.3f s, render %.3f s; pixels reused %.0f of %.0f\n", name,
+            s.time_prepare - g->last.time_prepare, s.time_render - g->last.time_render,
+            s.pixels_reused - g->last.pixels_reused, (double)img->width * img->height);
+    g->last = s;
+    return pray_write_image(g->c, img, name, (int)pray_option_get(g->c, "bits"));
+}
+
 // ---- parts of a render: --rows, --part, --frames (docs/distributed.md) ----
 // A row part is an image file of rows A to B-1 whose note (TIFF ImageDescription, PPM comment)
 // says where they belong: "pray-part rows=A:B height=H frame=F id=X". X tells the renders apart:
@@ -12124,6 +12165,10 @@ int main(int argc, char **argv) {
         render_id(sp.id, program, argc, argv);
         pray_set_frame(c, write_part, &sp);
     }
+    FrameLog flog;
+    memset(&flog, 0, sizeof flog);
+    flog.c = c;
+    if (stats && !sp.row1 && !sp.n) pray_set_frame(c, log_frame, &flog);
     the_ctx = c;
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
