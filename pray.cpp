@@ -6613,6 +6613,14 @@ struct Sample {
 
 struct Job;
 
+// Image sequences (10b): a frame's records are of every unit of the image, or of a sample of
+// them (every 8th pixel of every 8th row; every 4th band with undersampling) that tells the
+// next frame whether recording all is worth it.
+enum { COH_NONE, COH_ALL, COH_SAMPLE };
+inline bool coh_sampled(size_t u, int width, bool bands) {
+    return bands ? u % 4 == 0 : (u % (size_t)width) % 8 == 0 && (u / (size_t)width) % 8 == 0;
+}
+
 struct Worker {
     Job *job;
     Scratch w;
@@ -6642,6 +6650,7 @@ struct Job {
     unsigned *rec;
     const Regions *rg;
     const float *prev;
+    int sample;  // only the sample's records are kept (coh_sampled)
 };
 
 // Image sequences (10b): unit u of the image (a pixel; a band with undersampling) is taken over
@@ -6650,6 +6659,8 @@ bool unit_kept(Worker &k, size_t u) {
     const Job *job = k.job;
     if (job->redo && !job->redo[u]) return true;
     if (job->rec) {
+        k.w.rbits = NULL;
+        if (job->sample && !coh_sampled(u, job->s->width, job->adaptive > 0)) return false;
         k.w.rbits = job->rec + u * (size_t)job->rg->words;
         memset(k.w.rbits, 0, sizeof(unsigned) * (size_t)job->rg->words);
     }
@@ -7036,6 +7047,8 @@ struct CohPlan {
     unsigned *rec;
     const Regions *rg;
     const float *prev;
+    int sample;  // only a sample of the units is recorded (coh_sampled)
+    int record;  // what is recorded: COH_NONE, COH_ALL, COH_SAMPLE (10b)
 };
 
 // The rows of a band of the render driver: a band of tiles with undersampling.
@@ -7068,6 +7081,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         job.rec = plan->rec;
         job.rg = plan->rg;
         job.prev = plan->prev;
+        job.sample = plan->sample;
     }
     for (int i = 0; job.adaptive > 0 && i < s->prims.n; i++)  // undersampling looks into textures
         if (!model_pyramids(c, (pray_model *)s->prims[i].mat)) return c->status;  // (marks the parts done)
@@ -7119,7 +7133,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         c->stats.rays_lightbuf += k.lbuf;
         c->stats.rays_eyebuf += k.ebuf;
         c->stats.rays_shadowcache += k.cache;
-        if (job.rec) {
+        if (job.redo) {
             c->stats.pixels_reused += worker_at(wbuf, stride, i).kept;
             c->stats.pixels_retraced += worker_at(wbuf, stride, i).traced;
         }
@@ -7154,13 +7168,12 @@ struct Coherence {
     Scene prev;       // its prepared scene, without the acceleration structure
     Options opt;      // its options
     Box hull;         // the box of its finite parts
-    int recorded;     // `rec` and `img` are the last frame's too
+    int recorded;     // `rec` and `img` are the last frame's too: COH_ALL or COH_SAMPLE
     Regions rg;       // the cells its records are made of
     unsigned *rec;    // units x rg.words
     size_t units;     // pixels, or with undersampling bands
     float *img;       // its pixels, RGB
     size_t imgsize;   // floats at img
-    int misses, wait; // frames in a row traced in vain; frames not to record yet (coh_plan)
 };
 
 void coh_release(pray_ctx *c) {
@@ -7461,11 +7474,11 @@ Box finite_hull(const Scene *s) {
     return h;
 }
 
-// Regions around box b: the fine grid over b (grown by a thirty-second of its largest side),
-// as many cells as the budget COH_BYTES gives `units` records (false when fewer than 4 a
-// side); the coarse grid of 4 cells a side over b grown on every side by its size (by half its
-// largest side at least).
-bool coh_regions(Regions *R, Box b, size_t units) {
+// Regions around box b: the fine grid over b grown by `slack` times its largest side, as many
+// cells as the budget COH_BYTES gives `units` records (false when fewer than 4 a side); the
+// coarse grid of 4 cells a side over b grown on every side by its size (by half its largest
+// side at least).
+bool coh_regions(Regions *R, Box b, size_t units, double slack) {
     if (box_empty(b))
         for (int l = 0; l < 3; l++) b.lo[l] = -1, b.hi[l] = 1;
     double m = 0;
@@ -7481,7 +7494,7 @@ bool coh_regions(Regions *R, Box b, size_t units) {
         g.n = k ? COARSE : n;
         g.base = k ? 1 : BASE;
         for (int l = 0; l < 3; l++) {
-            double e = (double)b.hi[l] - b.lo[l], grow = k ? (e > m / 2 ? e : m / 2) : m / 32;
+            double e = (double)b.hi[l] - b.lo[l], grow = k ? (e > m / 2 ? e : m / 2) : m * slack;
             g.lo[l] = (double)b.lo[l] - grow;
             g.hi[l] = (double)b.hi[l] + grow;
             g.h[l] = (g.hi[l] - g.lo[l]) / g.n;
@@ -7492,15 +7505,16 @@ bool coh_regions(Regions *R, Box b, size_t units) {
 }
 
 // The plan of a program's frame (CohPlan). A frame like the one before in all but its scene
-// takes over from it when that one was recorded and no more than half of its units must be
-// traced again; else it is traced in full, and recorded when the frame before was like it, so
-// that a program's single frame, and frames whose camera moves, are never recorded. When
-// most of a frame had to be traced again, the next 1, 3, 7 or 15 frames are not recorded (the
-// more, the more often that happened in a row), so that an animation in which everything moves
-// pays for a recording now and then only. A recorded frame traced in full gets new cells, over
-// this frame, the one before and where things go on moving. Never fails: what cannot be had
-// (memory within the caps, a budget the image is too large for) is a frame traced in full and
-// not recorded.
+// (the same camera, lights, image and options) compares the two scenes (coh_diff). When the
+// one before has records of every unit and no more than half of them meet what changed, the
+// frame takes the others over, and traces and records those. Else it is traced in full, and
+// recorded in full when the sample of the records of the frame before says that no more than
+// half of a frame would be traced again; otherwise (and in a frame unlike the one before) only
+// the sample is recorded, at a cost of a per cent or two of its rays. So an animation in which
+// everything moves, or the camera, and a program's single frame are never recorded in full.
+// A frame traced in full gets new cells, over this frame, the one before and where things go
+// on moving. Never fails: what cannot be had (memory within the caps, a budget the image is
+// too large for) is a frame traced in full and not recorded.
 void coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
     memset(plan, 0, sizeof *plan);
     pray_status st0 = c->status;
@@ -7513,57 +7527,54 @@ void coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
         memcpy(c->msg, msg0, sizeof msg0);
         return;
     }
+    bool bands = c->cur.opt.v[OPT_ADAPTIVE] > 0;
     size_t units = (size_t)s->width * s->height;
-    if (c->cur.opt.v[OPT_ADAPTIVE] > 0) {
+    if (bands) {
         int rows = band_rows_of(c, s, true);
         units = (size_t)((s->height + rows - 1) / rows);
     }
     Options o = c->cur.opt;
     o.v[OPT_THREADS] = h->opt.v[OPT_THREADS];  // (the image does not depend on them)
     bool same = h->valid && same_bytes(o.v, h->opt.v, sizeof o.v) && coh_same_view(&h->prev, s);
-    bool tried = same && h->recorded && h->units == units;
+    bool tried = same && h->recorded != COH_NONE && h->units == units;
     unsigned *dirty = tried ? (unsigned *)mem_zalloc(c, sizeof(unsigned) * 2 * (size_t)h->rg.words) : NULL;
-    bool reuse = false;
+    bool known = false;  // where the frames differ
     if (dirty) {
         CohDiff d;
         d.s[0] = &h->prev;
         d.s[1] = s;
         d.pairs.init();
         bool ix0 = scene_ix(c, d.s[0], &d.x[0]), ix1 = ix0 && scene_ix(c, s, &d.x[1]);
-        reuse = ix1 && coh_diff(c, d, h->rg, dirty) && coh_twins(d);
+        known = ix1 && coh_diff(c, d, h->rg, dirty) && coh_twins(d);
         if (ix0) scene_ix_free(c, &d.x[0]);
         if (ix1) scene_ix_free(c, &d.x[1]);
         d.pairs.release(c);
     }
-    if (reuse) plan->redo = (unsigned char *)mem_alloc(c, units);
-    if (plan->redo) {  // a unit is traced again when its record meets a cell marked
-        size_t again = 0;
+    bool all = h->recorded == COH_ALL;
+    if (known && all) plan->redo = (unsigned char *)mem_alloc(c, units);
+    int record = COH_SAMPLE;
+    if (known) {  // a unit is traced again when its record meets a cell marked
+        size_t again = 0, n = 0;
         int nw = h->rg.words, nd = 0;
         for (int k = 0; k < nw; k++)  // (the words marked, in place at the front)
             if (dirty[k]) dirty[nd] = dirty[k], dirty[nw + nd++] = (unsigned)k;
         for (size_t u = 0; u < units; u++) {
+            if (!all && !coh_sampled(u, s->width, bands)) continue;
             const unsigned *r = h->rec + u * (size_t)nw;
             unsigned any = 0;
             for (int k = 0; k < nd && !any; k++) any = r[dirty[nw + k]] & dirty[k];
-            plan->redo[u] = any != 0;
+            if (plan->redo) plan->redo[u] = any != 0;
             again += any != 0;
+            n++;
         }
-        if (2 * again > units) {  // most of it: traced in full
+        if (2 * again <= n) record = COH_ALL;
+        if (2 * again > n || !plan->redo) {  // (most of it: traced in full)
             mem_free(c, plan->redo);
             plan->redo = NULL;
         }
     }
     mem_free(c, dirty);
-    bool record = plan->redo != NULL;
-    if (plan->redo) h->misses = 0;
-    else if (tried) {  // in vain: not recorded for a while
-        h->misses = h->misses < 4 ? h->misses + 1 : 4;
-        h->wait = (1 << h->misses) - 1;
-    } else if (same) {
-        record = h->wait == 0;
-        h->wait -= h->wait > 0;
-    } else h->wait = 0;
-    if (record && !plan->redo) {  // new cells: this frame, the one before and the next
+    if (!plan->redo) {  // new cells: this frame, the one before and the next
         Box b = finite_hull(s), cur = b;
         if (h->valid && !box_empty(h->hull) && !box_empty(cur)) {
             Box next;
@@ -7574,37 +7585,41 @@ void coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
             box_hull(&b, h->hull);
             if (!box_empty(next) && box_finite(next)) box_hull(&b, next);
         }
+        // (a sample's fine grid reaches further: it tells whether the next frame is worth
+        // recording, also when something moves out of this frame's box)
         Regions g;
-        record = coh_regions(&g, b, units);
-        if (record && (!h->rec || h->units != units || g.words != h->rg.words)) {
+        if (!coh_regions(&g, b, units, record == COH_ALL ? 1.0 / 32 : 0.5)) record = COH_NONE;
+        else if (!h->rec || h->units != units || g.words != h->rg.words) {
             mem_free(c, h->rec);
             h->rec = (unsigned *)mem_alloc(c, sizeof(unsigned) * (size_t)g.words * units);
         }
         h->rg = g;
         h->units = units;
-        record = record && h->rec;
+        if (!h->rec) record = COH_NONE;
     }
     if (c->status != st0) {  // out of memory somewhere: traced in full, not recorded
         c->status = st0;
         memcpy(c->msg, msg0, sizeof msg0);
         mem_free(c, plan->redo);
         memset(plan, 0, sizeof *plan);
-        record = false;
+        record = COH_NONE;
     }
-    h->recorded = 0;  // (until coh_keep)
-    if (!record) return;
+    h->recorded = COH_NONE;  // (until coh_keep)
+    plan->record = record;
+    if (record == COH_NONE) return;
     plan->rec = h->rec;
     plan->rg = &h->rg;
     plan->prev = plan->redo ? h->img : NULL;
+    plan->sample = record == COH_SAMPLE;
 }
 
 // After a program's frame: keep its scene (taken from *s, without its acceleration structure)
 // and options for the next, and its pixels when it was recorded.
-void coh_keep(pray_ctx *c, Scene *s, const float *img, bool recorded) {
+void coh_keep(pray_ctx *c, Scene *s, const float *img, int recorded) {
     Coherence *h = c->coh;
     if (!h) return;
     size_t n = (size_t)s->width * s->height * 3;
-    if (recorded && (!h->img || h->imgsize != n)) {
+    if (recorded == COH_ALL && (!h->img || h->imgsize != n)) {
         pray_status st0 = c->status;
         char msg0[sizeof c->msg];
         memcpy(msg0, c->msg, sizeof msg0);
@@ -7614,10 +7629,10 @@ void coh_keep(pray_ctx *c, Scene *s, const float *img, bool recorded) {
         if (!h->img) {  // the next frame is traced in full
             c->status = st0;
             memcpy(c->msg, msg0, sizeof msg0);
-            recorded = false;
+            recorded = COH_SAMPLE;
         }
     }
-    if (recorded) memcpy(h->img, img, sizeof(float) * n);
+    if (recorded == COH_ALL) memcpy(h->img, img, sizeof(float) * n);
     if (h->valid) scene_release(c, &h->prev);
     h->hull = finite_hull(s);
     accel_release(c, s->accel);
@@ -8772,7 +8787,7 @@ pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, cons
         else coh_release(c);
         st = render_scene(c, &s, r, out, &plan);
         mem_free(c, plan.redo);
-        if (st == PRAY_OK && coh) coh_keep(c, &s, out.rgb, plan.rec != NULL);
+        if (st == PRAY_OK && coh) coh_keep(c, &s, out.rgb, plan.record);
         else coh_release(c);
     }
     c->stats.time_prepare += t1 - t0;

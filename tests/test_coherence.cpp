@@ -74,7 +74,7 @@ Run same_frames(const std::string &program, std::vector<std::string> options) {
     }
     CHECK(a.st.pixels_reused == 0);
     double px = (double)b.frames[0].width * b.frames[0].height;
-    CHECK(b.st.pixels_reused + b.st.pixels_retraced <= px * b.frames.size());
+    CHECK(b.st.pixels_reused + b.st.pixels_retraced == px * b.st.frames_coherent);
     return b;
 }
 
@@ -177,29 +177,26 @@ TEST_CASE("coherence: a light, the camera or an option that changes: the frame i
                           "rendertiff Room, Lamp, Sun",
                           5);
     Run r = same_frames(p, {"width=40", "height=32", "threads=1"});
-    // frames 1, 2 and 3 change the light, the camera and an option: none is recorded; frame 4
-    // is like frame 3 and is recorded, for a frame 5 that does not come
+    // frames 1, 2 and 3 change the light, the camera and an option; frame 4 is like frame 3
+    // and is recorded, for a frame 5 that does not come
     CHECK(r.st.pixels_reused == 0);
-    CHECK(r.st.pixels_retraced == 40 * 32);
+    CHECK(r.st.pixels_retraced == 0);
     CHECK(r.st.frames_coherent == 0);
 }
 
 TEST_CASE("coherence: a frame like the one before takes over every pixel") {
-    // the first frame is not recorded (a program may have no other), the second is, and the
-    // third takes it over
+    // the first frame records a sample only (a program may have no other); the second, like
+    // it, is recorded in full, and the third takes it over
     Run r = same_frames(scene("rendertiff Room, Lamp, Sun", 3), {"width=40", "height=32", "threads=2"});
     CHECK(r.st.pixels_reused == 40 * 32);
-    CHECK(r.st.pixels_retraced == 40 * 32);
+    CHECK(r.st.pixels_retraced == 0);
     CHECK(r.st.frames_coherent == 1);
-    Run one = same_frames(scene("rendertiff Room, Lamp, Sun", 1), {"width=40", "height=32"});
-    CHECK(one.st.pixels_retraced == 0);  // (not recorded)
 }
 
-TEST_CASE("coherence: when everything moves, frames are recorded now and then only") {
-    Run r = same_frames(scene("rendertiff Room . [0.05*F, 0, 0], Lamp, Sun", 12), {"width=40", "height=32"});
-    // recorded: frame 1, 4 (after 1 not), 9 (after 3 not); frames 2, 5 and 10 try in vain
+TEST_CASE("coherence: when everything moves, no frame takes any pixel over") {
+    Run r = same_frames(scene("rendertiff Room . [0.05*F, 0, 0], Lamp, Sun", 6), {"width=40", "height=32"});
     CHECK(r.st.pixels_reused == 0);
-    CHECK(r.st.pixels_retraced == 3 * 40 * 32);
+    CHECK(r.st.frames_coherent == 0);
 }
 
 TEST_CASE("coherence: where a small ball moves, most pixels are taken over") {
@@ -209,7 +206,7 @@ TEST_CASE("coherence: where a small ball moves, most pixels are taken over") {
         double later = 2.0 * 64 * 48;  // the pixels of the frames after the second
         INFO("antialias ", aa, ": reused ", r.st.pixels_reused, " of ", later);
         CHECK(r.st.frames_coherent == 2);
-        CHECK(r.st.pixels_reused + r.st.pixels_retraced == later + 64 * 48);
+        CHECK(r.st.pixels_reused + r.st.pixels_retraced == later);
         CHECK(r.st.pixels_reused > 0.6 * later);
     }
 }
@@ -244,13 +241,13 @@ std::string random_animation(std::mt19937 &rng, int frames) {
     double lamp[3] = {2, -3, 4};
     for (int f = 0; f < frames; f++) {
         for (Obj &o : objs) {
-            unsigned k = rng() % 10;
+            unsigned k = rng() % 16;
             if (k == 0) o.shown = !o.shown;
             else if (k == 1) o.mat = (int)(rng() % 5);
             else if (k <= 3) o.x += num(-0.5, 0.5), o.y += num(-0.5, 0.5);
             else if (k == 4) o.turn += num(-40, 40);
         }
-        if (rng() % 6 == 0) lamp[0] += num(-1, 1);
+        if (rng() % 8 == 0) lamp[0] += num(-1, 1);
         p << "Obj = Floor\n";
         for (const Obj &o : objs) {
             if (!o.shown) continue;
@@ -279,9 +276,12 @@ std::string random_animation(std::mt19937 &rng, int frames) {
 TEST_CASE("coherence: random animations give the frames of coherence 0") {
     std::mt19937 rng(27);
     auto sets = option_sets(36, 28);
+    long coherent = 0;
     for (int i = 0; i < 24; i++) {
-        std::string p = random_animation(rng, 5);
+        std::string p = random_animation(rng, 6);
         INFO("animation ", i, ":\n", p);
-        same_frames(p, sets[i % sets.size()]);
+        coherent += same_frames(p, sets[i % sets.size()]).st.frames_coherent;
     }
+    MESSAGE("frames that took pixels over: ", coherent);
+    CHECK(coherent >= 16);  // (the animations do test something)
 }
