@@ -13,9 +13,11 @@
    [SECTION] 9b Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
                 [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas and
                 jumps, [9b.4] light and eye buffers, [9b.5] accel_build; per ray: [9b.6] list
-                evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver
+                evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver (which notes
+                where rays went, for image sequences)
    [SECTION] 9c Reading files (programs, textures, fonts), TIFF reader and textures, the built-in font
    [SECTION] 10 Whitted shading, textured surfaces, the render driver (threads, undersampling)
+   [SECTION] 10b Image sequences (3.7): comparing a frame's scene with the one before, records
    [SECTION] 11 Image writers: TIFF, PPM, PNG; writing files safely; public functions
    [SECTION] 12 PRAY lexer
    [SECTION] 13 PRAY parser
@@ -6617,6 +6619,11 @@ struct Job;
 // them (every 8th pixel of every 8th row; every 4th band with undersampling) that tells the
 // next frame whether recording all is worth it.
 enum { COH_NONE, COH_ALL, COH_SAMPLE };
+const size_t COH_BLOCK = 32;  // units whose records lie interleaved, word by word
+// Word i of unit u's record, in records of `words` words.
+inline size_t coh_word(size_t u, int i, int words) {
+    return (u / COH_BLOCK * (size_t)words + (size_t)i) * COH_BLOCK + u % COH_BLOCK;
+}
 inline bool coh_sampled(size_t u, int width, bool bands) {
     return bands ? u % 4 == 0 : (u % (size_t)width) % 8 == 0 && (u / (size_t)width) % 8 == 0;
 }
@@ -6628,6 +6635,8 @@ struct Worker {
     Array<Sample> cache;  // undersampling: the samples of the current tile
     pray_status st;
     double kept, traced;  // image sequences: pixels taken over from the frame before, and traced
+    unsigned *rtemp;      // ... the record of the unit being traced
+    size_t unit;          // ... and its number
 };
 
 
@@ -6651,6 +6660,7 @@ struct Job {
     const Regions *rg;
     const float *prev;
     int sample;  // only the sample's records are kept (coh_sampled)
+    size_t units;
 };
 
 // Image sequences (10b): unit u of the image (a pixel; a band with undersampling) is taken over
@@ -6658,13 +6668,24 @@ struct Job {
 bool unit_kept(Worker &k, size_t u) {
     const Job *job = k.job;
     if (job->redo && !job->redo[u]) return true;
-    if (job->rec) {
-        k.w.rbits = NULL;
-        if (job->sample && !coh_sampled(u, job->s->width, job->adaptive > 0)) return false;
-        k.w.rbits = job->rec + u * (size_t)job->rg->words;
-        memset(k.w.rbits, 0, sizeof(unsigned) * (size_t)job->rg->words);
+    k.w.rbits = NULL;
+    if (job->rec && (!job->sample || coh_sampled(u, job->s->width, job->adaptive > 0))) {
+        k.w.rbits = k.rtemp;
+        k.unit = u;
+        memset(k.rtemp, 0, sizeof(unsigned) * (size_t)job->rg->words);
     }
     return false;
+}
+
+// The unit traced is recorded: its record goes into the records of the image, which hold word
+// i of the records of COH_BLOCK units together (so that a frame reads the words it needs
+// only, a block of units after another; coh_word).
+void unit_done(Worker &k) {
+    const Job *job = k.job;
+    if (!k.w.rbits) return;
+    int nw = job->rg->words;
+    for (int i = 0; i < nw; i++) job->rec[coh_word(k.unit, i, nw)] = k.rtemp[i];
+    k.w.rbits = NULL;
 }
 
 // Undersampling works on the image's samples (antialias x antialias per pixel, in one lattice
@@ -6993,6 +7014,7 @@ void render_band(Worker &k, int band) {
         }
         k.traced += px;
         adaptive_band(k, b0, b1 < s->height ? b1 : s->height);
+        unit_done(k);
         return;
     }
     Ray rays[RAY_BATCH];
@@ -7002,7 +7024,7 @@ void render_band(Worker &k, int band) {
         if (s->antialias > 1) {  // pixel() makes each row of samples ahead
             for (int i = x0; i < x1; i++)
                 if (unit_kept(k, u + i)) put_kept(job, i, i + 1, j), k.kept++;
-                else put_pixel(job, i, j, pixel(k, i, j)), k.traced++;
+                else put_pixel(job, i, j, pixel(k, i, j)), k.traced++, unit_done(k);
             continue;
         }
         for (int i0 = x0; i0 < x1; i0 += RAY_BATCH) {
@@ -7010,7 +7032,7 @@ void render_band(Worker &k, int band) {
             for (int q = 0; q < n; q++) rays[q] = sample_ray(s, i0 + q, j, 0, 0);
             for (int q = 0; q < n; q++)
                 if (unit_kept(k, u + i0 + q)) put_kept(job, i0 + q, i0 + q + 1, j), k.kept++;
-                else put_pixel(job, i0 + q, j, trace(k.tr, rays[q], 1, -1, RAY_PRIMARY)), k.traced++;
+                else put_pixel(job, i0 + q, j, trace(k.tr, rays[q], 1, -1, RAY_PRIMARY)), k.traced++, unit_done(k);
         }
     }
 }
@@ -7049,6 +7071,7 @@ struct CohPlan {
     const float *prev;
     int sample;  // only a sample of the units is recorded (coh_sampled)
     int record;  // what is recorded: COH_NONE, COH_ALL, COH_SAMPLE (10b)
+    size_t units;
 };
 
 // The rows of a band of the render driver: a band of tiles with undersampling.
@@ -7082,6 +7105,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         job.rg = plan->rg;
         job.prev = plan->prev;
         job.sample = plan->sample;
+        job.units = plan->units;
     }
     for (int i = 0; job.adaptive > 0 && i < s->prims.n; i++)  // undersampling looks into textures
         if (!model_pyramids(c, (pray_model *)s->prims[i].mat)) return c->status;  // (marks the parts done)
@@ -7106,6 +7130,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         k.tr.s = s;
         k.tr.w = &k.w;
         k.w.rg = job.rg;
+        if (job.rec && !(k.rtemp = (unsigned *)thread_alloc(c, sizeof(unsigned) * (size_t)job.rg->words))) st = c->status;
         args[made] = &k;
     }
     if (st == PRAY_OK) {
@@ -7138,6 +7163,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
             c->stats.pixels_retraced += worker_at(wbuf, stride, i).traced;
         }
         scratch_release(c, &worker_at(wbuf, stride, i).w);
+        mem_free(c, worker_at(wbuf, stride, i).rtemp);
         worker_at(wbuf, stride, i).cache.release(c);
     }
     if (out.rgb) c->stats.rays_primary_full += (double)r.width * r.height * s->antialias * s->antialias;
@@ -7161,7 +7187,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
 // whose record meets no marked cell has the same rays and the same colour; the others are traced
 // again. With undersampling the unit is the band of rows the render driver samples alone.
 const double COH_BYTES = 64.0 * 1048576;  // the records of a frame at most
-const int COH_CELLS = 16;                 // cells along an axis at most (4 at least)
+const int COH_CELLS = 12;                 // cells along an axis at most (4 at least)
 
 struct Coherence {
     int valid;        // `prev`, `opt` and `hull` are the last frame's
@@ -7558,15 +7584,18 @@ void coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
         int nw = h->rg.words, nd = 0;
         for (int k = 0; k < nw; k++)  // (the words marked, in place at the front)
             if (dirty[k]) dirty[nd] = dirty[k], dirty[nw + nd++] = (unsigned)k;
-        for (size_t u = 0; u < units; u++) {
-            if (!all && !coh_sampled(u, s->width, bands)) continue;
-            const unsigned *r = h->rec + u * (size_t)nw;
-            unsigned any = 0;
-            for (int k = 0; k < nd && !any; k++) any = r[dirty[nw + k]] & dirty[k];
-            if (plan->redo) plan->redo[u] = any != 0;
-            again += any != 0;
-            n++;
+        unsigned char *hit = plan->redo ? plan->redo : (unsigned char *)mem_zalloc(c, units);
+        if (plan->redo) memset(hit, 0, units);
+        for (size_t b = 0; b < units && hit; b += COH_BLOCK) {  // (a block of units at a time)
+            size_t m = units - b < COH_BLOCK ? units - b : COH_BLOCK;
+            for (int k = 0; k < nd; k++) {
+                const unsigned *r = h->rec + coh_word(b, (int)dirty[nw + k], nw), x = dirty[k];
+                for (size_t j = 0; j < m; j++) hit[b + j] |= (r[j] & x) != 0;
+            }
         }
+        for (size_t u = 0; u < units && hit; u++)
+            if (all || coh_sampled(u, s->width, bands)) again += hit[u], n++;
+        if (hit != plan->redo) mem_free(c, hit);
         if (2 * again <= n) record = COH_ALL;
         if (2 * again > n || !plan->redo) {  // (most of it: traced in full)
             mem_free(c, plan->redo);
@@ -7591,7 +7620,7 @@ void coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
         if (!coh_regions(&g, b, units, record == COH_ALL ? 1.0 / 32 : 0.5)) record = COH_NONE;
         else if (!h->rec || h->units != units || g.words != h->rg.words) {
             mem_free(c, h->rec);
-            h->rec = (unsigned *)mem_alloc(c, sizeof(unsigned) * (size_t)g.words * units);
+            h->rec = (unsigned *)mem_alloc(c, sizeof(unsigned) * (size_t)g.words * ((units + COH_BLOCK - 1) / COH_BLOCK * COH_BLOCK));
         }
         h->rg = g;
         h->units = units;
@@ -7608,6 +7637,7 @@ void coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
     plan->record = record;
     if (record == COH_NONE) return;
     plan->rec = h->rec;
+    plan->units = units;
     plan->rg = &h->rg;
     plan->prev = plan->redo ? h->img : NULL;
     plan->sample = record == COH_SAMPLE;

@@ -3,13 +3,12 @@
 # frame with and without it, on one thread, for animations where little moves and one where
 # everything does. Prints a table for docs/benchmarks.md; never part of `make check`.
 #
-# A frame is recorded only when the frame before had the same camera, lights and options, so
-# the first two frames are traced in full either way; the frames after them are what coherence
-# is for. Their time is the CPU time (user + system) of the whole run less that of a run that
-# renders only the first two (--frames 0:2, the program still runs in full), divided by their
-# number: the interpreter and the writing of files are in both. Each run is made RUNS times
-# (default 3) and the least time kept, so that other work on the machine counts as little as
-# possible. Every frame is compared with coherence=0's, byte for byte.
+# The first frame of a program records a sample of its pixels, the second (when the sample
+# says it is worth it) records all, and the frames after it take pixels over; see
+# docs/acceleration.md. A frame's time is what `pray --stats` reports for it (preparing and
+# rendering, on one thread); each run is made RUNS times (default 3) and the least time of each
+# frame kept, so that other work on the machine counts as little as possible. Every frame is
+# compared with coherence=0's, byte for byte. Prints the time of each frame, then a summary.
 # Usage: bench/coherence.sh [RUNS]
 set -e
 cd "$(dirname "$0")/.."
@@ -31,23 +30,19 @@ while Frame < 8
 endwhile
 EOF
 
-# cpu FILE OPTIONS...: the least CPU seconds of RUNS runs
-cpu() {
-  f=$1
-  shift
-  best=
+# frame_times FILE COHERENCE: the least time of each frame over RUNS runs, one a line, in ms
+frame_times() {
   i=0
+  : > "$OUT/all"
   while [ $i -lt "$RUNS" ]; do
-    /usr/bin/time -f '%U %S' -o "$OUT/t" $PRAY --quiet --threads 1 "$@" "$f" > /dev/null
-    t=$(awk '{print $1 + $2}' "$OUT/t")
-    if [ -z "$best" ]; then best=$t; else best=$(echo "$best $t" | awk '{print ($2 < $1) ? $2 : $1}'); fi
+    $PRAY --quiet --stats --threads 1 -D coherence=$2 -o "$OUT/f###.ppm" "$1" 2>&1 > /dev/null |
+      awk '/^frame/ {k++; print k, 1000 * ($4 + $7)}' >> "$OUT/all"
     i=$((i + 1))
   done
-  echo "$best"
+  awk '{ if (!($1 in m) || $2 < m[$1]) m[$1] = $2; if ($1 > n) n = $1 } END {for (k = 1; k <= n; k++) print m[k]}' "$OUT/all"
 }
 
-echo "| animation | frames | pixels | per frame after the second, coherence=0 | coherence=1 | faster | pixels reused |"
-echo "|---|---:|---:|---:|---:|---:|---:|"
+summary=""
 for f in examples/roomball.ray examples/machine.ray examples/anim.ray "$OUT/roomall.ray"; do
   n=$(basename "$f" .ray)
   mkdir -p "$OUT/$n.0" "$OUT/$n.1"
@@ -55,13 +50,18 @@ for f in examples/roomball.ray examples/machine.ray examples/anim.ray "$OUT/room
     $PRAY --quiet --stats --threads 1 -D coherence=$c -o "$OUT/$n.$c/f###.ppm" "$f" > /dev/null 2> "$OUT/$n.$c.txt"
   done
   for g in "$OUT/$n.0"/*.ppm; do cmp -s "$g" "$OUT/$n.1/$(basename "$g")" || { echo "coherence: $n: $(basename "$g") differs" >&2; exit 1; }; done
-  frames=$(ls "$OUT/$n.0" | wc -l)
-  size=$(awk '/^frame/ {print $NF; exit}' "$OUT/$n.1.txt")
-  reused=$(awk -v s="$size" -v n="$frames" '/^frame/ {k++; if (k > 2) r += $(NF-2)} END {printf "%.1f %%", 100 * r / (s * (n - 2))}' "$OUT/$n.1.txt")
-  for c in 0 1; do
-    all=$(cpu "$f" -D coherence=$c -o "$OUT/$n.$c/f###.ppm")
-    two=$(cpu "$f" -D coherence=$c --frames 0:2 -o "$OUT/$n.$c/f###.ppm")
-    eval "t$c=\$(echo $all $two $frames | awk '{printf \"%.4f\", (\$1 - \$2) / (\$3 - 2)}')"
-  done
-  echo "$n $frames $size $t0 $t1 $reused" | awk '{printf "| %s | %d | %d | %.1f ms | %.1f ms | %.2fx | %s %s |\n", $1, $2, $3, 1000 * $4, 1000 * $5, $4 / $5, $6, $7}'
+  frame_times "$f" 0 > "$OUT/$n.t0"
+  frame_times "$f" 1 > "$OUT/$n.t1"
+  awk '/^frame/ {print $(NF-2), $NF}' "$OUT/$n.1.txt" > "$OUT/$n.px"
+  echo "$n: time per frame (ms), coherence=0 / coherence=1, and the pixels taken over"
+  paste "$OUT/$n.t0" "$OUT/$n.t1" "$OUT/$n.px" | awk '{printf "  frame %d: %8.1f %8.1f  %5.1f %%\n", NR - 1, $1, $2, 100 * $3 / $4}'
+  summary="$summary$(paste "$OUT/$n.t0" "$OUT/$n.t1" "$OUT/$n.px" | awk -v n=$n '
+    NR > 2 {a += $1; b += $2; r += $3; p += $4; k++}
+    NR <= 2 {a0 += $1; b0 += $2}
+    END {printf "| %s | %d | %d | %.1f / %.1f ms | %.1f / %.1f ms | %.1fx | %.1f %% |\n", n, NR, $4, a0 / 2, b0 / 2, a / k, b / k, a / b, 100 * r / p}')
+"
 done
+echo
+echo "| animation | frames | pixels | first two frames, coherence=0 / 1 | frames after them, coherence=0 / 1 | faster | pixels taken over |"
+echo "|---|---:|---:|---:|---:|---:|---:|"
+printf "%s" "$summary"
