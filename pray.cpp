@@ -7181,11 +7181,13 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
 // A program's frame with the camera, lights, image and options of the frame before takes over
 // every pixel whose rays cannot have met anything that changed. While a pixel is traced, the
 // ray driver notes in the pixel's record the regions of space its rays crossed (region_note,
-// 9b.8): cells of a coarse grid over the scene, and bit 0 for all space outside the grid's box.
-// The next frame compares its prepared scene with the frame before's, by value (coh_diff),
-// and marks the cells that the boxes of what changed reach, in both scenes (coh_mark). A pixel
-// whose record meets no marked cell has the same rays and the same colour; the others are traced
-// again. With undersampling the unit is the band of rows the render driver samples alone.
+// 9b.8): cells of a fine grid over the scene's finite parts, of a coarse grid around it, and
+// bit 0 for all space beyond. The next frame compares its prepared scene with the frame
+// before's, by value (coh_diff), and marks the cells that the boxes of what changed reach, in
+// both scenes (coh_mark). A pixel whose record meets no marked cell has the same rays and the
+// same colour; the others are traced again. With undersampling the unit is the band of rows
+// the render driver samples alone. The records of a frame are at most COH_BYTES; a frame that
+// cannot have them is traced in full (docs/acceleration.md, "Image sequences").
 const double COH_BYTES = 64.0 * 1048576;  // the records of a frame at most
 const int COH_CELLS = 12;                 // cells along an axis at most (4 at least)
 
@@ -7196,7 +7198,7 @@ struct Coherence {
     Box hull;         // the box of its finite parts
     int recorded;     // `rec` and `img` are the last frame's too: COH_ALL or COH_SAMPLE
     Regions rg;       // the cells its records are made of
-    unsigned *rec;    // units x rg.words
+    unsigned *rec;    // units x rg.words (coh_word)
     size_t units;     // pixels, or with undersampling bands
     float *img;       // its pixels, RGB
     size_t imgsize;   // floats at img
