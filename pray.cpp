@@ -7541,20 +7541,15 @@ bool coh_regions(Regions *R, Box b, size_t units, double slack) {
 // the sample is recorded, at a cost of a per cent or two of its rays. So an animation in which
 // everything moves, or the camera, and a program's single frame are never recorded in full.
 // A frame traced in full gets new cells, over this frame, the one before and where things go
-// on moving. Never fails: what cannot be had (memory within the caps, a budget the image is
-// too large for) is a frame traced in full and not recorded.
-void coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
+// on moving. Records that the budget (COH_BYTES) or the context's memory cap has no room for
+// (they may take half of what the cap leaves) are not made: the frame is traced in full. An
+// allocation that fails is out of memory, as anywhere else.
+pray_status coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
     memset(plan, 0, sizeof *plan);
     pray_status st0 = c->status;
-    char msg0[sizeof c->msg];
-    memcpy(msg0, c->msg, sizeof msg0);
     Coherence *h = c->coh;
     if (!h) h = c->coh = (Coherence *)mem_zalloc(c, sizeof(Coherence));
-    if (!h) {
-        c->status = st0;
-        memcpy(c->msg, msg0, sizeof msg0);
-        return;
-    }
+    if (!h) return c->status;
     bool bands = c->cur.opt.v[OPT_ADAPTIVE] > 0;
     size_t units = (size_t)s->width * s->height;
     if (bands) {
@@ -7619,50 +7614,48 @@ void coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
         // (a sample's fine grid reaches further: it tells whether the next frame is worth
         // recording, also when something moves out of this frame's box)
         Regions g;
+        memset(&g, 0, sizeof g);
         if (!coh_regions(&g, b, units, record == COH_ALL ? 1.0 / 32 : 0.5)) record = COH_NONE;
-        else if (!h->rec || h->units != units || g.words != h->rg.words) {
+        size_t bytes = sizeof(unsigned) * (size_t)g.words * ((units + COH_BLOCK - 1) / COH_BLOCK * COH_BLOCK);
+        if (record != COH_NONE && (!h->rec || h->units != units || g.words != h->rg.words)) {
             mem_free(c, h->rec);
-            h->rec = (unsigned *)mem_alloc(c, sizeof(unsigned) * (size_t)g.words * ((units + COH_BLOCK - 1) / COH_BLOCK * COH_BLOCK));
+            h->rec = NULL;
+            double img = record == COH_ALL ? sizeof(float) * 3.0 * (double)s->width * s->height : 0;
+            if (c->limit && (double)c->used + 2 * ((double)bytes + img) > (double)c->limit) record = COH_NONE;
+            else h->rec = (unsigned *)mem_alloc(c, bytes);
         }
         h->rg = g;
         h->units = units;
         if (!h->rec) record = COH_NONE;
     }
-    if (c->status != st0) {  // out of memory somewhere: traced in full, not recorded
-        c->status = st0;
-        memcpy(c->msg, msg0, sizeof msg0);
+    if (c->status != st0) {  // out of memory
         mem_free(c, plan->redo);
         memset(plan, 0, sizeof *plan);
-        record = COH_NONE;
+        return c->status;
     }
     h->recorded = COH_NONE;  // (until coh_keep)
     plan->record = record;
-    if (record == COH_NONE) return;
+    if (record == COH_NONE) return PRAY_OK;
     plan->rec = h->rec;
     plan->units = units;
     plan->rg = &h->rg;
     plan->prev = plan->redo ? h->img : NULL;
     plan->sample = record == COH_SAMPLE;
+    return PRAY_OK;
 }
 
 // After a program's frame: keep its scene (taken from *s, without its acceleration structure)
 // and options for the next, and its pixels when it was recorded.
-void coh_keep(pray_ctx *c, Scene *s, const float *img, int recorded) {
+pray_status coh_keep(pray_ctx *c, Scene *s, const float *img, int recorded) {
     Coherence *h = c->coh;
-    if (!h) return;
+    if (!h) return PRAY_OK;
     size_t n = (size_t)s->width * s->height * 3;
     if (recorded == COH_ALL && (!h->img || h->imgsize != n)) {
-        pray_status st0 = c->status;
-        char msg0[sizeof c->msg];
-        memcpy(msg0, c->msg, sizeof msg0);
         mem_free(c, h->img);
-        h->img = (float *)mem_alloc(c, sizeof(float) * n);
-        h->imgsize = h->img ? n : 0;
-        if (!h->img) {  // the next frame is traced in full
-            c->status = st0;
-            memcpy(c->msg, msg0, sizeof msg0);
-            recorded = COH_SAMPLE;
-        }
+        h->imgsize = 0;
+        if (c->limit && (double)c->used + 2.0 * sizeof(float) * n > (double)c->limit) recorded = COH_SAMPLE;
+        else if (!(h->img = (float *)mem_alloc(c, sizeof(float) * n))) return c->status;
+        else h->imgsize = n;
     }
     if (recorded == COH_ALL) memcpy(h->img, img, sizeof(float) * n);
     if (h->valid) scene_release(c, &h->prev);
@@ -7679,6 +7672,7 @@ void coh_keep(pray_ctx *c, Scene *s, const float *img, int recorded) {
     h->opt = c->cur.opt;
     h->valid = 1;
     h->recorded = recorded;
+    return PRAY_OK;
 }
 } // namespace
 
@@ -8815,12 +8809,12 @@ pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, cons
                    out.stride == (size_t)s.width;
         CohPlan plan;
         memset(&plan, 0, sizeof plan);
-        if (coh) coh_plan(c, &s, &plan);
+        if (coh) st = coh_plan(c, &s, &plan);
         else coh_release(c);
-        st = render_scene(c, &s, r, out, &plan);
+        if (st == PRAY_OK) st = render_scene(c, &s, r, out, &plan);
         mem_free(c, plan.redo);
-        if (st == PRAY_OK && coh) coh_keep(c, &s, out.rgb, plan.record);
-        else coh_release(c);
+        if (st == PRAY_OK && coh) st = coh_keep(c, &s, out.rgb, plan.record);
+        if (st != PRAY_OK || !coh) coh_release(c);
     }
     c->stats.time_prepare += t1 - t0;
     c->stats.time_render += clock_seconds() - t1;

@@ -285,3 +285,12 @@ TEST_CASE("coherence: random animations give the frames of coherence 0") {
     MESSAGE("frames that took pixels over: ", coherent);
     CHECK(coherent >= 16);  // (the animations do test something)
 }
+
+TEST_CASE("coherence: records the memory cap has no room for are not made, and the frames are the same") {
+    // 200 x 160 pixels' records are 7 MiB; the cap of 4 MiB leaves room for the render only
+    std::string p = scene("rendertiff Room | sphere(Red, [-2.2 + 0.2*F, -1, 0.9], 0.15), Lamp, Sun", 4);
+    Run r = same_frames(p, {"width=200", "height=160", "threads=1", "maxmem=4"});
+    CHECK(r.st.pixels_reused == 0);
+    Run big = same_frames(p, {"width=200", "height=160", "threads=1", "maxmem=64"});
+    CHECK(big.st.pixels_reused > 0);
+}
