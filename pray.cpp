@@ -6627,6 +6627,13 @@ inline size_t coh_word(size_t u, int i, int words) {
 inline bool coh_sampled(size_t u, int width, bool bands) {
     return bands ? u % 4 == 0 : (u % (size_t)width) % 8 == 0 && (u / (size_t)width) % 8 == 0;
 }
+// A sampled unit's place among the sample's records, and their number.
+inline size_t coh_slot(size_t u, int width, bool bands) {
+    return bands ? u / 4 : u / (size_t)width / 8 * (((size_t)width + 7) / 8) + u % (size_t)width / 8;
+}
+inline size_t coh_slots(size_t units, int width, bool bands) {
+    return bands ? (units + 3) / 4 : (units / (size_t)width + 7) / 8 * (((size_t)width + 7) / 8);
+}
 
 struct Worker {
     Job *job;
@@ -6684,7 +6691,8 @@ void unit_done(Worker &k) {
     const Job *job = k.job;
     if (!k.w.rbits) return;
     int nw = job->rg->words;
-    for (int i = 0; i < nw; i++) job->rec[coh_word(k.unit, i, nw)] = k.rtemp[i];
+    size_t u = job->sample ? coh_slot(k.unit, job->s->width, job->adaptive > 0) : k.unit;
+    for (int i = 0; i < nw; i++) job->rec[coh_word(u, i, nw)] = k.rtemp[i];
     k.w.rbits = NULL;
 }
 
@@ -7200,6 +7208,7 @@ struct Coherence {
     Regions rg;       // the cells its records are made of
     unsigned *rec;    // units x rg.words (coh_word)
     size_t units;     // pixels, or with undersampling bands
+    size_t recbytes;  // bytes at rec: of all units' records, or of the sample's (coh_slot)
     float *img;       // its pixels, RGB
     size_t imgsize;   // floats at img
 };
@@ -7581,17 +7590,17 @@ pray_status coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
         int nw = h->rg.words, nd = 0;
         for (int k = 0; k < nw; k++)  // (the words marked, in place at the front)
             if (dirty[k]) dirty[nd] = dirty[k], dirty[nw + nd++] = (unsigned)k;
-        unsigned char *hit = plan->redo ? plan->redo : (unsigned char *)mem_zalloc(c, units);
-        if (plan->redo) memset(hit, 0, units);
-        for (size_t b = 0; b < units && hit; b += COH_BLOCK) {  // (a block of units at a time)
-            size_t m = units - b < COH_BLOCK ? units - b : COH_BLOCK;
+        n = all ? units : coh_slots(units, s->width, bands);  // (records of all units, or the sample's)
+        unsigned char *hit = plan->redo ? plan->redo : (unsigned char *)mem_zalloc(c, n);
+        if (plan->redo) memset(hit, 0, n);
+        for (size_t b = 0; b < n && hit; b += COH_BLOCK) {  // (a block of units at a time)
+            size_t m = n - b < COH_BLOCK ? n - b : COH_BLOCK;
             for (int k = 0; k < nd; k++) {
                 const unsigned *r = h->rec + coh_word(b, (int)dirty[nw + k], nw), x = dirty[k];
                 for (size_t j = 0; j < m; j++) hit[b + j] |= (r[j] & x) != 0;
             }
         }
-        for (size_t u = 0; u < units && hit; u++)
-            if (all || coh_sampled(u, s->width, bands)) again += hit[u], n++;
+        for (size_t u = 0; u < n && hit; u++) again += hit[u];
         if (hit != plan->redo) mem_free(c, hit);
         if (2 * again <= n) record = COH_ALL;
         if (2 * again > n || !plan->redo) {  // (most of it: traced in full)
@@ -7616,13 +7625,15 @@ pray_status coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
         Regions g;
         memset(&g, 0, sizeof g);
         if (!coh_regions(&g, b, units, record == COH_ALL ? 1.0 / 32 : 0.5)) record = COH_NONE;
-        size_t bytes = sizeof(unsigned) * (size_t)g.words * ((units + COH_BLOCK - 1) / COH_BLOCK * COH_BLOCK);
-        if (record != COH_NONE && (!h->rec || h->units != units || g.words != h->rg.words)) {
+        size_t slots = record == COH_ALL ? units : coh_slots(units, s->width, bands);
+        size_t bytes = sizeof(unsigned) * (size_t)g.words * ((slots + COH_BLOCK - 1) / COH_BLOCK * COH_BLOCK);
+        if (record != COH_NONE && (!h->rec || h->recbytes != bytes)) {
             mem_free(c, h->rec);
             h->rec = NULL;
             double img = record == COH_ALL ? sizeof(float) * 3.0 * (double)s->width * s->height : 0;
             if (c->limit && (double)c->used + 2 * ((double)bytes + img) > (double)c->limit) record = COH_NONE;
             else h->rec = (unsigned *)mem_alloc(c, bytes);
+            h->recbytes = h->rec ? bytes : 0;
         }
         h->rg = g;
         h->units = units;
