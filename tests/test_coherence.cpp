@@ -294,3 +294,12 @@ TEST_CASE("coherence: records the memory cap has no room for are not made, and t
     Run big = same_frames(p, {"width=200", "height=160", "threads=1", "maxmem=64"});
     CHECK(big.st.pixels_reused > 0);
 }
+
+TEST_CASE("coherence: the pixels taken over do not depend on the number of threads") {
+    std::string p = scene("rendertiff Room | sphere(Red, [-2.2 + 0.3*F, -1, 0.9], 0.2), Lamp, Sun", 5);
+    double reused[3];
+    for (int t = 1; t <= 3; t++) reused[t - 1] = same_frames(p, {"width=48", "height=40", "threads=" + std::to_string(t)}).st.pixels_reused;
+    CHECK(reused[0] > 0);
+    CHECK(reused[1] == reused[0]);
+    CHECK(reused[2] == reused[0]);
+}
