@@ -13,9 +13,11 @@
    [SECTION] 9b Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
                 [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas and
                 jumps, [9b.4] light and eye buffers, [9b.5] accel_build; per ray: [9b.6] list
-                evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver
+                evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver (which notes
+                where rays went, for image sequences)
    [SECTION] 9c Reading files (programs, textures, fonts), TIFF reader and textures, the built-in font
    [SECTION] 10 Whitted shading, textured surfaces, the render driver (threads, undersampling)
+   [SECTION] 10b Image sequences (3.7): comparing a frame's scene with the one before, records
    [SECTION] 11 Image writers: TIFF, PPM, PNG; writing files safely; public functions
    [SECTION] 12 PRAY lexer
    [SECTION] 13 PRAY parser
@@ -474,6 +476,8 @@ struct Block {
     pray_ctx *owner;
 };
 
+struct Coherence;  // image sequences (10b): what a program's last frame left for its next
+
 // A texture the host registered under a name (pray_texture_register).
 struct TexName {
     TexName *next;
@@ -485,7 +489,7 @@ struct TexName {
 
 // Options by index; the table in section 6 has their names, defaults and ranges.
 enum {
-    OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_CUTOFF, OPT_DEPTH, OPT_EYEBUFFER, OPT_FREEZE,
+    OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_COHERENCE, OPT_CUTOFF, OPT_DEPTH, OPT_EYEBUFFER, OPT_FREEZE,
     OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_LIGHTBUFFER, OPT_MAXFRAMES, OPT_MAXLINE, OPT_MAXMEM, OPT_MAXNEST,
     OPT_MAXOUTPUT, OPT_MAXPIXELS, OPT_MAXPRIMS, OPT_MAXRAYS, OPT_MAXSTEPS, OPT_MAXSTRING, OPT_MERGE, OPT_NEST, OPT_OUTPUT,
     OPT_SHADOWCACHE, OPT_SHADOWS, OPT_TEXMEM, OPT_THREADS,
@@ -551,6 +555,7 @@ struct pray_ctx {
     int eye_inside;          // the camera's eye is inside the solid last rendered (render_scene)
     volatile sig_atomic_t cancel;  // pray_cancel: the running call stops at its next check
     int calls;               // cancellable public calls running (a run renders and writes)
+    Coherence *coh;          // image sequences (option coherence): the frame before, or NULL
 };
 
 namespace {
@@ -1457,6 +1462,7 @@ const OptDef OPTS[OPT_COUNT] = {
     {"bits", 8, 8, 16, 1, 0},
     {"bounds", 1, 0, 1, 1, 0},
     {"brute", 0, 0, 1, 1, 0},
+    {"coherence", 1, 0, 1, 1, 0},
     {"cutoff", 1, 0, 1, 1, 0},
     {"depth", 5, 1, 64, 1, 16},
     {"eyebuffer", 1, 0, 1, 1, 0},
@@ -2565,6 +2571,18 @@ struct Cross {
     int enter;
 };
 
+// Image sequences (10b): while a pixel is traced, the regions of space its rays cross are set in
+// its record: bits over the cells of a grid over the scene's finite parts, then over the cells
+// of a coarse grid around it, for what lies outside the first, and bit 0 for all beyond both.
+struct RegionGrid {
+    double lo[3], hi[3], h[3];  // the box, and the sides of a cell
+    int n, base;                // cells along each axis; the bit of the first
+};
+struct Regions {
+    RegionGrid g[2];  // the fine grid, and the coarse one around it
+    int words;        // unsigned words of a record
+};
+
 struct Counters {
     double rays[4];  // primary, shadow, reflected, refracted
     double tests;
@@ -2605,6 +2623,9 @@ struct Scratch {
     unsigned char *nfixval;         // ... and its value
     int root_fixed;                 // the root's status cannot change any more on this ray
     int *blocker;                   // per light: the shadow cache's voxel, x y z; x -1: none (shadow_probe)
+    // image sequences (10b): the record of the pixel being traced (NULL: none kept) and its regions
+    unsigned *rbits;
+    const struct Regions *rg;
 };
 
 // Empty the shadow cache. Each band of the image starts with it empty, so that what the cache
@@ -2837,6 +2858,12 @@ struct ShadowHit {
         return false;
     }
 };
+
+// Where a visitor stopped its ray (image sequences, 10b): at its hit, or nowhere.
+inline real visit_end(const FirstHit &v) { return v.found ? v.h.t : REAL_INF; }
+inline real visit_end(const ShadowHit &v) { return czero(v.f) ? v.t : REAL_INF; }
+template <class Visit>
+inline real visit_end(const Visit &) { return REAL_INF; }
 
 // =============================================================================================
 // [SECTION] 9b Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
@@ -5155,17 +5182,13 @@ struct Stretches {
     }
 };
 
-// The one way a ray reaches the accelerated scene: begin the ray, then give the list evaluator
-// the outer list up to the part the source covers, that part's stretches, and the outer list
+// The lists of a ray that drive (below) has begun: give the list evaluator the outer list up to the part the source covers, that part's stretches, and the outer list
 // after it, up to tmax. Without a grid, the outer list holds everything: with bounds, a node
 // whose box the ray misses is outside for the whole ray first. Returns true when the visitor
 // stopped or nothing further can be seen.
 template <class Visit, class Source>
-bool drive(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, const Source *src) {
+bool drive_lists(const Scene *s, Scratch *w, const Ray &ray, real tmax, const Source *src, Stretches<Visit> &out) {
     const Accel *A = s->accel;
-    if (s->root < 0) return true;
-    ray_begin(s, w);
-    Stretches<Visit> out(s, w, ray, tmax, self, visit);
     real ta = 0, tb = 0;
     if (!src || !src->span(&ta, &tb) || !(tb > 0) || !(ta < tmax)) {
         if (A->bounds && A->g.n[0] == 0) {
@@ -5190,6 +5213,92 @@ bool drive(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visi
     if (ta > 0 && out(A->outer, 0, ta)) return true;
     if (src->walk(out, ta, tb)) return true;
     return tb < tmax && out(A->outer, tb, tmax);
+}
+
+// The part [*ta, *tb] of the ray inside the grid's box; false when none.
+bool region_clip(const RegionGrid &g, const double *o, const double *d, double *ta, double *tb) {
+    for (int a = 0; a < 3; a++) {
+        if (d[a] == 0) {
+            if (o[a] < g.lo[a] || o[a] > g.hi[a]) return false;
+            continue;
+        }
+        double t0 = (g.lo[a] - o[a]) / d[a], t1 = (g.hi[a] - o[a]) / d[a];
+        if (t0 > t1) {
+            double x = t0;
+            t0 = t1;
+            t1 = x;
+        }
+        if (t0 > *ta) *ta = t0;
+        if (t1 < *tb) *tb = t1;
+    }
+    return *ta <= *tb;
+}
+
+// Set the bits of the grid's cells that the part [ta, tb] (inside its box) of the ray crosses,
+// cell by cell (Amanatides and Woo's walk).
+void region_walk(const RegionGrid &g, const double *o, const double *d, double ta, double tb, unsigned *bits) {
+    int n = g.n, c[3], step[3];
+    double next[3], delta[3];
+    for (int a = 0; a < 3; a++) {
+        double f = floor((o[a] + d[a] * ta - g.lo[a]) / g.h[a]);
+        c[a] = f < 0 ? 0 : f >= n ? n - 1 : (int)f;
+        step[a] = d[a] > 0 ? 1 : d[a] < 0 ? -1 : 0;
+        next[a] = step[a] ? (g.lo[a] + (c[a] + (step[a] > 0)) * g.h[a] - o[a]) / d[a] : HUGE_VAL;
+        delta[a] = step[a] ? g.h[a] / fabs(d[a]) : 0;
+    }
+    for (;;) {
+        int id = g.base + c[0] + n * (c[1] + n * c[2]);
+        bits[id >> 5] |= 1u << (id & 31);
+        int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
+        if (!(next[a] <= tb)) break;
+        c[a] += step[a];
+        if (c[a] < 0 || c[a] >= n) break;
+        next[a] += delta[a];
+    }
+}
+
+// Image sequences (10b): set in the record of the pixel being traced the regions that the
+// part (0, end] of the ray crosses: the fine grid's cells where it is in the fine grid's box,
+// the coarse grid's cells where it is in the coarse grid's box only, and bit 0 where it is
+// outside both. A walk rounded past a corner of cells misses a sliver of a cell there; the boxes
+// of what changed are widened by more than that (coh_mark).
+void region_note(Scratch *w, const Ray &ray, real end) {
+    const Regions &R = *w->rg;
+    unsigned *bits = w->rbits;
+    double o[3] = {(double)ray.o.x, (double)ray.o.y, (double)ray.o.z};
+    double d[3] = {(double)ray.d.x, (double)ray.d.y, (double)ray.d.z};
+    double a1 = 0, b1 = (double)end, a0, b0;
+    bool in1 = region_clip(R.g[1], o, d, &a1, &b1);
+    if (!in1 || a1 > 0 || b1 < (double)end) bits[0] |= 1u;
+    if (!in1) return;
+    a0 = a1;
+    b0 = b1;
+    if (!region_clip(R.g[0], o, d, &a0, &b0)) {
+        region_walk(R.g[1], o, d, a1, b1, bits);
+        return;
+    }
+    region_walk(R.g[0], o, d, a0, b0, bits);
+    if (a1 < a0) region_walk(R.g[1], o, d, a1, a0, bits);
+    if (b0 < b1) region_walk(R.g[1], o, d, b0, b1, bits);
+}
+
+// The one way a ray reaches the accelerated scene (drive_lists); a pixel being traced for an
+// image sequence notes the part of the ray the lists were evaluated on, up to where the visitor
+// stopped: what it brought back depends on nothing else.
+template <class Visit, class Source>
+bool drive(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, const Source *src) {
+    if (s->root < 0) {
+        if (w->rbits) region_note(w, ray, tmax);
+        return true;
+    }
+    ray_begin(s, w);
+    Stretches<Visit> out(s, w, ray, tmax, self, visit);
+    bool done = drive_lists(s, w, ray, tmax, src, out);
+    if (w->rbits) {
+        real e = visit_end(visit);
+        region_note(w, ray, e < out.at ? e : out.at);
+    }
+    return done;
 }
 
 // All hits along the ray in (0, tmax), by the reference or the accelerated path.
@@ -5233,6 +5342,7 @@ bool shadow_probe(const Scene *s, Scratch *w, const Ray &ray, real tmax, int sel
     probe.f = cmake(1, 1, 1);
     eval_list(s, A, w, ray, A->g.voxel[voxel_index(A->g, ix)], ta, tb, tmax, self, probe);
     if (!czero(probe.f)) return false;
+    if (w->rbits) region_note(w, ray, tb);  // (the whole ray lets through no more than (ta, tb])
     w->k.cache += 1;
     visit.f = probe.f;
     return true;
@@ -6610,13 +6720,37 @@ struct Sample {
 
 struct Job;
 
+// Image sequences (10b): a frame's records are of every unit of the image, or of a sample of
+// them (every 8th pixel of every 8th row; every 4th band with undersampling) that tells the
+// next frame whether recording all is worth it.
+enum { COH_NONE, COH_ALL, COH_SAMPLE };
+const size_t COH_BLOCK = 32;  // units whose records lie interleaved, word by word
+// Word i of unit u's record, in records of `words` words.
+inline size_t coh_word(size_t u, int i, int words) {
+    return (u / COH_BLOCK * (size_t)words + (size_t)i) * COH_BLOCK + u % COH_BLOCK;
+}
+inline bool coh_sampled(size_t u, int width, bool bands) {
+    return bands ? u % 4 == 0 : (u % (size_t)width) % 8 == 0 && (u / (size_t)width) % 8 == 0;
+}
+// A sampled unit's place among the sample's records, and their number.
+inline size_t coh_slot(size_t u, int width, bool bands) {
+    return bands ? u / 4 : u / (size_t)width / 8 * (((size_t)width + 7) / 8) + u % (size_t)width / 8;
+}
+inline size_t coh_slots(size_t units, int width, bool bands) {
+    return bands ? (units + 3) / 4 : (units / (size_t)width + 7) / 8 * (((size_t)width + 7) / 8);
+}
+
 struct Worker {
     Job *job;
     Scratch w;
     Tracer tr;
     Array<Sample> cache;  // undersampling: the samples of the current tile
     pray_status st;
+    double kept, traced;  // image sequences: pixels taken over from the frame before, and traced
+    unsigned *rtemp;      // ... the record of the unit being traced
+    size_t unit;          // ... and its number
 };
+
 
 struct Job {
     pray_ctx *c;
@@ -6631,7 +6765,41 @@ struct Job {
     double adaptive;  // undersampling threshold, 0 = off
     int step;         // undersampling: spacing of the coarse lattice, in samples
     int tile;         // undersampling: side of a tile, in samples (a multiple of step)
+    // image sequences (10b): per unit of the image (a pixel; with undersampling a band) whether
+    // it is traced (NULL: every one) and its record (NULL: none kept); the frame before's pixels
+    const unsigned char *redo;
+    unsigned *rec;
+    const Regions *rg;
+    const float *prev;
+    int sample;  // only the sample's records are kept (coh_sampled)
+    size_t units;
 };
+
+// Image sequences (10b): unit u of the image (a pixel; a band with undersampling) is taken over
+// from the frame before (true); else it is traced, into its record emptied (when kept).
+bool unit_kept(Worker &k, size_t u) {
+    const Job *job = k.job;
+    if (job->redo && !job->redo[u]) return true;
+    k.w.rbits = NULL;
+    if (job->rec && (!job->sample || coh_sampled(u, job->s->width, job->adaptive > 0))) {
+        k.w.rbits = k.rtemp;
+        k.unit = u;
+        memset(k.rtemp, 0, sizeof(unsigned) * (size_t)job->rg->words);
+    }
+    return false;
+}
+
+// The unit traced is recorded: its record goes into the records of the image, which hold word
+// i of the records of COH_BLOCK units together (so that a frame reads the words it needs
+// only, a block of units after another; coh_word).
+void unit_done(Worker &k) {
+    const Job *job = k.job;
+    if (!k.w.rbits) return;
+    int nw = job->rg->words;
+    size_t u = job->sample ? coh_slot(k.unit, job->s->width, job->adaptive > 0) : k.unit;
+    for (int i = 0; i < nw; i++) job->rec[coh_word(u, i, nw)] = k.rtemp[i];
+    k.w.rbits = NULL;
+}
 
 // Undersampling works on the image's samples (antialias x antialias per pixel, in one lattice
 // over the whole image): a coarse lattice of them is traced, every 4th pixel, or with antialias
@@ -6706,6 +6874,12 @@ void put_pixel(const Job *job, int i, int j, pray_rgb c) {
     px[0] = (float)c.r;
     px[1] = (float)c.g;
     px[2] = (float)c.b;
+}
+
+// Pixels i0 .. i1-1 of row j as the frame before had them (image sequences; the whole image).
+void put_kept(const Job *job, int i0, int i1, int j) {
+    memcpy(job->out.rgb + out_index(job, i0, j) * 3, job->prev + ((size_t)j * job->s->width + i0) * 3,
+           sizeof(float) * 3 * (size_t)(i1 - i0));
 }
 
 // The per-pixel outputs of pixel (i, j): pray_intersect's first hit on the ray through its centre
@@ -6945,20 +7119,33 @@ void render_band(Worker &k, int band) {
     if (!job->out.rgb) return;
     if (job->adaptive > 0) {  // (the whole band: its tiles are sampled from the top)
         int b0 = band * job->band_rows, b1 = b0 + job->band_rows;
+        double px = (double)(y1 - y0) * (x1 - x0);
+        if (unit_kept(k, (size_t)band)) {  // (a band depends on nothing outside it)
+            for (int j = y0; j < y1; j++) put_kept(job, x0, x1, j);
+            k.kept += px;
+            return;
+        }
+        k.traced += px;
         adaptive_band(k, b0, b1 < s->height ? b1 : s->height);
+        unit_done(k);
         return;
     }
     Ray rays[RAY_BATCH];
     for (int j = y0; j < y1 && !cancelled(job->c); j++) {
         set_row_background(k, j);
+        size_t u = (size_t)j * s->width;  // (image sequences: the whole image is rendered)
         if (s->antialias > 1) {  // pixel() makes each row of samples ahead
-            for (int i = x0; i < x1; i++) put_pixel(job, i, j, pixel(k, i, j));
+            for (int i = x0; i < x1; i++)
+                if (unit_kept(k, u + i)) put_kept(job, i, i + 1, j), k.kept++;
+                else put_pixel(job, i, j, pixel(k, i, j)), k.traced++, unit_done(k);
             continue;
         }
         for (int i0 = x0; i0 < x1; i0 += RAY_BATCH) {
             int n = x1 - i0 < RAY_BATCH ? x1 - i0 : RAY_BATCH;
             for (int q = 0; q < n; q++) rays[q] = sample_ray(s, i0 + q, j, 0, 0);
-            for (int q = 0; q < n; q++) put_pixel(job, i0 + q, j, trace(k.tr, rays[q], 1, -1, RAY_PRIMARY));
+            for (int q = 0; q < n; q++)
+                if (unit_kept(k, u + i0 + q)) put_kept(job, i0 + q, i0 + q + 1, j), k.kept++;
+                else put_pixel(job, i0 + q, j, trace(k.tr, rays[q], 1, -1, RAY_PRIMARY)), k.traced++, unit_done(k);
         }
     }
 }
@@ -6987,8 +7174,30 @@ void worker_main(void *arg) {
 
 Worker &worker_at(char *buf, size_t stride, int i) { return *(Worker *)(buf + LINE_SLACK + (size_t)i * stride); }
 
-// Render the rectangle r of the image into the buffers (stride set).
-pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const pray_buffers &out) {
+// What a frame of an image sequence takes over from the frame before (10b): per unit of the image
+// (a pixel; with undersampling a band of rows) whether it is traced again (redo NULL: all
+// are), its record (rec NULL: none is kept) over the regions rg, and the frame before's pixels.
+struct CohPlan {
+    unsigned char *redo;
+    unsigned *rec;
+    const Regions *rg;
+    const float *prev;
+    int sample;  // only a sample of the units is recorded (coh_sampled)
+    int record;  // what is recorded: COH_NONE, COH_ALL, COH_SAMPLE (10b)
+    size_t units;
+};
+
+// The rows of a band of the render driver: a band of tiles with undersampling.
+int band_rows_of(const pray_ctx *c, const Scene *s, bool rgb) {
+    int step = s->antialias * (s->antialias > 1 ? ADAPT_PIXELS_AA : ADAPT_PIXELS);
+    int tile = step * (ADAPT_TILE > step ? ADAPT_TILE / step : 1);
+    return rgb && c->cur.opt.v[OPT_ADAPTIVE] > 0 ? tile / s->antialias : 4;
+}
+
+// Render the rectangle r of the image into the buffers (stride set); `plan`: what an image
+// sequence's frame takes over from the one before (NULL: nothing).
+pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const pray_buffers &out,
+                         const CohPlan *plan) {
     int nt = opt_int(c, OPT_THREADS);
     if (nt <= 0) nt = cpu_count();
     if (!PRAY_HAS_THREADS || nt < 1) nt = 1;
@@ -7002,7 +7211,15 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
     job.adaptive = out.rgb ? c->cur.opt.v[OPT_ADAPTIVE] : 0;
     job.step = s->antialias * (s->antialias > 1 ? ADAPT_PIXELS_AA : ADAPT_PIXELS);
     job.tile = job.step * (ADAPT_TILE > job.step ? ADAPT_TILE / job.step : 1);
-    job.band_rows = job.adaptive > 0 ? job.tile / s->antialias : 4;
+    job.band_rows = band_rows_of(c, s, out.rgb != NULL);
+    if (plan) {
+        job.redo = plan->redo;
+        job.rec = plan->rec;
+        job.rg = plan->rg;
+        job.prev = plan->prev;
+        job.sample = plan->sample;
+        job.units = plan->units;
+    }
     for (int i = 0; job.adaptive > 0 && i < s->prims.n; i++)  // undersampling looks into textures
         if (!model_pyramids(c, (pray_model *)s->prims[i].mat)) return c->status;  // (marks the parts done)
     job.band0 = r.y / job.band_rows;
@@ -7034,6 +7251,8 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         else if (job.adaptive > 0 && !k.cache.reserve(c, (job.tile + 1) * (job.tile + 1))) st = c->status;
         k.tr.s = s;
         k.tr.w = &k.w;
+        k.w.rg = job.rg;
+        if (job.rec && !(k.rtemp = (unsigned *)thread_alloc(c, sizeof(unsigned) * (size_t)job.rg->words))) st = c->status;
         args[made] = &k;
     }
     if (st == PRAY_OK) {
@@ -7061,10 +7280,16 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         c->stats.rays_lightbuf += k.lbuf;
         c->stats.rays_eyebuf += k.ebuf;
         c->stats.rays_shadowcache += k.cache;
+        if (job.redo) {
+            c->stats.pixels_reused += worker_at(wbuf, stride, i).kept;
+            c->stats.pixels_retraced += worker_at(wbuf, stride, i).traced;
+        }
         scratch_release(c, &worker_at(wbuf, stride, i).w);
+        mem_free(c, worker_at(wbuf, stride, i).rtemp);
         worker_at(wbuf, stride, i).cache.release(c);
     }
     if (out.rgb) c->stats.rays_primary_full += (double)r.width * r.height * s->antialias * s->antialias;
+    if (job.redo && st == PRAY_OK) c->stats.frames_coherent += 1;
     c->stats.threads = nt;
     mem_free(c, wbuf);
     mem_free(c, args);
@@ -7072,6 +7297,508 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
     return st;
 }
 
+// =============================================================================================
+// [SECTION] 10b Image sequences (thesis 3.7): what changed between frames, what to trace again
+// =============================================================================================
+// A program's frame with the camera, lights, image and options of the frame before takes over
+// every pixel whose rays cannot have met anything that changed. While a pixel is traced, the
+// ray driver notes in the pixel's record the regions of space its rays crossed (region_note,
+// 9b.8): cells of a fine grid over the scene's finite parts, of a coarse grid around it, and
+// bit 0 for all space beyond. The next frame compares its prepared scene with the frame
+// before's, by value (coh_diff), and marks the cells that the boxes of what changed reach, in
+// both scenes (coh_mark). A pixel whose record meets no marked cell has the same rays and the
+// same colour; the others are traced again. With undersampling the unit is the band of rows
+// the render driver samples alone. The records of a frame are at most COH_BYTES; a frame that
+// cannot have them is traced in full (docs/acceleration.md, "Image sequences").
+const double COH_BYTES = 64.0 * 1048576;  // the records of a frame at most
+const int COH_CELLS = 12;                 // cells along an axis at most (4 at least)
+
+struct Coherence {
+    int valid;        // `prev`, `opt` and `hull` are the last frame's
+    Scene prev;       // its prepared scene, without the acceleration structure
+    Options opt;      // its options
+    Box hull;         // the box of its finite parts
+    int recorded;     // `rec` and `img` are the last frame's too: COH_ALL or COH_SAMPLE
+    Regions rg;       // the cells its records are made of
+    unsigned *rec;    // units x rg.words (coh_word)
+    size_t units;     // pixels, or with undersampling bands
+    size_t recbytes;  // bytes at rec: of all units' records, or of the sample's (coh_slot)
+    float *img;       // its pixels, RGB
+    size_t imgsize;   // floats at img
+};
+
+void coh_release(pray_ctx *c) {
+    Coherence *h = c->coh;
+    if (!h) return;
+    if (h->valid) scene_release(c, &h->prev);
+    mem_free(c, h->rec);
+    mem_free(c, h->img);
+    mem_free(c, h);
+    c->coh = NULL;
+}
+
+// ---- comparing two prepared scenes by value ----
+inline bool same_bytes(const void *a, const void *b, size_t n) { return memcmp(a, b, n) == 0; }
+inline bool same_real(real a, real b) { return same_bytes(&a, &b, sizeof a); }
+inline bool same_r3(R3 a, R3 b) { return same_real(a.x, b.x) && same_real(a.y, b.y) && same_real(a.z, b.z); }
+inline bool same_rgb_bits(pray_rgb a, pray_rgb b) { return same_bytes(&a, &b, sizeof a); }
+
+bool tex_same(const pray_texture *a, const pray_texture *b) {
+    if (a == b) return true;
+    return a && b && a->w == b->w && a->hgt == b->hgt &&
+           same_bytes(a->rgb, b->rgb, sizeof(float) * 3 * (size_t)a->w * (size_t)a->hgt);
+}
+
+// Two models alike in every coefficient, texture (its texels) and part.
+bool model_same(const pray_model *a, const pray_model *b) {
+    if (a == b) return true;
+    if (!a || !b || a->kind != b->kind || a->has_exponent != b->has_exponent || a->has_index != b->has_index)
+        return false;
+    const pray_rgb *x[7] = {&a->diffuse, &a->specular, &a->ambient, &a->emit, &a->reflect, &a->transmit, &a->factor};
+    const pray_rgb *y[7] = {&b->diffuse, &b->specular, &b->ambient, &b->emit, &b->reflect, &b->transmit, &b->factor};
+    for (int i = 0; i < 7; i++)
+        if (!same_rgb_bits(*x[i], *y[i])) return false;
+    double u[5] = {a->exponent, a->index, a->amount, a->dx, a->dy}, v[5] = {b->exponent, b->index, b->amount, b->dx, b->dy};
+    return same_bytes(u, v, sizeof u) && tex_same(a->tex, b->tex) && model_same(a->a, b->a) && model_same(a->b, b->b);
+}
+
+// A primitive's surface, its texture coordinates and its model (not its number, nor its twins).
+bool prim_same(const Prim &a, const Prim &b) {
+    if (a.kind != b.kind || a.axis != b.axis || a.map != b.map || !a.tm != !b.tm) return false;
+    if (!same_r3(a.p, b.p) || !same_r3(a.n, b.n) || !same_real(a.r, b.r) || !same_real(a.r2, b.r2) ||
+        !same_real(a.d, b.d) || !same_bytes(&a.box, &b.box, sizeof a.box))
+        return false;
+    if (a.tm && (!same_r3(a.tm->u, b.tm->u) || !same_r3(a.tm->v, b.tm->v) || a.tm->mirrored != b.tm->mirrored))
+        return false;
+    return model_same(a.mat, b.mat);
+}
+
+inline unsigned fnv(unsigned h, const void *p, size_t n) {
+    const unsigned char *b = (const unsigned char *)p;
+    for (size_t i = 0; i < n; i++) h = (h ^ b[i]) * 16777619u;
+    return h;
+}
+
+// Per element of a prepared scene (numbered in post-order, so a subtree's primitives and nodes
+// are runs of numbers): a hash of its value, and per node its subtree's first primitive and its
+// numbers of primitives and nodes.
+struct SceneIx {
+    unsigned *ph, *nh;
+    int *p0, *pc, *nc;
+};
+
+bool scene_ix(pray_ctx *c, const Scene *s, SceneIx *x) {
+    size_t np = (size_t)s->prims.n + 1, nn = (size_t)s->nodes.n + 1;
+    x->ph = (unsigned *)mem_alloc(c, sizeof(unsigned) * np);
+    x->nh = x->ph ? (unsigned *)mem_alloc(c, sizeof(unsigned) * nn) : NULL;
+    x->p0 = x->nh ? (int *)mem_alloc(c, sizeof(int) * 3 * nn) : NULL;
+    if (!x->p0) return false;
+    x->pc = x->p0 + nn;
+    x->nc = x->pc + nn;
+    for (int i = 0; i < s->prims.n; i++) {
+        const Prim &q = s->prims[i];
+        unsigned h = fnv(2166136261u, &q.kind, sizeof q.kind);
+        real v[8] = {q.p.x, q.p.y, q.p.z, q.n.x, q.n.y, q.n.z, q.r, q.d};
+        h = fnv(h, v, sizeof v);
+        if (q.mat->kind == M_FLAT) h = fnv(h, &q.mat->diffuse, sizeof(pray_rgb) * 6);
+        x->ph[i] = h;
+    }
+    for (int j = 0; j < s->nodes.n; j++) {  // (children before their parents)
+        const Node &nd = s->nodes[j];
+        unsigned h = fnv(2166136261u, &nd.op, sizeof nd.op);
+        int pc = 0, nc = 1;
+        for (int k = 0; k < nd.n; k++) {
+            int e = s->kids[nd.k0 + k], i = e_index(e);
+            unsigned kh = e_is_node(e) ? x->nh[i] + 1 : x->ph[i];
+            h = fnv(h, &kh, sizeof kh);
+            if (k == 0) x->p0[j] = e_is_node(e) ? x->p0[i] : i;
+            pc += e_is_node(e) ? x->pc[i] : 1;
+            nc += e_is_node(e) ? x->nc[i] : 0;
+        }
+        x->nh[j] = h;
+        x->pc[j] = pc;
+        x->nc[j] = nc;
+    }
+    return true;
+}
+
+void scene_ix_free(pray_ctx *c, SceneIx *x) {
+    mem_free(c, x->ph);
+    mem_free(c, x->nh);
+    mem_free(c, x->p0);
+}
+
+struct CohDiff {
+    const Scene *s[2];  // the frame before, this frame
+    SceneIx x[2];
+    Array<int> pairs;   // twins' numbers (surf) of the primitives found alike: before, now
+};
+
+inline unsigned elem_hash(const CohDiff &d, int w, int e) { return e_is_node(e) ? d.x[w].nh[e_index(e)] + 1 : d.x[w].ph[e_index(e)]; }
+
+// Element a of the frame before and b of this frame are alike: the same tree of the same
+// primitives, numbered alike. Their primitives' twins are noted (coh_twins).
+bool elem_same(pray_ctx *c, CohDiff &d, int a, int b) {
+    if (a < 0 || b < 0) return a == b;
+    if (e_is_node(a) != e_is_node(b) || elem_hash(d, 0, a) != elem_hash(d, 1, b)) return false;
+    const Scene *A = d.s[0], *B = d.s[1];
+    int pa = e_index(a), pb = e_index(b), np = 1, na = 0, nb = 0, nn = 0;
+    if (e_is_node(a)) {
+        const SceneIx &x = d.x[0], &y = d.x[1];
+        if (x.pc[pa] != y.pc[pb] || x.nc[pa] != y.nc[pb]) return false;
+        np = x.pc[pa];
+        nn = x.nc[pa];
+        na = pa - nn + 1;
+        nb = pb - nn + 1;
+        pa = x.p0[pa];
+        pb = y.p0[pb];
+    }
+    for (int k = 0; k < np; k++)
+        if (!prim_same(A->prims[pa + k], B->prims[pb + k])) return false;
+    for (int k = 0; k < nn; k++) {
+        const Node &u = A->nodes[na + k], &v = B->nodes[nb + k];
+        if (u.op != v.op || u.n != v.n) return false;
+        for (int i = 0; i < u.n; i++) {
+            int ea = A->kids[u.k0 + i], eb = B->kids[v.k0 + i];
+            if (e_is_node(ea) != e_is_node(eb)) return false;
+            int ra = e_index(ea) - (e_is_node(ea) ? na : pa), rb = e_index(eb) - (e_is_node(eb) ? nb : pb);
+            if (ra != rb) return false;
+        }
+    }
+    for (int k = 0; k < np; k++)
+        if (!d.pairs.push(c, A->prims[pa + k].surf) || !d.pairs.push(c, B->prims[pb + k].surf)) return false;
+    return true;
+}
+
+// The cells of grid g that box b (widened by eps) reaches, set in `dirty`; false when b
+// reaches out of the grid's box.
+bool grid_mark(const RegionGrid &g, unsigned *dirty, const Box &b, const double *eps) {
+    int lo[3], hi[3];
+    bool inside = true, none = false;
+    for (int a = 0; a < 3; a++) {
+        double l = (double)b.lo[a] - eps[a], u = (double)b.hi[a] + eps[a];
+        if (l < g.lo[a] || u > g.hi[a]) inside = false;
+        if (u < g.lo[a] || l > g.hi[a]) none = true;
+        double fl = floor((l - g.lo[a]) / g.h[a]), fu = floor((u - g.lo[a]) / g.h[a]);
+        lo[a] = fl < 0 ? 0 : fl >= g.n ? g.n - 1 : (int)fl;
+        hi[a] = fu < 0 ? 0 : fu >= g.n ? g.n - 1 : (int)fu;
+    }
+    for (int z = lo[2]; z <= hi[2] && !none; z++)
+        for (int y = lo[1]; y <= hi[1]; y++)
+            for (int x = lo[0]; x <= hi[0]; x++) {
+                int id = g.base + x + g.n * (y + g.n * z);
+                dirty[id >> 5] |= 1u << (id & 31);
+            }
+    return inside;
+}
+
+// Mark the regions that box b within box `clip` reaches (an empty box is nothing): the fine
+// grid's cells, the coarse grid's when it reaches out of the fine grid's box, and bit 0 when
+// out of the coarse grid's box. The box is widened by an eighth of a fine cell and by rounding.
+void coh_mark(const Regions &R, unsigned *dirty, const Box &box, const Box &clip) {
+    Box b = box;
+    box_clip(&b, clip);
+    if (box_empty(b)) return;
+    double eps[3];
+    for (int a = 0; a < 3; a++)
+        eps[a] = R.g[0].h[a] / 8 + 1024 * REAL_EPS * (fabs(R.g[1].lo[a]) + fabs(R.g[1].hi[a]));
+    if (!grid_mark(R.g[0], dirty, b, eps) && !grid_mark(R.g[1], dirty, b, eps)) dirty[0] |= 1u;
+}
+
+inline const Box *elem_box_or_all(const Scene *s, int e, Box *all) {
+    if (e >= 0) return &elem_box(s, e);
+    *all = box_all();
+    return all;
+}
+
+// Mark in `dirty` (coh_mark) where the frame before and this frame may differ: a subtree that
+// is not alike in both marks its boxes in both. The membership of a node in space follows from
+// its children's, so a node of the same operation and number of children passes the question
+// on to each pair of children, within the hull of the two nodes' boxes (outside it, the node is
+// outside in both frames); a union (or a difference with the same first child) whose children
+// were added or removed pairs those alike in order, and marks the others. Pairs are taken in
+// order, so primitives alike keep their order (ties at one distance are taken in the order of
+// primitive numbers). False when out of memory.
+bool coh_diff(pray_ctx *c, CohDiff &d, const Regions &g, unsigned *dirty) {
+    const Scene *A = d.s[0], *B = d.s[1];
+    Array<int> st;
+    Array<Box> clips;  // per pair on the stack: where its difference lies
+    st.init();
+    clips.init();
+    bool ok = st.push(c, A->root) && st.push(c, B->root) && clips.push(c, box_all());
+    const int LOOK = 256;  // children looked ahead for one alike
+    while (ok && st.n) {
+        int b = st[--st.n], a = st[--st.n];
+        Box clip = clips[--clips.n];
+        if (elem_same(c, d, a, b)) continue;
+        if (c->status != PRAY_OK) break;
+        if (a >= 0 && b >= 0 && e_is_node(a) && e_is_node(b)) {
+            const Node &u = A->nodes[e_index(a)], &v = B->nodes[e_index(b)];
+            if (u.op == v.op && u.n == v.n) {
+                Box in = u.box;
+                box_hull(&in, v.box);
+                box_clip(&in, clip);
+                for (int k = 0; k < u.n && ok; k++)
+                    ok = st.push(c, A->kids[u.k0 + k]) && st.push(c, B->kids[v.k0 + k]) && clips.push(c, in);
+                continue;
+            }
+            int k0 = u.op == O_DIFF ? 1 : 0;
+            if (u.op == v.op && (u.op == O_UNION || (u.op == O_DIFF && elem_same(c, d, A->kids[u.k0], B->kids[v.k0])))) {
+                int j = k0;
+                for (int i = k0; i < u.n && ok; i++) {
+                    int ea = A->kids[u.k0 + i], m = j, end = v.n < j + LOOK ? v.n : j + LOOK;
+                    unsigned ha = elem_hash(d, 0, ea);
+                    for (; m < end; m++)
+                        if (elem_hash(d, 1, B->kids[v.k0 + m]) == ha && elem_same(c, d, ea, B->kids[v.k0 + m])) break;
+                    if (m == end) {
+                        coh_mark(g, dirty, elem_box(A, ea), clip);
+                        continue;
+                    }
+                    for (; j < m; j++) coh_mark(g, dirty, elem_box(B, B->kids[v.k0 + j]), clip);
+                    j = m + 1;
+                }
+                for (; j < v.n; j++) coh_mark(g, dirty, elem_box(B, B->kids[v.k0 + j]), clip);
+                continue;
+            }
+        }
+        Box all;
+        coh_mark(g, dirty, *elem_box_or_all(A, a, &all), clip);
+        coh_mark(g, dirty, *elem_box_or_all(B, b, &all), clip);
+    }
+    st.release(c);
+    clips.release(c);
+    return ok && c->status == PRAY_OK;
+}
+
+int pair_cmp(const void *pa, const void *pb) {
+    const int *a = (const int *)pa, *b = (const int *)pb;
+    return a[0] != b[0] ? (a[0] < b[0] ? -1 : 1) : a[1] != b[1] ? (a[1] < b[1] ? -1 : 1) : 0;
+}
+
+// Primitives alike are twins (one surface, 7) of each other in both frames or in neither:
+// whether a shadow ray leaving one ignores another must not change.
+bool coh_twins(CohDiff &d) {
+    int n = d.pairs.n / 2;
+    for (int pass = 0; pass < 2; pass++) {
+        qsort(d.pairs.p, (size_t)n, 2 * sizeof(int), pair_cmp);
+        for (int i = 1; i < n; i++)
+            if (d.pairs[2 * i] == d.pairs[2 * i - 2] && d.pairs[2 * i + 1] != d.pairs[2 * i - 1]) return false;
+        for (int i = 0; i < n; i++) {  // (the other way round)
+            int t = d.pairs[2 * i];
+            d.pairs[2 * i] = d.pairs[2 * i + 1];
+            d.pairs[2 * i + 1] = t;
+        }
+    }
+    return true;
+}
+
+// ---- the frame's plan ----
+// The camera, lights, image and the bounds of every ray's worth (Scene::most) are the same.
+bool coh_same_view(const Scene *a, const Scene *b) {
+    if (a->parallel != b->parallel || a->width != b->width || a->height != b->height || a->depth != b->depth ||
+        a->shadows != b->shadows || a->antialias != b->antialias || a->maxrays != b->maxrays ||
+        a->lights.n != b->lights.n || (a->root < 0) != (b->root < 0))
+        return false;
+    const R3 *u[9] = {&a->eye, &a->point, &a->cx, &a->cy, &a->dir, &a->keye, &a->kpoint, &a->kcx, &a->kcy};
+    const R3 *v[9] = {&b->eye, &b->point, &b->cx, &b->cy, &b->dir, &b->keye, &b->kpoint, &b->kcx, &b->kcy};
+    for (int i = 0; i < 9; i++)
+        if (!same_r3(*u[i], *v[i])) return false;
+    for (int i = 0; i < a->lights.n; i++) {
+        const Light &p = a->lights[i], &q = b->lights[i];
+        if (p.point != q.point || !same_r3(p.v, q.v) || !same_rgb_bits(p.intensity, q.intensity)) return false;
+    }
+    return same_rgb_bits(a->bg_top, b->bg_top) && same_rgb_bits(a->bg_bottom, b->bg_bottom) &&
+           same_bytes(a->most, b->most, sizeof(double) * (size_t)(a->depth + 1)) && same_bytes(&a->cut, &b->cut, sizeof a->cut);
+}
+
+// The box of the scene's finite parts (empty when it has none).
+Box finite_hull(const Scene *s) {
+    Box h;
+    for (int l = 0; l < 3; l++) {
+        h.lo[l] = REAL_BIG;
+        h.hi[l] = -REAL_BIG;
+    }
+    for (int i = 0; i < s->prims.n; i++)
+        if (box_finite(s->prims[i].box) && !box_empty(s->prims[i].box)) box_hull(&h, s->prims[i].box);
+    for (int j = 0; j < s->nodes.n; j++)
+        if (box_finite(s->nodes[j].box) && !box_empty(s->nodes[j].box)) box_hull(&h, s->nodes[j].box);
+    return h;
+}
+
+// Regions around box b: the fine grid over b grown by `slack` times its largest side, as many
+// cells as the budget COH_BYTES gives `units` records (false when fewer than 4 a side); the
+// coarse grid of 4 cells a side over b grown on every side by its size (by half its largest
+// side at least).
+bool coh_regions(Regions *R, Box b, size_t units, double slack) {
+    if (box_empty(b))
+        for (int l = 0; l < 3; l++) b.lo[l] = -1, b.hi[l] = 1;
+    double m = 0;
+    for (int l = 0; l < 3; l++) m = (double)b.hi[l] - b.lo[l] > m ? (double)b.hi[l] - b.lo[l] : m;
+    if (!(m > 0)) m = 1;
+    const int COARSE = 4, BASE = 1 + COARSE * COARSE * COARSE;
+    int n = COH_CELLS;
+    while (n >= 4 && (double)units * ((BASE + n * n * n + 31) / 32) * sizeof(unsigned) > COH_BYTES) n--;
+    if (n < 4) return false;
+    R->words = (BASE + n * n * n + 31) / 32;
+    for (int k = 0; k < 2; k++) {
+        RegionGrid &g = R->g[k];
+        g.n = k ? COARSE : n;
+        g.base = k ? 1 : BASE;
+        for (int l = 0; l < 3; l++) {
+            double e = (double)b.hi[l] - b.lo[l], grow = k ? (e > m / 2 ? e : m / 2) : m * slack;
+            g.lo[l] = (double)b.lo[l] - grow;
+            g.hi[l] = (double)b.hi[l] + grow;
+            g.h[l] = (g.hi[l] - g.lo[l]) / g.n;
+            if (!(g.h[l] > 0) || !finite_num(g.h[l])) return false;
+        }
+    }
+    return true;
+}
+
+// The plan of a program's frame (CohPlan). A frame like the one before in all but its scene
+// (the same camera, lights, image and options) compares the two scenes (coh_diff). When the
+// one before has records of every unit and no more than half of them meet what changed, the
+// frame takes the others over, and traces and records those. Else it is traced in full, and
+// recorded in full when the sample of the records of the frame before says that no more than
+// half of a frame would be traced again; otherwise (and in a frame unlike the one before) only
+// the sample is recorded, at a cost of a per cent or two of its rays. So an animation in which
+// everything moves, or the camera, and a program's single frame are never recorded in full.
+// A frame traced in full gets new cells, over this frame, the one before and where things go
+// on moving. Records that the budget (COH_BYTES) or the context's memory cap has no room for
+// (they may take half of what the cap leaves) are not made: the frame is traced in full. An
+// allocation that fails is out of memory, as anywhere else.
+pray_status coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
+    memset(plan, 0, sizeof *plan);
+    pray_status st0 = c->status;
+    Coherence *h = c->coh;
+    if (!h) h = c->coh = (Coherence *)mem_zalloc(c, sizeof(Coherence));
+    if (!h) return c->status;
+    bool bands = c->cur.opt.v[OPT_ADAPTIVE] > 0;
+    size_t units = (size_t)s->width * s->height;
+    if (bands) {
+        int rows = band_rows_of(c, s, true);
+        units = (size_t)((s->height + rows - 1) / rows);
+    }
+    Options o = c->cur.opt;
+    o.v[OPT_THREADS] = h->opt.v[OPT_THREADS];  // (the image does not depend on them)
+    bool same = h->valid && same_bytes(o.v, h->opt.v, sizeof o.v) && coh_same_view(&h->prev, s);
+    bool tried = same && h->recorded != COH_NONE && h->units == units;
+    unsigned *dirty = tried ? (unsigned *)mem_zalloc(c, sizeof(unsigned) * 2 * (size_t)h->rg.words) : NULL;
+    bool known = false;  // where the frames differ
+    if (dirty) {
+        CohDiff d;
+        d.s[0] = &h->prev;
+        d.s[1] = s;
+        d.pairs.init();
+        bool ix0 = scene_ix(c, d.s[0], &d.x[0]), ix1 = ix0 && scene_ix(c, s, &d.x[1]);
+        known = ix1 && coh_diff(c, d, h->rg, dirty) && coh_twins(d);
+        if (ix0) scene_ix_free(c, &d.x[0]);
+        if (ix1) scene_ix_free(c, &d.x[1]);
+        d.pairs.release(c);
+    }
+    bool all = h->recorded == COH_ALL;
+    if (known && all) plan->redo = (unsigned char *)mem_alloc(c, units);
+    int record = COH_SAMPLE;
+    if (known) {  // a unit is traced again when its record meets a cell marked
+        size_t again = 0, n = 0;
+        int nw = h->rg.words, nd = 0;
+        for (int k = 0; k < nw; k++)  // (the words marked, in place at the front)
+            if (dirty[k]) dirty[nd] = dirty[k], dirty[nw + nd++] = (unsigned)k;
+        n = all ? units : coh_slots(units, s->width, bands);  // (records of all units, or the sample's)
+        unsigned char *hit = plan->redo ? plan->redo : (unsigned char *)mem_zalloc(c, n);
+        if (plan->redo) memset(hit, 0, n);
+        for (size_t b = 0; b < n && hit; b += COH_BLOCK) {  // (a block of units at a time)
+            size_t m = n - b < COH_BLOCK ? n - b : COH_BLOCK;
+            for (int k = 0; k < nd; k++) {
+                const unsigned *r = h->rec + coh_word(b, (int)dirty[nw + k], nw), x = dirty[k];
+                for (size_t j = 0; j < m; j++) hit[b + j] |= (r[j] & x) != 0;
+            }
+        }
+        for (size_t u = 0; u < n && hit; u++) again += hit[u];
+        if (hit != plan->redo) mem_free(c, hit);
+        if (2 * again <= n) record = COH_ALL;
+        if (2 * again > n || !plan->redo) {  // (most of it: traced in full)
+            mem_free(c, plan->redo);
+            plan->redo = NULL;
+        }
+    }
+    mem_free(c, dirty);
+    if (!plan->redo) {  // new cells: this frame, the one before and the next
+        Box b = finite_hull(s), cur = b;
+        if (h->valid && !box_empty(h->hull) && !box_empty(cur)) {
+            Box next;
+            for (int l = 0; l < 3; l++) {
+                next.lo[l] = 2 * cur.lo[l] - h->hull.lo[l];
+                next.hi[l] = 2 * cur.hi[l] - h->hull.hi[l];
+            }
+            box_hull(&b, h->hull);
+            if (!box_empty(next) && box_finite(next)) box_hull(&b, next);
+        }
+        // (a sample's fine grid reaches further: it tells whether the next frame is worth
+        // recording, also when something moves out of this frame's box)
+        Regions g;
+        memset(&g, 0, sizeof g);
+        if (!coh_regions(&g, b, units, record == COH_ALL ? 1.0 / 32 : 0.5)) record = COH_NONE;
+        size_t slots = record == COH_ALL ? units : coh_slots(units, s->width, bands);
+        size_t bytes = sizeof(unsigned) * (size_t)g.words * ((slots + COH_BLOCK - 1) / COH_BLOCK * COH_BLOCK);
+        if (record != COH_NONE && (!h->rec || h->recbytes != bytes)) {
+            mem_free(c, h->rec);
+            h->rec = NULL;
+            double img = record == COH_ALL ? sizeof(float) * 3.0 * (double)s->width * s->height : 0;
+            if (c->limit && (double)c->used + 2 * ((double)bytes + img) > (double)c->limit) record = COH_NONE;
+            else h->rec = (unsigned *)mem_alloc(c, bytes);
+            h->recbytes = h->rec ? bytes : 0;
+        }
+        h->rg = g;
+        h->units = units;
+        if (!h->rec) record = COH_NONE;
+    }
+    if (c->status != st0) {  // out of memory
+        mem_free(c, plan->redo);
+        memset(plan, 0, sizeof *plan);
+        return c->status;
+    }
+    h->recorded = COH_NONE;  // (until coh_keep)
+    plan->record = record;
+    if (record == COH_NONE) return PRAY_OK;
+    plan->rec = h->rec;
+    plan->units = units;
+    plan->rg = &h->rg;
+    plan->prev = plan->redo ? h->img : NULL;
+    plan->sample = record == COH_SAMPLE;
+    return PRAY_OK;
+}
+
+// After a program's frame: keep its scene (taken from *s, without its acceleration structure)
+// and options for the next, and its pixels when it was recorded.
+pray_status coh_keep(pray_ctx *c, Scene *s, const float *img, int recorded) {
+    Coherence *h = c->coh;
+    if (!h) return PRAY_OK;
+    size_t n = (size_t)s->width * s->height * 3;
+    if (recorded == COH_ALL && (!h->img || h->imgsize != n)) {
+        mem_free(c, h->img);
+        h->imgsize = 0;
+        if (c->limit && (double)c->used + 2.0 * sizeof(float) * n > (double)c->limit) recorded = COH_SAMPLE;
+        else if (!(h->img = (float *)mem_alloc(c, sizeof(float) * n))) return c->status;
+        else h->imgsize = n;
+    }
+    if (recorded == COH_ALL) memcpy(h->img, img, sizeof(float) * n);
+    if (h->valid) scene_release(c, &h->prev);
+    h->hull = finite_hull(s);
+    accel_release(c, s->accel);
+    s->accel = NULL;
+    h->prev = *s;
+    memset(s, 0, sizeof *s);
+    s->prims.init();
+    s->maps.init();
+    s->nodes.init();
+    s->lights.init();
+    s->kids.init();
+    h->opt = c->cur.opt;
+    h->valid = 1;
+    h->recorded = recorded;
+    return PRAY_OK;
+}
 } // namespace
 
 // =============================================================================================
@@ -8224,7 +8951,18 @@ pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, cons
     if (st == PRAY_OK) {
         c->stats.primitives = s.prims.n;
         c->stats.nodes = s.nodes.n;
-        st = render_scene(c, &s, r, out);
+        // a program's frame of the whole image, in colour only, may take over from the one before
+        bool coh = opt_int(c, OPT_COHERENCE) && c->running && s.accel && out.rgb && !out.primitive && !out.depth &&
+                   !out.normal && r.x == 0 && r.y == 0 && r.width == s.width && r.height == s.height &&
+                   out.stride == (size_t)s.width;
+        CohPlan plan;
+        memset(&plan, 0, sizeof plan);
+        if (coh) st = coh_plan(c, &s, &plan);
+        else coh_release(c);
+        if (st == PRAY_OK) st = render_scene(c, &s, r, out, &plan);
+        mem_free(c, plan.redo);
+        if (st == PRAY_OK && coh) st = coh_keep(c, &s, out.rgb, plan.record);
+        if (st != PRAY_OK || !coh) coh_release(c);
     }
     c->stats.time_prepare += t1 - t0;
     c->stats.time_render += clock_seconds() - t1;
@@ -11143,6 +11881,7 @@ pray_status pray_run_string(pray_ctx *c, const char *name, const char *text, siz
         if (nm[i] == '/' || nm[i] == '\\' || nm[i] == ':') c->run_dir_len = i + 1;
     c->running = 1;
     pray_status st = run_program(c, nm, text, len);
+    coh_release(c);
     c->running = 0;
     c->run_dir = NULL;
     c->run_dir_len = 0;
@@ -11336,6 +12075,26 @@ void print_stats(pray_ctx *c) {
             s.area_moves, s.set_inside, s.set_outside, s.checks, s.frozen_skips, s.intersection_tests,
             s.time_parse, s.time_prepare, s.time_render, s.threads, s.threads == 1 ? "" : "s", s.memory_peak,
             s.memory_parse, s.memory_run, s.memory_prepare, s.memory_accel, s.memory_render);
+    if (s.pixels_reused + s.pixels_retraced > 0)
+        fprintf(stderr, "coherence: %ld of %d frames took pixels over from the frame before: %.0f pixels reused, %.0f traced\n",
+                s.frames_coherent, pray_frames(c), s.pixels_reused, s.pixels_retraced);
+}
+
+// --stats: a line per frame of a program, before it is written: its time and the pixels it took
+// over from the frame before (option coherence).
+struct FrameLog {
+    pray_ctx *c;
+    pray_stats last;
+};
+pray_status log_frame(void *ud, const pray_image *img, const char *name) {
+    FrameLog *g = (FrameLog *)ud;
+    pray_stats s;
+    pray_stats_get(g->c, &s);
+    fprintf(stderr, "frame %s: prepare %.3f s, render %.3f s; pixels reused %.0f of %.0f\n", name,
+            s.time_prepare - g->last.time_prepare, s.time_render - g->last.time_render,
+            s.pixels_reused - g->last.pixels_reused, (double)img->width * img->height);
+    g->last = s;
+    return pray_write_image(g->c, img, name, (int)pray_option_get(g->c, "bits"));
 }
 
 // ---- parts of a render: --rows, --part, --frames (docs/distributed.md) ----
@@ -11845,6 +12604,10 @@ int main(int argc, char **argv) {
         render_id(sp.id, program, argc, argv);
         pray_set_frame(c, write_part, &sp);
     }
+    FrameLog flog;
+    memset(&flog, 0, sizeof flog);
+    flog.c = c;
+    if (stats && !sp.row1 && !sp.n) pray_set_frame(c, log_frame, &flog);
     the_ctx = c;
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);

@@ -177,7 +177,8 @@ void pray_cancel(pray_ctx *ctx);
    half a step of the output; 0: the whole ray tree), antialias (samples per pixel side, 1), adaptive (0), grid (-1 =
    automatic), gridmem (MiB for the grid, 64), freeze, merge, bounds, lightbuffer, eyebuffer,
    shadowcache, shadows (1/0, default 1), brute (1 = the brute-force reference renderer, 0),
-   threads (0 = automatic), maxsteps (statements a program may execute, 10000000; 0 = no
+   coherence (1: a program's frame with the camera, lights and options of the frame before
+   re-traces only the pixels whose rays could have met what changed; 0: every pixel), threads (0 = automatic), maxsteps (statements a program may execute, 10000000; 0 = no
    limit), texmem (MiB for textures, 256),
    bits (8 or 16 per sample in TIFF/PPM files), and the string option output (file name of
    `rendertiff`; its extension picks the format).
@@ -358,6 +359,10 @@ typedef struct pray_stats {
     double memory_peak;
     double memory_parse, memory_run, memory_prepare, memory_accel, memory_render;
     long nested_grids, nested_voxels; /* grids nested in crowded voxels, and their voxels */
+    /* Image sequences (option coherence): pixels of the run's frames taken over from the frame
+       before, pixels traced, and the frames that took any over. */
+    double pixels_reused, pixels_retraced;
+    long frames_coherent;
 } pray_stats;
 
 /* Render `root` lit by `lights` (NULL = no light) with the context's camera, background and
