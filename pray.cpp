@@ -539,7 +539,7 @@ struct pray_ctx {
     Setup cur;       // in force now
     Setup base;      // what the host set; every run starts from it and ends back at it
     int running;     // a program is running: its settings change `cur` only
-    unsigned fixed;  // bit per option: set from the command line, programs cannot change it
+    unsigned char fixed[OPT_COUNT];  // per option: set from the command line, programs cannot change it
     pray_stats stats;
     int frames;
     pray_texture *textures;  // files decoded in this run
@@ -8286,7 +8286,7 @@ pray_status pray_option(pray_ctx *c, const char *name, double value) {
     if (c->untrusted && top > 0 && (value == 0 || value > top))
         return fail(c, PRAY_ERR_ARG, "option '%s': %.15g%s is above %.15g, the ceiling in untrusted mode", name, value,
                     value == 0 ? " (no limit)" : "", top);
-    if (c->fixed & (1u << i)) return PRAY_OK;
+    if (c->fixed[i]) return PRAY_OK;
     double w = i == OPT_WIDTH ? value : c->cur.opt.v[OPT_WIDTH], h = i == OPT_HEIGHT ? value : c->cur.opt.v[OPT_HEIGHT];
     if (w * h > MAX_IMAGE_PIXELS)
         return fail(c, PRAY_ERR_ARG, "image of %.0f x %.0f pixels is too large", w, h);
@@ -8311,7 +8311,7 @@ pray_status pray_option_string(pray_ctx *c, const char *name, const char *value)
     if (c->untrusted && c->running && (untrusted_path_problem(value) || strchr(value, '/') || strchr(value, '\\')))
         return fail(c, PRAY_ERR_ARG, "option 'output': an untrusted program may name a file, not a directory ('%s')",
                     value);
-    if (!(c->fixed & (1u << i))) strcpy(c->cur.opt.output, value);
+    if (!c->fixed[i]) strcpy(c->cur.opt.output, value);
     if (!c->running) c->base = c->cur;
     return PRAY_OK;
 }
@@ -8320,7 +8320,7 @@ pray_status pray_option_fix(pray_ctx *c, const char *name, const char *text) {
     if (!c) return PRAY_ERR_ARG;
     int i = name ? opt_find(name) : -1;
     if (i < 0) return opt_unknown(c, name ? name : "");
-    c->fixed &= ~(1u << i);
+    c->fixed[i] = 0;
     pray_status st;
     if (i == OPT_OUTPUT) st = pray_option_string(c, name, text);
     else {
@@ -8330,7 +8330,7 @@ pray_status pray_option_fix(pray_ctx *c, const char *name, const char *text) {
             return fail(c, PRAY_ERR_ARG, "option '%s': '%s' is not a number", name, text ? *Shown(text) : "");
         st = pray_option(c, name, v);
     }
-    if (st == PRAY_OK) c->fixed |= 1u << i;
+    if (st == PRAY_OK) c->fixed[i] = 1;
     return st;
 }
 
