@@ -73,12 +73,23 @@ examples: $(PRAY) textures
 	  printf '%-12s' $$n; $(RUN) ./$(PRAY) --quiet -o out/$$n.$$ext $$f >/dev/null || exit 1; echo " -> out/$$n.$$ext"; \
 	done
 
-$(TESTS): $(TEST_SRC) tests/*.hpp pray.cpp pray.hpp build/png
-	$(CXX) $(TESTFLAGS) $(TEST_SRC) -o $@ $(LDLIBS) -lpthread
+# Each test file is compiled on its own (make -j builds them side by side; the packages first);
+# only tests/test_internal.cpp includes pray.cpp, and with it the whole library.
+TEST_HDR = tests/*.hpp pray.hpp build/png
+build/tests/%.o: tests/%.cpp $(TEST_HDR) | deps
+	@mkdir -p build/tests
+	$(CXX) $(TESTFLAGS) -c $< -o $@
+$(TESTS): $(TEST_SRC:tests/%.cpp=build/tests/%.o)
+	$(CXX) $(TESTFLAGS) $^ -o $@ $(LDLIBS) -lpthread
 
 # The same tests with the renderer in single precision (PRAY_REAL=float).
-$(TESTS_FLOAT): $(TEST_SRC) tests/*.hpp pray.cpp pray.hpp build/png
-	$(CXX) $(TESTFLAGS) -DPRAY_REAL=float $(TEST_SRC) -o $@ $(LDLIBS) -lpthread
+build/tests-float/%.o: tests/%.cpp $(TEST_HDR) | deps
+	@mkdir -p build/tests-float
+	$(CXX) $(TESTFLAGS) -DPRAY_REAL=float -c $< -o $@
+$(TESTS_FLOAT): $(TEST_SRC:tests/%.cpp=build/tests-float/%.o)
+	$(CXX) $(TESTFLAGS) -DPRAY_REAL=float $^ -o $@ $(LDLIBS) -lpthread
+
+build/tests/test_internal.o build/tests-float/test_internal.o build/sanitize/test_internal.o: pray.cpp
 
 # A build without file access (PRAY_NO_STDIO): rendering into buffers and textures the host
 # registers, which such builds use instead of files (tests/test_buffers.cpp).
@@ -145,10 +156,15 @@ cmake-check:
 # the suite (whose command-line tests use the plain ./pray) and the bad inputs run with them.
 # float-cast-overflow: part of clang's "undefined" but not of GCC's.
 SANFLAGS = -fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=undefined,float-cast-overflow -O1 -g
+build/sanitize/%.o: tests/%.cpp $(TEST_HDR) | deps
+	@mkdir -p build/sanitize
+	$(CXX) $(TESTFLAGS) $(SANFLAGS) -c $< -o $@
+build/sanitize/pray_tests: $(TEST_SRC:tests/%.cpp=build/sanitize/%.o)
+	$(CXX) $(TESTFLAGS) $(SANFLAGS) $^ -o $@ $(LDLIBS) -lpthread
 sanitize: deps $(PRAY) textures
 	@mkdir -p build/sanitize
 	$(CXX) -std=c++98 $(SANFLAGS) $(WARN) -fno-exceptions -fno-rtti -DPRAY_MAIN pray.cpp -o build/sanitize/pray $(LDLIBS)
-	$(CXX) $(TESTFLAGS) $(SANFLAGS) $(TEST_SRC) -o build/sanitize/pray_tests $(LDLIBS) -lpthread
+	@$(MAKE) --no-print-directory build/sanitize/pray_tests
 	@echo "== tests under the sanitizers"
 	./build/sanitize/pray_tests
 	@echo "== bad inputs under the sanitizers"
@@ -218,4 +234,4 @@ ports:
 	sh ports/check
 
 clean:
-	rm -rf $(PRAY) $(PRAY_MPI) build/mpi $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embed$(EXE) tests/*.o tests/*.ppm out
+	rm -rf $(PRAY) $(PRAY_MPI) build/mpi build/tests build/tests-float build/sanitize $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embed$(EXE) tests/*.o tests/*.ppm out
