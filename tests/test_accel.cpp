@@ -107,7 +107,7 @@ bool apply(pray_ctx *c, const Opts &o) {
 enum RayKind {
     R_RANDOM, R_AXIS, R_GRID_EDGE, R_GRID_FACE, R_GRID_CORNER, R_GRID_SLOPE, R_FRACTION, R_BOX_CORNER,
     R_IN_GRID, R_ON_BOX, R_IN_SOLID, R_TANGENT_SPHERE, R_TANGENT_CYL, R_ALONG_CYL, R_IN_FACE, R_TMAX,
-    R_TMAX_HIT, R_NEAR_AXIS, R_TMAX_GRID, R_GRID_EXIT, R_NKINDS
+    R_TMAX_HIT, R_NEAR_AXIS, R_TMAX_GRID, R_GRID_EXIT, R_GRAZE, R_NKINDS
 };
 const char *ray_kind_name(int k) {
     static const char *n[] = {"random", "axis-parallel", "along grid edge", "in grid face", "grid corner diagonal",
@@ -115,7 +115,8 @@ const char *ray_kind_name(int k) {
                               "starting inside grid", "starting on box boundary", "starting inside solid",
                               "tangent to sphere", "tangent to cylinder", "along cylinder surface",
                               "in a plane face", "tmax limit", "tmax at a hit", "nearly axis-parallel",
-                              "tmax at a grid corner", "crossing a face where it leaves the grid"};
+                              "tmax at a grid corner", "crossing a face where it leaves the grid",
+                              "grazing an edge, a rim, a side or an outline"};
     return n[k];
 }
 
@@ -388,6 +389,14 @@ std::vector<RayCase> make_rays(const Scene &s, Rng &rng) {
         if (rng.chance(0.5)) set_comp(o, a, comp(C, a) - comp(d, a) * far);
         push(o, d, R_NEAR_AXIS);
     }
+    // grazing the version-2 primitives (and stretched ones): along an edge or a side line,
+    // tangent to a rim, a side or an outline; from far, from the point, or a hair beside it
+    for (int i = 0; i < 24 && !s.grazes.empty(); i++) {
+        const Graze &g = s.grazes[rng.below((int)s.grazes.size())];
+        pray_vec o = g.p;
+        if (rng.chance(0.2)) o = add(o, mul(rng.dir(), 1e-9 * s.scale));
+        push(rng.chance(0.3) ? o : sub(o, mul(unit(g.d), far)), g.d, R_GRAZE);
+    }
     // tmax limits (shadow-like)
     size_t n0 = v.size();
     for (int i = 0; i < 14 && n0; i++) {
@@ -613,6 +622,9 @@ TEST_CASE("accel hits: blocks sharing faces, on quarter units (20 seeds)") { run
 TEST_CASE("accel hits: an unbounded floor with solids on it (15 seeds)") { run_kind(K_FLOOR, 1, 15, g_total); }
 TEST_CASE("accel hits: dense clusters of small solids with a few far away, where grids nest (5 seeds)") {
     run_kind(K_CLUSTER, 1, 5, g_total);
+}
+TEST_CASE("accel hits: boxes, rods, cones, stretched and mirrored solids with the others, grazed (60 seeds)") {
+    run_kind(K_SHAPES, 1, 60, g_total);
 }
 TEST_CASE("accel hits: scenes scaled from 1e-3 to 1e6 and moved far from the origin (20 seeds)") {
     run_kind(K_SCALED, 1, 20, g_total);
