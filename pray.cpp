@@ -1820,6 +1820,7 @@ struct Scene {
     int root;
     int prune;        // drop parts that bounds show cannot matter
     int leaves;       // primitives met so far while flattening
+    int tori;         // tori among the primitives (each may cross a ray four times)
     Accel *accel;     // NULL: the brute-force reference
     Array<Light> lights;
     int parallel;
@@ -2258,6 +2259,7 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
             q.r = (real)o->r;
         }
         if (o->fr && !prim_frame(c, s, o, &q)) return -3;
+        s->tori += o->kind == O_TORUS;
         q.r2 = q.r * q.r;
         q.box = q.fr ? frame_box(q, *o->fr) : prim_box(q);
         if (!s->prims.push(c, q)) return -3;
@@ -2716,14 +2718,17 @@ struct Ray {
     R3 o, d;  // d is a unit vector
 };
 
-enum { SPAN_NONE, SPAN_ALL, SPAN };
+// SPAN2: two intervals, [t0, t1] and then [t2, t3] (a torus; where the caller asks for the
+// second, else a span it cannot take: an evaluation that can takes over).
+enum { SPAN_NONE, SPAN_ALL, SPAN, SPAN2 };
 
-int framed_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t1);
+int framed_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t1, real *t23);
 
 // The parameter interval [t0, t1] of the ray inside the primitive (t0 may be -inf, t1 +inf).
 // `self`: the ray starts on this primitive's surface; its crossing there is known by identity
 // and left out, and which side the ray goes to decides its status at the start.
-inline int prim_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t1) {
+// (t23: where a torus puts its second interval; NULL for callers that take one interval only.)
+inline int prim_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t1, real *t23 = 0) {
     switch (q.kind) {
     case O_SPHERE: {
         R3 oc = ray.o - q.p;
@@ -2791,7 +2796,7 @@ inline int prim_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t
         *t1 = tc + h;
         return SPAN;
     }
-    default: return framed_span(q, ray, self, t0, t1);
+    default: return framed_span(q, ray, self, t0, t1, t23);
     }
 }
 
@@ -2854,9 +2859,129 @@ int quadric_span(real A, real B, real C, real *t0, real *t1) {
     return *t0 <= *t1 ? SPAN : SPAN_NONE;
 }
 
-int framed_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t1) {
+// The real roots of the depressed quartic x^4 + c2 x^2 + c1 x + c0 where it changes sign, in
+// increasing order: 0, 2 or 4 of them, where it turns negative and positive again in turn.
+// Each lies alone between two extremes (roots of the derivative, a cubic solved in closed form
+// and polished), where it is bracketed and refined by Newton steps kept in the bracket.
+int quartic_roots(double c2, double c1, double c0, double *root) {
+    // the extremes: 4 x^3 + 2 c2 x + c1 = 0, i.e. x^3 + P x + Q = 0
+    double P = c2 / 2, Q = c1 / 4, ext[3];
+    int ne;
+    double D = (Q / 2) * (Q / 2) + (P / 3) * (P / 3) * (P / 3);
+    if (D > 0) {
+        double A = cbrt_pos(fabs(Q) / 2 + sqrt(D));
+        if (Q > 0) A = -A;
+        ext[0] = A != 0 ? A - P / (3 * A) : 0;
+        ne = 1;
+    } else {
+        double m = 2 * sqrt(-P / 3), c = m > 0 ? 3 * Q / (P * m) : 0;
+        double th = acos(c > 1 ? 1 : c < -1 ? -1 : c) / 3;
+        for (int k = 0; k < 3; k++) ext[k] = m * cos(th - 2.0943951023931954923 * k);
+        ne = 3;
+    }
+    for (int k = 0; k < ne; k++)
+        for (int it = 0; it < 2; it++) {  // polish
+            double x = ext[k], g = 3 * x * x + P;
+            if (g != 0) ext[k] = x - ((x * x + P) * x + Q) / g;
+        }
+    for (int i = 1; i < ne; i++)  // sort
+        for (int j = i; j > 0 && ext[j] < ext[j - 1]; j--) {
+            double x = ext[j];
+            ext[j] = ext[j - 1];
+            ext[j - 1] = x;
+        }
+    double B = 1 + (fabs(c2) > fabs(c1) ? fabs(c2) : fabs(c1));
+    if (fabs(c0) + 1 > B) B = fabs(c0) + 1;
+    double pts[5];
+    int np = 0;
+    pts[np++] = -B;
+    for (int k = 0; k < ne; k++)
+        if (ext[k] > -B && ext[k] < B) pts[np++] = ext[k];
+    pts[np++] = B;
+    int n = 0;
+    for (int i = 0; i + 1 < np; i++) {
+        double lo = pts[i], hi = pts[i + 1];
+        double flo = ((lo * lo + c2) * lo + c1) * lo + c0, fhi = ((hi * hi + c2) * hi + c1) * hi + c0;
+        if ((flo < 0) == (fhi < 0)) continue;
+        bool down = flo >= 0;  // f falls through the root: entering
+        double x = (lo + hi) / 2;
+        for (int it = 0; it < 200; it++) {
+            double fx = ((x * x + c2) * x + c1) * x + c0;
+            if (fx == 0) break;
+            if ((fx < 0) == down) hi = x;
+            else lo = x;
+            double g = (4 * x * x + 2 * c2) * x + c1, y = g != 0 ? x - fx / g : lo;
+            if (!(y > lo && y < hi)) y = lo + (hi - lo) / 2;  // Newton left the bracket: halve it
+            if (y == x || !(hi - lo > 0) || y == lo || y == hi) {
+                x = y;
+                break;
+            }
+            x = y;
+        }
+        root[n++] = x;
+    }
+    return n & ~1;  // (in pairs: the quartic is positive far out on both sides)
+}
+
+// The torus: centre p, unit axis n, radius r to the tube's centre line, tube radius f.rt. The
+// ray is taken in units of r from its point nearest the centre, so that the quartic's
+// coefficients are of order 1 whatever the torus' size and distance; a ray that passes farther
+// than r + rt from the centre misses. `self`: the crossing nearest the origin is the ray's start.
+int torus_span(const Prim &q, R3 o, R3 d, bool self, real *t) {
+    const PrimFrame &f = *q.fr;
+    double R = (double)q.r, rt = (double)f.rt / R;
+    double dv[3] = {(double)d.x, (double)d.y, (double)d.z}, ov[3], nv[3] = {(double)q.n.x, (double)q.n.y, (double)q.n.z};
+    R3 oc = o - q.p;
+    ov[0] = (double)oc.x / R;
+    ov[1] = (double)oc.y / R;
+    ov[2] = (double)oc.z / R;
+    double dl = sqrt(dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2]);
+    if (!(dl > 0)) return SPAN_NONE;
+    for (int i = 0; i < 3; i++) dv[i] /= dl;  // x = o + s d, t = (s + sc) R / dl
+    double sc = -(ov[0] * dv[0] + ov[1] * dv[1] + ov[2] * dv[2]);
+    for (int i = 0; i < 3; i++) ov[i] += sc * dv[i];
+    double oo = ov[0] * ov[0] + ov[1] * ov[1] + ov[2] * ov[2];
+    if (oo >= (1 + rt) * (1 + rt)) return SPAN_NONE;
+    double on = ov[0] * nv[0] + ov[1] * nv[1] + ov[2] * nv[2], dn = dv[0] * nv[0] + dv[1] * nv[1] + dv[2] * nv[2];
+    double k = oo + 1 - rt * rt;
+    // (s^2 + k)^2 = 4 |(o + s d) across the axis|^2, with o.d = 0
+    double c2 = 2 * k - 4 * (1 - dn * dn), c1 = 8 * on * dn, c0 = k * k - 4 * (oo - on * on);
+    double root[4];
+    int n = quartic_roots(c2, c1, c0, root);
+    if (n == 0) return SPAN_NONE;
+    double scale = R / dl;
+    real tt[4];
+    for (int i = 0; i < n; i++) tt[i] = (real)((root[i] + sc) * scale);
+    if (self) {  // the root nearest 0 is the start: the ray is inside after it when it enters there
+        int b = 0;
+        for (int i = 1; i < n; i++)
+            if (fabs((double)tt[i]) < fabs((double)tt[b])) b = i;
+        tt[b] = 0;
+        for (int i = 0; i < n; i++)  // (rounding may leave an earlier root just past 0)
+            if (i < b && tt[i] > 0) tt[i] = 0;
+    }
+    if (n == 4 && !(tt[1] < tt[2])) {  // intervals that touch (a ray grazing the hole's rim): one
+        tt[1] = tt[3];
+        n = 2;
+    }
+    for (int i = 0; i < n; i++) t[i] = tt[i];
+    return n == 2 ? SPAN : SPAN2;
+}
+
+int framed_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t1, real *t23) {
     const PrimFrame &f = *q.fr;
     R3 o = to_local(f, ray.o), d = dir_local(f, ray.d);
+    if (q.kind == O_TORUS) {
+        real t[4];
+        int k = torus_span(q, o, d, self, t);
+        *t0 = t[0];
+        *t1 = t[1];
+        if (k == SPAN2 && t23) {
+            t23[0] = t[2];
+            t23[1] = t[3];
+        }
+        return k;
+    }
     int k = SPAN;
     *t0 = -REAL_INF;
     *t1 = REAL_INF;
@@ -2922,7 +3047,7 @@ bool framed_inside(const Prim &q, R3 x) {
         R3 perp = v - q.n * s;
         return (q.kind == P_ECYLINDER || (s > 0 && s < f.h)) && dot(perp, perp) < r * r;
     }
-    default: return false;
+    default: return false;  // (a torus is not convex)
     }
 }
 
@@ -2959,7 +3084,12 @@ R3 framed_normal(const Prim &q, R3 x) {
         R3 n = unit(perp) - q.n * k;
         return dot(n, n) > 0 ? n : q.n * (real)(s < f.h / 2 ? -1 : 1);
     }
-    default: return r3(0, 0, 1);
+    default: {  // torus: away from the nearest point of the tube's centre line
+        R3 v = x - q.p;
+        R3 rho = v - q.n * dot(v, q.n);
+        real l = (real)sqrt((double)dot(rho, rho));
+        return l > 0 ? v - rho * (q.r / l) : q.n * (real)(dot(v, q.n) < 0 ? -1 : 1);
+    }
     }
 }
 
@@ -3023,6 +3153,7 @@ struct Scratch {
     // per ray, stamped with the ray number (thesis 3.5: no explicit unfreezing)
     unsigned ray;
     Span *span;                     // per primitive: its interval along the ray, once per ray
+    real *span2;                    // per primitive: a torus' second interval (NULL without tori)
     unsigned *nfrozen;              // frozen for this ray: an ancestor's status is fixed
     unsigned *nfixed;               // status known for the rest of this ray ...
     unsigned char *nfixval;         // ... and its value
@@ -3045,7 +3176,8 @@ void *thread_alloc(pray_ctx *c, size_t n) { return mem_zalloc(c, n + LINE_SLACK)
 bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     memset(w, 0, sizeof *w);
     size_t np = (size_t)s->prims.n + 1, nn = (size_t)s->nodes.n + 1;
-    w->cross = (Cross *)thread_alloc(c, sizeof(Cross) * 2 * np);
+    w->cross = (Cross *)thread_alloc(c, sizeof(Cross) * 2 * (np + (size_t)s->tori));
+    if (s->tori) w->span2 = (real *)thread_alloc(c, sizeof(real) * 2 * np);
     w->hull = (Hull *)thread_alloc(c, sizeof(Hull) * nn);
     w->pstat = (unsigned char *)thread_alloc(c, np);
     w->nstat = (unsigned char *)thread_alloc(c, nn);
@@ -3057,12 +3189,13 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->nfixval = (unsigned char *)thread_alloc(c, nn);
     w->blocker = (int *)thread_alloc(c, sizeof(int) * 3 * (size_t)(s->lights.n + 1));
     if (w->blocker) shadow_cache_clear(s, w);
-    return w->blocker && w->cross && w->hull && w->pstat && w->nstat && w->nfirst && w->cnt && w->span &&
+    return w->blocker && w->cross && (w->span2 || !s->tori) && w->hull && w->pstat && w->nstat && w->nfirst && w->cnt && w->span &&
            w->nfrozen && w->nfixed && w->nfixval;
 }
 
 void scratch_release(pray_ctx *c, Scratch *w) {
     mem_free(c, w->span);
+    mem_free(c, w->span2);
     mem_free(c, w->nfrozen);
     mem_free(c, w->nfixed);
     mem_free(c, w->nfixval);
@@ -3153,24 +3286,20 @@ int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit
     }
     for (int i = 0; i < np; i++) {
         const Prim &q = s->prims[i];
-        real t0 = 0, t1 = 0;
+        real t[4] = {0, 0, 0, 0};
         w->k.tests += 1;
-        int k = prim_span(q, ray, twin(s, i, self), &t0, &t1);
+        int k = prim_span(q, ray, twin(s, i, self), &t[0], &t[1], &t[2]);
         bool in = false;
         if (k == SPAN_ALL) in = true;
-        else if (k == SPAN) {
-            in = t0 <= 0 && 0 < t1;
-            if (t0 > 0 && t0 < tmax) {
-                w->cross[nc].t = t0;
-                w->cross[nc].prim = i;
-                w->cross[nc].enter = 1;
-                nc++;
-            }
-            if (t1 > 0 && t1 < tmax) {
-                w->cross[nc].t = t1;
-                w->cross[nc].prim = i;
-                w->cross[nc].enter = 0;
-                nc++;
+        else if (k == SPAN || k == SPAN2) {
+            for (int j = 0; j < (k == SPAN2 ? 4 : 2); j++) {
+                in = in || (!(j & 1) && t[j] <= 0 && 0 < t[j + 1]);
+                if (t[j] > 0 && t[j] < tmax) {
+                    w->cross[nc].t = t[j];
+                    w->cross[nc].prim = i;
+                    w->cross[nc].enter = !(j & 1);
+                    nc++;
+                }
             }
         }
         w->pstat[i] = in;
@@ -3759,6 +3888,7 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
     group.init();
     gsolid.init();
     bool mem = np == 0 || (plan->push(c, 0) && plan->push(c, 0) && plan->push(c, 0)), ok = np > 0 && mem;
+    for (int i = 0; ok && s->tori && i < np; i++) ok = s->prims[prims[i]].kind != O_TORUS;  // (two intervals)
     for (int i = 0; ok && i < np; i++) {
         int path[PLAN_DEPTH], n = 0;  // the ancestors, the root last
         for (int p = s->prims[prims[i]].parent; ok && p >= 0; p = s->nodes[p].parent) {
@@ -4815,7 +4945,7 @@ inline const Span &span_get(const Scene *s, Scratch *w, const Ray &ray, int p, i
     if (sp.stamp != w->ray) {
         sp.stamp = w->ray;
         w->k.tests += 1;
-        sp.kind = prim_span(s->prims[p], ray, twin(s, p, self), &sp.t0, &sp.t1);
+        sp.kind = prim_span(s->prims[p], ray, twin(s, p, self), &sp.t0, &sp.t1, w->span2 ? w->span2 + 2 * p : NULL);
     }
     return sp;
 }
@@ -5134,8 +5264,23 @@ bool eval_full(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
         int kind = sp.kind;
         real t0 = sp.t0, t1 = sp.t1;
         bool in = kind == SPAN_ALL || (kind == SPAN && t0 <= a && a < t1);
+        if (kind == SPAN2) {  // a torus: two intervals; it settles after the second (settle_prim)
+            const real *t23 = w->span2 + 2 * p;
+            in = (t0 <= a && a < t1) || (t23[0] <= a && a < t23[1]);
+            real t[4] = {t0, t1, t23[0], t23[1]};
+            for (int j = 0; j < 4; j++)
+                if (t[j] > a && t[j] <= b && t[j] < tmax) {
+                    w->cross[nc].t = t[j];
+                    w->cross[nc].prim = p;
+                    w->cross[nc].enter = !(j & 1);
+                    nc++;
+                }
+            kind = SPAN;
+            t0 = t23[0];
+            t1 = t23[1];
+        }
         w->pstat[p] = in;
-        if (kind == SPAN) {
+        if (kind == SPAN && sp.kind == SPAN) {
             if (t0 > a && t0 <= b && t0 < tmax) {
                 w->cross[nc].t = t0;
                 w->cross[nc].prim = p;
@@ -5177,7 +5322,10 @@ bool eval_full(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
                 root = !root;
                 last = i;
             }
-            if (A->freeze && (s->prims[x.prim].settles & (st ? 2 : 1)) && (!st || w->span[x.prim].t1 >= REAL_INF))
+            // (a torus left for good: at the end of its second interval)
+            const Span &sp = w->span[x.prim];
+            if (A->freeze && (s->prims[x.prim].settles & (st ? 2 : 1)) &&
+                (!st ? sp.kind != SPAN2 || x.t >= w->span2[2 * x.prim + 1] : sp.t1 >= REAL_INF))
                 settle(s, w, 2 * x.prim, st);
         }
         if (root != before && last >= 0) {
@@ -8163,6 +8311,17 @@ pray_object *pray_cone(pray_ctx *c, pray_model *m, pray_vec p1, double r1, pray_
     return framed_new(c, O_CONE, m, p1, p2, r1, r2);
 }
 
+pray_object *pray_torus(pray_ctx *c, pray_model *m, pray_vec centre, pray_vec axis, double R, double r) {
+    if (!c || !model_ok(c, m, "pray_torus") || bad_vec(c, centre, "torus", false) || bad_vec(c, axis, "torus axis", true))
+        return NULL;
+    if (!finite_num(R) || !finite_num(r) || !(r > 0) || !(R > r) || !finite_num(R + r)) {
+        fail(c, PRAY_ERR_ARG, "torus: the radii must be numbers with R > r > 0, not R = %g and r = %g", nan_clean(R),
+             nan_clean(r));
+        return NULL;
+    }
+    return framed_new(c, O_TORUS, m, centre, vunit(axis), R, r);
+}
+
 pray_object *pray_one(pray_ctx *c, pray_model *m) {
     return c && model_ok(c, m, "pray_one") ? obj_new(c, O_ONE, m) : NULL;
 }
@@ -10297,6 +10456,13 @@ pray_status bi_stretch(Interp &I, const Expr *call, Value *a, Value *out) {
     if (want(I, call, a, 0, V_OBJECT) || want(I, call, a, 1, V_VECTOR)) return I.c->status;
     return made(I, call, V_OBJECT, pray_stretch(I.c, (pray_object *)a[0].ref, vec_of(a[1])), out);
 }
+pray_status bi_torus(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_MODEL) || want(I, call, a, 1, V_POINT) || want(I, call, a, 2, V_VECTOR) ||
+        want(I, call, a, 3, V_NUM) || want(I, call, a, 4, V_NUM))
+        return I.c->status;
+    return made(I, call, V_OBJECT,
+                pray_torus(I.c, (pray_model *)a[0].ref, vec_of(a[1]), vec_of(a[2]), a[3].v[0], a[4].v[0]), out);
+}
 pray_status bi_dirlight(Interp &I, const Expr *call, Value *a, Value *out) {
     if (want(I, call, a, 0, V_INTENS) || want(I, call, a, 1, V_VECTOR)) return I.c->status;
     return made(I, call, V_LIGHT, pray_dirlight(I.c, rgb_of(a[0]), vec_of(a[1])), out);
@@ -10449,6 +10615,7 @@ const Builtin BUILTINS[] = {
     {"stretch", 2, 2, bi_stretch},
     {"tan", 1, 1, bi_tan},           {"text", 8, 8, bi_text},
     {"tiff", 3, 3, bi_tiff},         {"tiffbump", 3, 3, bi_tiffbump},
+    {"torus", 5, 5, bi_torus},
     {"transparent", 2, 2, bi_transparent},
 };
 const int NBUILTINS = (int)(sizeof BUILTINS / sizeof BUILTINS[0]);

@@ -264,11 +264,14 @@ pray_object *pray_cylinder(pray_ctx *ctx, pray_model *m, pray_vec point, pray_ve
 pray_object *pray_one(pray_ctx *ctx, pray_model *m);
 /* Language version 2 (see the manual: box, rod, cone): an axis-aligned box with opposite corners
    p1 and p2 (each extent > 0); a finite cylinder with flat caps; a truncated cone from the disc
-   of radius r1 around p1 to that of radius r2 around p2 (r1, r2 >= 0, not both 0). Their texture
-   coordinates are a planemap's at p1 along X and Y, carried along by every transformation. */
+   of radius r1 around p1 to that of radius r2 around p2 (r1, r2 >= 0, not both 0); a torus with
+   centre, axis, radius R to the tube's centre line and tube radius r (R > r > 0). Their texture
+   coordinates are a planemap's at their first point along X and Y, carried along by every
+   transformation. */
 pray_object *pray_box(pray_ctx *ctx, pray_model *m, pray_vec p1, pray_vec p2);
 pray_object *pray_rod(pray_ctx *ctx, pray_model *m, pray_vec p1, pray_vec p2, double radius);
 pray_object *pray_cone(pray_ctx *ctx, pray_model *m, pray_vec p1, double r1, pray_vec p2, double r2);
+pray_object *pray_torus(pray_ctx *ctx, pray_model *m, pray_vec centre, pray_vec axis, double R, double r);
 /* A half-space and a ball with texture coordinates (see the language manual: planemap,
    spheremap). */
 pray_object *pray_planemap(pray_ctx *ctx, pray_model *m, pray_vec point, pray_vec normal, pray_vec u,

@@ -336,11 +336,11 @@ public:
         return pray_csg(c_, PRAY_DIFFERENCE, s, cylinder(cc, a, r * rng.range(0.2, 0.7)));
     }
 
-    // A version-2 primitive (box, rod, cone) or a stretched sphere or capped cylinder,
+    // A version-2 primitive (box, rod, cone, torus) or a stretched sphere or capped cylinder,
     // placed by random stretches (negative ones mirror), rotations, scales and translations, in
     // that order or with a stretch after a rotation (which shears); its grazing rays recorded.
     pray_object *shape() {
-        int k = rng.below(5);
+        int k = rng.below(6);
         std::vector<Graze> loc;
         pray_object *o = nullptr;
         pray_vec p1 = point(-0.6, 0.6);
@@ -379,7 +379,7 @@ public:
                 pray_vec u = rng.dir();
                 loc.push_back(Graze{add(p1, mul(u, r)), side(u)});
             }
-        } else {  // a capped cylinder, stretched below
+        } else if (k == 4) {  // a capped cylinder, stretched below
             pray_vec a = axis();
             double r = radius(0.08, 0.5), h = radius(0.1, 0.6);
             o = pray_csg(c_, PRAY_INTERSECTION, pray_cylinder(c_, m_, p1, a, r),
@@ -389,6 +389,16 @@ public:
             pray_vec u = side(a);
             loc.push_back(Graze{add(p1, mul(u, r)), a});
             loc.push_back(Graze{add(add(p1, mul(u, r)), mul(a, h)), cross(a, u)});
+        } else {  // torus
+            pray_vec a = axis();
+            double R = radius(0.2, 0.6), r = R * rng.range(0.1, 0.9);
+            o = pray_torus(c_, m_, p1, a, R, r);
+            pray_vec u = side(a), w = cross(a, u);
+            loc.push_back(Graze{add(p1, mul(u, R + r)), w});                   // the outline
+            loc.push_back(Graze{add(p1, mul(u, R - r)), w});                   // the hole's rim
+            loc.push_back(Graze{add(add(p1, mul(u, R)), mul(a, r)), u});      // across the top
+            loc.push_back(Graze{add(add(p1, mul(u, R)), mul(a, r)), w});      // along the top
+            loc.push_back(Graze{add(p1, mul(a, r)), u});                      // over the hole
         }
         sc.nprims++;
         Aff f = aff_id();

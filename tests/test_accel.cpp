@@ -623,7 +623,7 @@ TEST_CASE("accel hits: an unbounded floor with solids on it (15 seeds)") { run_k
 TEST_CASE("accel hits: dense clusters of small solids with a few far away, where grids nest (5 seeds)") {
     run_kind(K_CLUSTER, 1, 5, g_total);
 }
-TEST_CASE("accel hits: boxes, rods, cones, stretched and mirrored solids with the others, grazed (60 seeds)") {
+TEST_CASE("accel hits: boxes, rods, cones, tori, stretched and mirrored solids with the others, grazed (60 seeds)") {
     run_kind(K_SHAPES, 1, 60, g_total);
 }
 TEST_CASE("accel hits: scenes scaled from 1e-3 to 1e6 and moved far from the origin (20 seeds)") {
