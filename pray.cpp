@@ -1276,7 +1276,7 @@ bool frame_ok(const Xform &f) {
 
 // A copy of primitive a (which has a frame, or is given one) with f applied to its frame: its
 // local parameters and texture coordinates stay as they are.
-pray_object *obj_reframe(pray_ctx *c, const pray_object *a, const Xform &f) {
+pray_object *obj_reframe(pray_ctx *c, const pray_object *a, const Xform &f, const char *what) {
     pray_object *o = obj_new(c, a->kind, a->mat);
     if (!o) return NULL;
     o->p = a->p;
@@ -1291,7 +1291,7 @@ pray_object *obj_reframe(pray_ctx *c, const pray_object *a, const Xform &f) {
     *o->fr = a->fr ? xf_compose(f, *a->fr) : f;
     if (!frame_ok(*o->fr)) {
         release_handle(c, o);
-        fail(c, PRAY_ERR_ARG, "the transformation takes a primitive out of the range of numbers");
+        fail(c, PRAY_ERR_ARG, "%s takes a primitive out of the range of numbers", what);
         return NULL;
     }
     return o;
@@ -1299,7 +1299,7 @@ pray_object *obj_reframe(pray_ctx *c, const pray_object *a, const Xform &f) {
 
 // A copy of the tree with the map applied to every primitive.
 pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
-    if (a->fr) return obj_reframe(c, a, f);
+    if (a->fr) return obj_reframe(c, a, f, "the transformation");
     pray_object *o = obj_new(c, a->kind, a->mat);
     if (!o) return NULL;
     double s = fabs(xf_scale_of(f));
@@ -1364,7 +1364,7 @@ pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
 // vectors so that each point keeps its texture coordinates. Other primitives take the map into
 // their frames.
 pray_object *obj_stretch(pray_ctx *c, pray_object *a, pray_vec v) {
-    if (is_prim(a->kind) && a->kind != O_PLANE) return obj_reframe(c, a, xf_stretch(v));
+    if (is_prim(a->kind) && a->kind != O_PLANE) return obj_reframe(c, a, xf_stretch(v), "stretch");
     if (!is_node(a->kind) && a->kind != O_PLANE) return obj_new(c, a->kind, a->mat);  // one, nothing
     pray_object *o = obj_new(c, a->kind, a->mat);
     if (!o) return NULL;
@@ -8289,8 +8289,11 @@ pray_object *pray_box(pray_ctx *c, pray_model *m, pray_vec p1, pray_vec p2) {
     double e[3] = {fabs(d.x), fabs(d.y), fabs(d.z)}, a[3] = {fabs(p1.x) + fabs(p2.x), fabs(p1.y) + fabs(p2.y), fabs(p1.z) + fabs(p2.z)};
     for (int i = 0; i < 3; i++)
         if (!(e[i] > 1e-12 * a[i]) || !finite_num(e[i])) {
-            fail(c, PRAY_ERR_ARG, "box: the corners must differ in every coordinate (in %c: %g and %g)", "xyz"[i],
-                 i == 0 ? p1.x : i == 1 ? p1.y : p1.z, i == 0 ? p2.x : i == 1 ? p2.y : p2.z);
+            double u = i == 0 ? p1.x : i == 1 ? p1.y : p1.z;
+            if (e[i] == 0) fail(c, PRAY_ERR_ARG, "box: the corners must differ in every coordinate (both have %c = %g)", "xyz"[i], u);
+            else if (finite_num(e[i]))
+                fail(c, PRAY_ERR_ARG, "box: the corners are too close in %c to tell apart (%g apart at %g)", "xyz"[i], e[i], u);
+            else fail(c, PRAY_ERR_ARG, "box: the extent in %c is beyond the range of numbers", "xyz"[i]);
             return NULL;
         }
     return framed_new(c, O_BOX, m, p1, p2, 0, 0);
@@ -8314,9 +8317,13 @@ pray_object *pray_cone(pray_ctx *c, pray_model *m, pray_vec p1, double r1, pray_
 pray_object *pray_torus(pray_ctx *c, pray_model *m, pray_vec centre, pray_vec axis, double R, double r) {
     if (!c || !model_ok(c, m, "pray_torus") || bad_vec(c, centre, "torus", false) || bad_vec(c, axis, "torus axis", true))
         return NULL;
-    if (!finite_num(R) || !finite_num(r) || !(r > 0) || !(R > r) || !finite_num(R + r)) {
+    if (!finite_num(R) || !finite_num(r) || !(r > 0) || !(R > r)) {
         fail(c, PRAY_ERR_ARG, "torus: the radii must be numbers with R > r > 0, not R = %g and r = %g", nan_clean(R),
              nan_clean(r));
+        return NULL;
+    }
+    if (!finite_num(R + r)) {
+        fail(c, PRAY_ERR_ARG, "torus: R + r is beyond the range of numbers");
         return NULL;
     }
     return framed_new(c, O_TORUS, m, centre, vunit(axis), R, r);
