@@ -2995,6 +2995,11 @@ int framed_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t1, re
     case P_ECYLINDER:
     case O_ROD:
     case O_CONE: {
+        // along the local direction made a unit vector (t = s / dl), so that the quadric's
+        // coefficients neither overflow nor underflow
+        real dl = (real)sqrt((double)dot(d, d));
+        if (!(dl > 0)) return SPAN_NONE;
+        d = d * ((real)1 / dl);
         R3 oc = o - q.p;
         real so = 0, sd = 0;
         if (q.kind != P_ELLIPSOID) {
@@ -3012,15 +3017,18 @@ int framed_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t1, re
             ro = q.r + f.k * so;
             rd = f.k * sd;
         }
-        // |oc + t d|^2 - (ro + t rd)^2 <= 0; scaled by 1 / |d|^2 against overflow and underflow
+        // |oc + s d|^2 - (ro + s rd)^2 <= 0 (d across the axis is taken as 0 where its square
+        // would lose its precision: a ray along the axis)
+        const real DD_MIN = sizeof(real) < sizeof(double) ? (real)1e-30 : (real)1e-290;
         real dd = dot(d, d);
+        if (dd < DD_MIN) dd = 0;
         if (dd == 0 && rd == 0) {
             if (!(dot(oc, oc) < ro * ro)) k = SPAN_NONE;
             else if (q.kind == P_ECYLINDER) k = SPAN_ALL;
-            break;
-        }
-        real sc = dd > 0 ? 1 / dd : 1;
-        k = quadric_span((dd - rd * rd) * sc, (dot(oc, d) - ro * rd) * sc, (dot(oc, oc) - ro * ro) * sc, t0, t1);
+        } else
+            k = quadric_span(dd - rd * rd, dot(oc, d) - ro * rd, dot(oc, oc) - ro * ro, t0, t1);
+        *t0 /= dl;
+        *t1 /= dl;
         break;
     }
     default: k = SPAN_NONE; break;
