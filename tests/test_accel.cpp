@@ -904,7 +904,7 @@ TEST_CASE("accel images: random scenes at 40 x 40, every grid x freeze x merge x
           "--brute; freezing never adds intersection tests") {
     const Pick picks[] = {{K_RANDOM, 3}, {K_RANDOM, 17}, {K_RANDOM, 42}, {K_RANDOM, 77}, {K_RANDOM, 101},
                           {K_MANY, 2},   {K_MANY, 5},    {K_LATTICE, 1}, {K_LATTICE, 4}, {K_BLOCKS, 3},
-                          {K_BLOCKS, 12}, {K_FLOOR, 2},  {K_FLOOR, 9}};
+                          {K_BLOCKS, 12}, {K_FLOOR, 2},  {K_FLOOR, 9},   {K_SHAPES, 3},  {K_SHAPES, 8}};
     auto t0 = std::chrono::steady_clock::now();
     long renders = 0, image_mismatches = 0, freeze_violations = 0;
     std::vector<std::string> problems;
@@ -1207,7 +1207,7 @@ TEST_CASE("accel light buffers: lightbuffer=0 and 1 give the reference's image, 
           "the objects; a field of spheres under the sun and a lamp") {
     const Pick picks[] = {{K_RANDOM, 5},  {K_RANDOM, 23}, {K_RANDOM, 64}, {K_MANY, 1},   {K_MANY, 7},
                           {K_LATTICE, 2}, {K_LATTICE, 9}, {K_BLOCKS, 4},  {K_FLOOR, 3},  {K_FLOOR, 11},
-                          {K_SCALED, 2},  {K_SCALED, 6},  {K_SCALED, 13}};
+                          {K_SCALED, 2},  {K_SCALED, 6},  {K_SCALED, 13}, {K_SHAPES, 5}};
     SwitchTally t;
     // (128 x 128 and coarse grids: a buffer is built for images with enough pixels per voxel)
     shadow_switch_picks(picks, &Opts::lightbuffer, "lightbuffer", &pray_stats::rays_lightbuf, &pray_stats::lightbuf_voxels,
@@ -1227,7 +1227,8 @@ TEST_CASE("accel light buffers: lightbuffer=0 and 1 give the reference's image, 
 TEST_CASE("accel shadow cache: shadowcache=0 and 1 give the reference's image, through glass and with lights amid "
           "the objects; a table and a pane of glass over a field of spheres") {
     const Pick picks[] = {{K_RANDOM, 30}, {K_RANDOM, 41}, {K_RANDOM, 64}, {K_RANDOM, 66}, {K_MANY, 4},  {K_LATTICE, 3},
-                          {K_BLOCKS, 7},  {K_FLOOR, 5},   {K_FLOOR, 12},  {K_SCALED, 2},  {K_SCALED, 6}};
+                          {K_BLOCKS, 7},  {K_FLOOR, 5},   {K_FLOOR, 12},  {K_SCALED, 2},  {K_SCALED, 6},
+                          {K_SHAPES, 11}};
     SwitchTally t;
     // (the lamps amid the objects end their shadow rays in voxels that hold surfaces beyond them)
     shadow_switch_picks(picks, &Opts::shadowcache, "shadowcache", &pray_stats::rays_shadowcache, nullptr, {3, 8}, 64, t);
@@ -1305,7 +1306,7 @@ TEST_CASE("accel threads: the counts of a render are the same for 1, 2, 3 and 8 
 TEST_CASE("accel eye buffer: eyebuffer=0 and 1 give the reference's image from eyes outside, inside, on the edge of "
           "and far from the grid's box; a field of spheres; none for a parallel camera") {
     const Pick picks[] = {{K_RANDOM, 4},  {K_RANDOM, 31}, {K_MANY, 3},   {K_MANY, 8},   {K_LATTICE, 5},
-                          {K_BLOCKS, 6},  {K_FLOOR, 4},   {K_FLOOR, 13}, {K_SCALED, 3}, {K_SCALED, 9}};
+                          {K_BLOCKS, 6},  {K_FLOOR, 4},   {K_FLOOR, 13}, {K_SCALED, 3}, {K_SCALED, 9}, {K_SHAPES, 6}};
     SwitchTally t;
     each_pick(picks, [&](pray_ctx *c, const Scene &s) {
         pray_light *lights = some_lights(c);
