@@ -31,7 +31,7 @@ std::vector<testkit::Frame> render(const std::string &path, bool brute) {
 } // namespace
 
 TEST_CASE("gallery: every example renders, and equals the brute-force reference") {
-    const char *scenes[] = {"anim", "csg", "cube", "fractal", "glass", "glassab", "holes", "loop", "maketex",
+    const char *scenes[] = {"anim", "chess", "csg", "cube", "fractal", "glass", "glassab", "holes", "loop", "maketex",
                             "mirror", "models", "parallel", "pc", "rabbit", "redsph", "room", "sign", "textures"};
     const char *dir = std::getenv("PRAY_EXAMPLES");
     for (const char *n : scenes) {
