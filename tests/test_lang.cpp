@@ -1378,3 +1378,47 @@ TEST_CASE("version 2: the API refuses infinities, NaNs and degenerate sizes of t
     pray_release(c, m);
     pray_free(c);
 }
+
+TEST_CASE("version 2: a box's texture coordinates are a planemap's at its first corner, and stretch carries both alike") {
+    // a 2 x 2 checker, seen straight from above: the top face of the box against a planemap
+    // through the first corner's X and Y, at the box's top, cutting a taller box
+    auto render = [](const std::string &solid) {
+        pray_ctx *c = pray_new();
+        float rgb[12] = {0, 0, 0, 1, 1, 1, 1, 1, 1, 0, 0, 0};
+        pray_texture *t = pray_texture_rgb(c, 2, 2, rgb, "checker");
+        REQUIRE(pray_texture_register(c, "checker", t) == PRAY_OK);
+        pray_release(c, t);
+        std::vector<testkit::Frame> frames;
+        pray_set_frame(c, testkit::frame_sink, &frames);
+        std::string prog = "option \"width\", 64\noption \"height\", 64\n"
+                           "parallel <2, 0, 0>, <0, -2, 0>, [0.1, 0.1, 9], [0.1, 0.1, 0]\n"
+                           "T = tiff(color({0.1}), color({0.9}), \"checker\")\nG = color({0.5})\n"
+                           "rendertiff " + solid + ", none\n";
+        pray_status st = pray_run_string(c, "tex.ray", prog.data(), prog.size());
+        CHECK_MESSAGE(st == PRAY_OK, pray_error(c));
+        pray_free(c);
+        return frames.empty() ? testkit::Frame() : frames[0];
+    };
+    const std::string box = "box(T, [-0.7, 0.6, 0.5], [0.9, -0.4, -0.3])";
+    const std::string map = "(planemap(T, [-0.7, 0.6, 0.5], <0, 0, 1>, <1, 0, 0>, <0, 1, 0>) & box(G, [-0.7, -0.4, -0.3], [0.9, 0.6, 2]))";
+    for (const char *how : {"", " . <0, 0, 30>", " . 0.5", " . [0.3, -0.2, 0]"}) {
+        for (const char *st : {"", "<2, 1.5, 1>", "<-1.2, 0.7, 1>"}) {
+            auto wrap = [&](const std::string &o) {
+                std::string x = *st ? "stretch(" + o + ", " + st + ")" : o;
+                return "(" + x + how + ")";
+            };
+            testkit::Frame a = render(wrap(box)), b = render(wrap(map));
+            REQUIRE(a.width == 64);
+            REQUIRE(b.width == 64);
+            int differ = 0, textured = 0;
+            for (int i = 0; i < 64 * 64; i++) {
+                float va = a.pixels[3 * i], vb = b.pixels[3 * i];
+                textured += va > 0.05f && va < 0.95f;
+                differ += std::fabs(va - vb) > 1e-4f;
+            }
+            INFO("stretch " << std::string(st) << ", then" << std::string(how));
+            CHECK(textured > 40);
+            CHECK(differ <= (*st || *how ? 12 : 0));  // (pixels on the checker's edges, by rounding)
+        }
+    }
+}
