@@ -1769,6 +1769,7 @@ struct PrimFrame {
     R3 fwd[3];      // rows of the linear map local -> world
     R3 lo, hi;      // a box's corners
     real h, k, rt;  // rod, cone: the axis' length; cone: slope (r2 - r1) / h; torus: tube radius
+    int plain;      // the frame is the world's: rays need no mapping
 };
 // Kinds of prepared primitives beside ObjKind's: a sphere and a cylinder in a frame.
 enum { P_ELLIPSOID = O_COMPL + 1, P_ECYLINDER };
@@ -2062,17 +2063,27 @@ bool prim_frame(pray_ctx *c, Scene *s, const pray_object *o, Prim *q) {
         f->inv[i] = r3((real)g.m[i][0], (real)g.m[i][1], (real)g.m[i][2]);
         f->fwd[i] = r3((real)o->fr->m[i][0], (real)o->fr->m[i][1], (real)o->fr->m[i][2]);
     }
+    // a box only moved (the frame a translation): its corners and texture origin are moved
+    // instead, and rays need no mapping
+    Xform id = xf_identity();
+    id.t = o->fr->t;
+    bool moved_box = o->kind == O_BOX && memcmp(&id, o->fr, sizeof id) == 0;
+    if (moved_box) {
+        q->p = r3of(vadd(o->p, o->fr->t));
+        f->t = r3(0, 0, 0);
+    }
+    f->plain = moved_box || (vmaxabs(o->fr->t) == 0 && memcmp(&id, o->fr, sizeof id) == 0);
     pray_vec axis = vsub(o->v, o->p);
     double h = vlen(axis);
     switch (o->kind) {
     case O_SPHERE: q->kind = P_ELLIPSOID; break;
     case O_CYLINDER: q->kind = P_ECYLINDER; break;
-    case O_BOX:
-        f->lo = r3of(vmake(o->p.x < o->v.x ? o->p.x : o->v.x, o->p.y < o->v.y ? o->p.y : o->v.y,
-                           o->p.z < o->v.z ? o->p.z : o->v.z));
-        f->hi = r3of(vmake(o->p.x < o->v.x ? o->v.x : o->p.x, o->p.y < o->v.y ? o->v.y : o->p.y,
-                           o->p.z < o->v.z ? o->v.z : o->p.z));
+    case O_BOX: {
+        pray_vec t = moved_box ? o->fr->t : vmake(0, 0, 0), a = vadd(o->p, t), b = vadd(o->v, t);
+        f->lo = r3of(vmake(a.x < b.x ? a.x : b.x, a.y < b.y ? a.y : b.y, a.z < b.z ? a.z : b.z));
+        f->hi = r3of(vmake(a.x < b.x ? b.x : a.x, a.y < b.y ? b.y : a.y, a.z < b.z ? b.z : a.z));
         break;
+    }
     case O_ROD:
     case O_CONE:
         q->n = r3of(vunit(axis));
@@ -2103,7 +2114,7 @@ Box frame_box(const Prim &q, const Xform &fr) {
         double ea = e[0] * a[0] + e[1] * a[1] + e[2] * a[2];
         double disc = sqrt(fabs(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] - ea * ea));
         double len = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
-        double ti = i == 0 ? fr.t.x : i == 1 ? fr.t.y : fr.t.z;
+        double ti = (double)comp(f.t, i);  // (a moved box: 0, its corners moved)
         double lo, hi, p = e[0] * q.p.x + e[1] * q.p.y + e[2] * q.p.z + ti;
         switch (q.kind) {
         case P_ELLIPSOID: lo = p - q.r * len, hi = p + q.r * len; break;
@@ -2970,7 +2981,8 @@ int torus_span(const Prim &q, R3 o, R3 d, bool self, real *t) {
 
 int framed_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t1, real *t23) {
     const PrimFrame &f = *q.fr;
-    R3 o = to_local(f, ray.o), d = dir_local(f, ray.d);
+    R3 o = ray.o, d = ray.d;
+    if (!f.plain) o = to_local(f, o), d = dir_local(f, d);
     if (q.kind == O_TORUS) {
         real t[4];
         int k = torus_span(q, o, d, self, t);
