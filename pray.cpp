@@ -8,7 +8,7 @@
    [SECTION] 5  Scene values: models, lights, solids (reference counted handles)
    [SECTION] 6  Options
    [SECTION] 7  Prepared scene: flattened n-ary CSG tree, boxes, simplification, snapping
-   [SECTION] 8  Ray/primitive intersection
+   [SECTION] 8  Ray/primitive intersection; primitives in a frame (box, rod, cone, torus, stretched)
    [SECTION] 9  CSG status-tree sweep (the brute-force reference, thesis 3.4)
    [SECTION] 9b Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
                 [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas and
@@ -2721,7 +2721,7 @@ pray_status scene_compact(pray_ctx *c, Scene *s) {
 }
 
 // =============================================================================================
-// [SECTION] 8 Ray/primitive intersection
+// [SECTION] 8 Ray/primitive intersection; primitives in a frame (box, rod, cone, torus, stretched)
 // =============================================================================================
 const real REAL_INF = (real)HUGE_VAL;
 
