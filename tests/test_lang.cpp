@@ -1370,9 +1370,11 @@ TEST_CASE("version 2: the API refuses infinities, NaNs and degenerate sizes of t
     refused(pray_stretch(c, s, far), "stretch: coordinates are not finite");
     refused(pray_stretch(c, s, pray_vec{1, nan, 1}), "stretch: coordinates are not finite");
     refused(pray_stretch(c, s, pray_vec{1, 1, 0}), "stretch: the factors must not be 0, not <1, 1, 0>");
-    pray_object *e = pray_stretch(c, s, pray_vec{1e200, 1, 1});
+    // (frames stay within what the renderer's precision holds)
+    const double big = std::strstr(pray_features(), "real=float") ? 1e25 : 1e200;
+    pray_object *e = pray_stretch(c, s, pray_vec{big, 1, 1});
     REQUIRE(e);
-    refused(pray_scale(c, e, 1e200), "the transformation takes a primitive out of the range of numbers");
+    refused(pray_scale(c, e, big), "the transformation takes a primitive out of the range of numbers");
     pray_release(c, e);
     pray_release(c, s);
     pray_release(c, m);
