@@ -1773,7 +1773,6 @@ struct PrimFrame {
 };
 // Kinds of prepared primitives beside ObjKind's: a sphere and a cylinder in a frame.
 enum { P_ELLIPSOID = O_COMPL + 1, P_ECYLINDER };
-inline bool framed_kind(int kind) { return (kind >= O_BOX && kind <= O_TORUS) || kind >= P_ELLIPSOID; }
 
 struct Prim {
     int kind;           // O_SPHERE, O_PLANE, O_CYLINDER; in a frame (fr): O_BOX, O_ROD, O_CONE,
