@@ -8,7 +8,7 @@
    [SECTION] 5  Scene values: models, lights, solids (reference counted handles)
    [SECTION] 6  Options
    [SECTION] 7  Prepared scene: flattened n-ary CSG tree, boxes, simplification, snapping
-   [SECTION] 8  Ray/primitive intersection
+   [SECTION] 8  Ray/primitive intersection; primitives in a frame (box, rod, cone, torus, stretched)
    [SECTION] 9  CSG status-tree sweep (the brute-force reference, thesis 3.4)
    [SECTION] 9b Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
                 [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas and
@@ -857,7 +857,8 @@ void sincos_deg(double deg, double *s, double *c) {
     }
 }
 
-// An affine map x -> m x + t with m a multiple of a rotation (the only maps `.` makes).
+// An affine map x -> m x + t: m is a multiple of a rotation for the maps `.` makes; `stretch`
+// and the frames of primitives (pray_object::fr) make general ones.
 struct Xform {
     double m[3][3];
     pray_vec t;
@@ -913,6 +914,41 @@ double xf_scale_of(const Xform &f) {
     double s = sqrt(f.m[0][0] * f.m[0][0] + f.m[1][0] * f.m[1][0] + f.m[2][0] * f.m[2][0]);
     return d < 0 ? -s : s;
 }
+// f after g: x -> f(g(x)).
+Xform xf_compose(const Xform &f, const Xform &g) {
+    Xform h;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) h.m[i][j] = f.m[i][0] * g.m[0][j] + f.m[i][1] * g.m[1][j] + f.m[i][2] * g.m[2][j];
+    h.t = xf_point(f, g.t);
+    return h;
+}
+Xform xf_stretch(pray_vec v) {
+    Xform f = xf_identity();
+    f.m[0][0] = v.x;
+    f.m[1][1] = v.y;
+    f.m[2][2] = v.z;
+    return f;
+}
+// The inverse of f's linear part (its translation left zero); false when it has none in the
+// range of numbers.
+bool xf_inverse(const Xform &f, Xform *g) {
+    const double(*m)[3] = f.m;
+    double c[3][3];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {  // cofactor of m[j][i]: the adjugate, transposed as it goes
+            int j1 = (j + 1) % 3, j2 = (j + 2) % 3, i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+            c[i][j] = m[j1][i1] * m[j2][i2] - m[j1][i2] * m[j2][i1];
+        }
+    double det = m[0][0] * c[0][0] + m[0][1] * c[1][0] + m[0][2] * c[2][0];
+    *g = xf_identity();
+    bool ok = det != 0 && finite_num(det);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            g->m[i][j] = ok ? c[i][j] / det : 0;
+            ok = ok && finite_num(g->m[i][j]);
+        }
+    return ok;
+}
 // Normals transform with the inverse transpose; for s R that is R / s, which points the same way
 // as s R n: a reflection (s < 0) turns a half-space's outward normal along with the space.
 pray_vec xf_normal(const Xform &f, pray_vec n) { return xf_dir(f, n); }
@@ -939,7 +975,11 @@ struct Handle {
     int kind;
     unsigned magic;
 };
-enum ObjKind { O_SPHERE, O_PLANE, O_CYLINDER, O_ONE, O_NOTHING, O_UNION, O_INTER, O_DIFF, O_COMPL };
+enum ObjKind {
+    O_SPHERE, O_PLANE, O_CYLINDER, O_BOX, O_ROD, O_CONE, O_TORUS,  // primitives
+    O_ONE, O_NOTHING, O_UNION, O_INTER, O_DIFF, O_COMPL
+};
+inline bool is_prim(int kind) { return kind <= O_TORUS; }
 // Texture coordinates of a primitive (planemap, spheremap): its U and V vectors. Kept apart, as
 // few primitives have them.
 struct MapInfo {
@@ -993,7 +1033,8 @@ struct pray_light {
     LightSrc *src;
 };
 
-// A solid. Primitives use p, v, r; nodes use kids->k[k0 .. k0+nkids). Chains of one operation
+// A solid. Primitives use p, v, r (a cone also r2: the radius at v; a torus r2: the tube's
+// radius), in the frame fr when they have one; nodes use kids->k[k0 .. k0+nkids). Chains of one operation
 // share one Kids array that grows at either end, so `All = All | s` and `All = s | All` in a loop
 // cost O(1) per step and build one node.
 struct pray_object {
@@ -1001,8 +1042,12 @@ struct pray_object {
     int kind;
     pray_model *mat;
     pray_vec p, v;
-    double r;
+    double r, r2;
     MapInfo *map;    // texture coordinates, or NULL
+    // The primitive's own frame: p, v, r and map are in local coordinates, which fr maps to the
+    // world. NULL: they are in the world. box, rod, cone and torus always have one; a sphere or a
+    // cylinder gets one when stretched. (A half-space is stretched exactly without one.)
+    Xform *fr;
     Kids *kids;
     int nkids, k0;
     long nprims;
@@ -1039,6 +1084,7 @@ void release_handle(pray_ctx *c, void *p) {
         release_handle(c, o->mat);
         release_handle(c, o->kids);
         mem_free(c, o->map);
+        mem_free(c, o->fr);
         break;
     }
     case H_KIDS: {
@@ -1094,7 +1140,7 @@ pray_object *obj_new(pray_ctx *c, int kind, pray_model *m) {
     o->kind = kind;
     o->mat = m;
     retain(m);
-    o->nprims = kind <= O_CYLINDER ? 1 : 0;
+    o->nprims = is_prim(kind) ? 1 : 0;
     o->depth = 1;
     return o;
 }
@@ -1234,8 +1280,43 @@ pray_object *complement_of(pray_ctx *c, pray_object *a) {
     return o;
 }
 
+// Whether a frame maps into the range of numbers and back (render precision included).
+bool frame_ok(const Xform &f) {
+    Xform g;
+    if (!vfinite(f.t) || !xf_inverse(f, &g)) return false;
+    double big = sizeof(real) < sizeof(double) ? 1e30 : 1e300;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            if (!(fabs(f.m[i][j]) < big && fabs(g.m[i][j]) < big)) return false;
+    return vmaxabs(f.t) < big;
+}
+
+// A copy of primitive a (which has a frame, or is given one) with f applied to its frame: its
+// local parameters and texture coordinates stay as they are.
+pray_object *obj_reframe(pray_ctx *c, const pray_object *a, const Xform &f, const char *what) {
+    pray_object *o = obj_new(c, a->kind, a->mat);
+    if (!o) return NULL;
+    o->p = a->p;
+    o->v = a->v;
+    o->r = a->r;
+    o->r2 = a->r2;
+    o->fr = (Xform *)mem_alloc(c, sizeof(Xform));
+    if (!o->fr || (a->map && !obj_map(c, o, a->map->kind, a->map->u, a->map->v, a->map->mirrored))) {
+        release_handle(c, o);
+        return NULL;
+    }
+    *o->fr = a->fr ? xf_compose(f, *a->fr) : f;
+    if (!frame_ok(*o->fr)) {
+        release_handle(c, o);
+        fail(c, PRAY_ERR_ARG, "%s takes a primitive out of the range of numbers", what);
+        return NULL;
+    }
+    return o;
+}
+
 // A copy of the tree with the map applied to every primitive.
 pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
+    if (a->fr) return obj_reframe(c, a, f, "the transformation");
     pray_object *o = obj_new(c, a->kind, a->mat);
     if (!o) return NULL;
     double s = fabs(xf_scale_of(f));
@@ -1267,7 +1348,7 @@ pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
         break;
     default: break;
     }
-    if (a->kind <= O_CYLINDER &&
+    if (is_prim(a->kind) &&
         (!map_ok || !vfinite(o->p) || !vfinite(o->v) || !finite_num(o->r) || (a->kind != O_PLANE && !(o->r > 0)) ||
          (a->kind != O_SPHERE && vlen(o->v) == 0))) {
         release_handle(c, o);
@@ -1292,6 +1373,59 @@ pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
         o->nprims = a->nprims;
         o->depth = a->depth;
     }
+    return o;
+}
+
+// A copy of the tree scaled by the components of v along the world axes (none of them 0).
+// Half-spaces stay half-spaces: their normals turn by the inverse of the map, and a planemap's
+// vectors so that each point keeps its texture coordinates. Other primitives take the map into
+// their frames.
+pray_object *obj_stretch(pray_ctx *c, pray_object *a, pray_vec v) {
+    if (is_prim(a->kind) && a->kind != O_PLANE) return obj_reframe(c, a, xf_stretch(v), "stretch");
+    if (!is_node(a->kind) && a->kind != O_PLANE) return obj_new(c, a->kind, a->mat);  // one, nothing
+    pray_object *o = obj_new(c, a->kind, a->mat);
+    if (!o) return NULL;
+    if (a->kind == O_PLANE) {
+        o->p = vmake(a->p.x * v.x, a->p.y * v.y, a->p.z * v.z);
+        o->v = vunit(vmake(a->v.x / v.x, a->v.y / v.y, a->v.z / v.z));
+        bool ok = vfinite(o->p) && vlen(o->v) > 0;
+        if (ok && a->map) {
+            // s = (x - p).u / |u|^2 for x = S y: u' = w |u|^2 / |w|^2 with w = S^-1 u
+            pray_vec uv[2] = {a->map->u, a->map->v};
+            for (int i = 0; i < 2; i++) {
+                pray_vec w = vmake(uv[i].x / v.x, uv[i].y / v.y, uv[i].z / v.z);
+                double lu = vlen(uv[i]), lw = vlen(w);
+                uv[i] = vmul(w, (lu / lw) * (lu / lw));
+            }
+            if (!obj_map(c, o, MAP_PLANE, uv[0], uv[1], 0)) {
+                release_handle(c, o);
+                return NULL;
+            }
+            ok = map_len_ok(uv[0]) && map_len_ok(uv[1]) && vfinite(uv[0]) && vfinite(uv[1]);
+        }
+        if (!ok) {
+            release_handle(c, o);
+            fail(c, PRAY_ERR_ARG, "stretch takes a primitive out of the range of numbers");
+            return NULL;
+        }
+        return o;
+    }
+    o->kids = kids_new(c, a->nkids);
+    if (!o->kids) {
+        release_handle(c, o);
+        return NULL;
+    }
+    for (int i = 0; i < a->nkids; i++) {
+        pray_object *k = obj_stretch(c, kid(a, i), v);
+        if (!k) {
+            release_handle(c, o);
+            return NULL;
+        }
+        o->kids->k[o->kids->used++] = k;
+    }
+    o->nkids = a->nkids;
+    o->nprims = a->nprims;
+    o->depth = a->depth;
     return o;
 }
 
@@ -1645,8 +1779,22 @@ struct PrimMap {
     int mirrored;  // longitudes of a spheremap run the other way
 };
 
+// A primitive's own frame in render precision (local = inv (x - t)), and what the primitive
+// has there beyond Prim's parameters. Apart from the primitive, as few have one.
+struct PrimFrame {
+    R3 t;           // the world point of the local origin
+    R3 inv[3];      // rows of the linear map world -> local
+    R3 fwd[3];      // rows of the linear map local -> world
+    R3 lo, hi;      // a box's corners
+    real h, k, rt;  // rod, cone: the axis' length; cone: slope (r2 - r1) / h; torus: tube radius
+    int plain;      // the frame is the world's: rays need no mapping
+};
+// Kinds of prepared primitives beside ObjKind's: a sphere and a cylinder in a frame.
+enum { P_ELLIPSOID = O_COMPL + 1, P_ECYLINDER };
+
 struct Prim {
-    int kind;           // O_SPHERE, O_PLANE, O_CYLINDER
+    int kind;           // O_SPHERE, O_PLANE, O_CYLINDER; in a frame (fr): O_BOX, O_ROD, O_CONE,
+                        // O_TORUS, P_ELLIPSOID, P_ECYLINDER
     Axis axis;          // a plane whose normal lies along an axis: that component; else none
     Box box;            // contains the solid
     R3 p;               // centre, point on the plane, point on the axis
@@ -1655,6 +1803,7 @@ struct Prim {
     const pray_model *mat;
     int map;            // MapKind; with tm: the texture coordinates (NULL for MAP_NONE)
     const PrimMap *tm;
+    const PrimFrame *fr;  // framed kinds: p, n, r are local (NULL for the others)
     int id;             // position among the declared primitives, left to right
     int surf;           // the same number for primitives snapped to exactly one surface (twins)
     int parent;         // node index, -1 for the root
@@ -1682,12 +1831,14 @@ struct Accel;
 struct Scene {
     Array<Prim> prims;
     Array<PrimMap *> maps;  // the primitives' PrimMap blocks
+    Array<PrimFrame *> frames;  // and PrimFrame blocks
     int models_held;        // each primitive holds a reference to its model (scene_hold_models)
     Array<Node> nodes;
     Array<int> kids;  // element codes of the nodes' children
     int root;
     int prune;        // drop parts that bounds show cannot matter
     int leaves;       // primitives met so far while flattening
+    int tori;         // tori among the primitives (each may cross a ray four times)
     Accel *accel;     // NULL: the brute-force reference
     Array<Light> lights;
     int parallel;
@@ -1717,6 +1868,8 @@ void scene_release(pray_ctx *c, Scene *s) {
     s->lights.release(c);
     for (int i = 0; i < s->maps.n; i++) mem_free(c, s->maps[i]);
     s->maps.release(c);
+    for (int i = 0; i < s->frames.n; i++) mem_free(c, s->frames[i]);
+    s->frames.release(c);
     if (s->models_held)
         for (int i = 0; i < s->prims.n; i++) release_handle(c, (pray_model *)s->prims[i].mat);
     s->models_held = 0;
@@ -1912,6 +2065,122 @@ void capped_cylinder_box(const Scene *s, const int *kids, int n, Box *b) {
     }
 }
 
+// The frame block of primitive q made from object o's frame, with the parameters of its kind;
+// false when out of memory.
+bool prim_frame(pray_ctx *c, Scene *s, const pray_object *o, Prim *q) {
+    PrimFrame *f = (PrimFrame *)mem_zalloc(c, sizeof(PrimFrame));
+    if (!f || !s->frames.push(c, f)) {
+        mem_free(c, f);
+        return false;
+    }
+    Xform g;
+    xf_inverse(*o->fr, &g);  // (frame_ok has checked it)
+    f->t = r3of(o->fr->t);
+    for (int i = 0; i < 3; i++) {
+        f->inv[i] = r3((real)g.m[i][0], (real)g.m[i][1], (real)g.m[i][2]);
+        f->fwd[i] = r3((real)o->fr->m[i][0], (real)o->fr->m[i][1], (real)o->fr->m[i][2]);
+    }
+    // a box only moved (the frame a translation): its corners and texture origin are moved
+    // instead, and rays need no mapping
+    Xform id = xf_identity();
+    id.t = o->fr->t;
+    bool moved_box = o->kind == O_BOX && memcmp(&id, o->fr, sizeof id) == 0;
+    if (moved_box) {
+        q->p = r3of(vadd(o->p, o->fr->t));
+        f->t = r3(0, 0, 0);
+    }
+    f->plain = moved_box || (vmaxabs(o->fr->t) == 0 && memcmp(&id, o->fr, sizeof id) == 0);
+    pray_vec axis = vsub(o->v, o->p);
+    double h = vlen(axis);
+    switch (o->kind) {
+    case O_SPHERE: q->kind = P_ELLIPSOID; break;
+    case O_CYLINDER: q->kind = P_ECYLINDER; break;
+    case O_BOX: {
+        pray_vec t = moved_box ? o->fr->t : vmake(0, 0, 0), a = vadd(o->p, t), b = vadd(o->v, t);
+        f->lo = r3of(vmake(a.x < b.x ? a.x : b.x, a.y < b.y ? a.y : b.y, a.z < b.z ? a.z : b.z));
+        f->hi = r3of(vmake(a.x < b.x ? b.x : a.x, a.y < b.y ? b.y : a.y, a.z < b.z ? b.z : a.z));
+        break;
+    }
+    case O_ROD:
+    case O_CONE:
+        q->n = r3of(vunit(axis));
+        q->r = (real)o->r;
+        f->h = (real)h;
+        f->k = (real)((o->r2 - o->r) / h);
+        break;
+    case O_TORUS:
+        q->n = r3of(vunit(o->v));
+        q->r = (real)o->r;
+        f->rt = (real)o->r2;
+        break;
+    default: break;
+    }
+    q->fr = f;
+    return true;
+}
+
+// The world box of a primitive in a frame: its local extent along each world axis. (A disc of
+// radius r across unit axis a reaches r |e - a (e.a)| along the world axis whose row of the
+// frame's map is e.)
+Box frame_box(const Prim &q, const Xform &fr) {
+    Box b;
+    const PrimFrame &f = *q.fr;
+    double a[3] = {q.n.x, q.n.y, q.n.z}, scale = 0;
+    for (int i = 0; i < 3; i++) {
+        const double *e = fr.m[i];
+        double ea = e[0] * a[0] + e[1] * a[1] + e[2] * a[2];
+        double disc = sqrt(fabs(e[0] * e[0] + e[1] * e[1] + e[2] * e[2] - ea * ea));
+        double len = sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2]);
+        double ti = (double)comp(f.t, i);  // (a moved box: 0, its corners moved)
+        double lo, hi, p = e[0] * q.p.x + e[1] * q.p.y + e[2] * q.p.z + ti;
+        switch (q.kind) {
+        case P_ELLIPSOID: lo = p - q.r * len, hi = p + q.r * len; break;
+        case P_ECYLINDER:
+            lo = ea == 0 ? p - q.r * disc : -HUGE_VAL;
+            hi = ea == 0 ? p + q.r * disc : HUGE_VAL;
+            break;
+        case O_BOX: {
+            lo = hi = ti;
+            double l3[3] = {f.lo.x, f.lo.y, f.lo.z}, h3[3] = {f.hi.x, f.hi.y, f.hi.z};
+            for (int j = 0; j < 3; j++) {
+                double u = e[j] * l3[j], v = e[j] * h3[j];
+                lo += u < v ? u : v;
+                hi += u < v ? v : u;
+            }
+            break;
+        }
+        case O_ROD:
+        case O_CONE: {
+            double r2 = q.kind == O_ROD ? (double)q.r : (double)q.r + (double)f.k * (double)f.h;
+            double p2 = p + ea * (double)f.h;
+            lo = p - q.r * disc;
+            hi = p + q.r * disc;
+            if (p2 - r2 * disc < lo) lo = p2 - r2 * disc;
+            if (p2 + r2 * disc > hi) hi = p2 + r2 * disc;
+            break;
+        }
+        default: {  // torus
+            double ext = ((double)q.r + (double)f.rt) * disc + (double)f.rt * fabs(ea);
+            lo = p - ext;
+            hi = p + ext;
+        }
+        }
+        b.lo[i] = (real)lo;
+        b.hi[i] = (real)hi;
+        if (lo > -HUGE_VAL && fabs(lo) > scale) scale = fabs(lo);
+        if (hi < HUGE_VAL && fabs(hi) > scale) scale = fabs(hi);
+    }
+    // points reach the local frame and back with the rounding of both maps: pad by as much
+    double mf = 0, mi = 0;
+    for (int i = 0; i < 3; i++) {
+        double lf = sqrt((double)dot(f.fwd[i], f.fwd[i])), li = sqrt((double)dot(f.inv[i], f.inv[i]));
+        mf = lf > mf ? lf : mf;
+        mi = li > mi ? li : mi;
+    }
+    box_pad(&b, 4 * scale * mf * mi);
+    return b;
+}
+
 const Box &elem_box(const Scene *s, int e) {
     return e_is_node(e) ? s->nodes[e_index(e)].box : s->prims[e_index(e)].box;
 }
@@ -1984,7 +2253,11 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
     case O_NOTHING: return E_NONE;
     case O_SPHERE:
     case O_PLANE:
-    case O_CYLINDER: {
+    case O_CYLINDER:
+    case O_BOX:
+    case O_ROD:
+    case O_CONE:
+    case O_TORUS: {
         Prim q = Prim();  // zeros, and no axis
         q.kind = o->kind;
         q.p = r3of(o->p);
@@ -2009,12 +2282,14 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
             q.n = r3of(vunit(o->v));
             q.d = dot(q.n, q.p);
             q.axis = plane_axis(q.n);
-        } else {
+        } else if (o->kind == O_CYLINDER) {
             q.n = r3of(vunit(o->v));
             q.r = (real)o->r;
         }
+        if (o->fr && !prim_frame(c, s, o, &q)) return -3;
+        s->tori += o->kind == O_TORUS;
         q.r2 = q.r * q.r;
-        q.box = prim_box(q);
+        q.box = q.fr ? frame_box(q, *o->fr) : prim_box(q);
         if (!s->prims.push(c, q)) return -3;
         retain((void *)q.mat);  // (the tree may go before the scene: scene_build)
         return 2 * (s->prims.n - 1);
@@ -2216,7 +2491,7 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
         int j = i + 1;
         for (; j < n && same_key(k[i], k[j]); j++) {
             Prim &b = s->prims[k[j].prim];
-            if (!snap_close(a, b, k[i].sign, k[j].sign)) continue;
+            if (a.fr || !snap_close(a, b, k[i].sign, k[j].sign)) continue;  // (not in frames)
             int f = k[i].sign * k[j].sign;  // +1 same orientation, -1 opposite
             b.surf = a.surf;                // twins from now on
             if (a.kind != O_PLANE) b.p = a.p;  // a plane's point is its texture origin only
@@ -2463,7 +2738,7 @@ pray_status scene_compact(pray_ctx *c, Scene *s) {
 }
 
 // =============================================================================================
-// [SECTION] 8 Ray/primitive intersection
+// [SECTION] 8 Ray/primitive intersection; primitives in a frame (box, rod, cone, torus, stretched)
 // =============================================================================================
 const real REAL_INF = (real)HUGE_VAL;
 
@@ -2471,12 +2746,17 @@ struct Ray {
     R3 o, d;  // d is a unit vector
 };
 
-enum { SPAN_NONE, SPAN_ALL, SPAN };
+// SPAN2: two intervals, [t0, t1] and then [t2, t3] (a torus; where the caller asks for the
+// second, else a span it cannot take: an evaluation that can takes over).
+enum { SPAN_NONE, SPAN_ALL, SPAN, SPAN2 };
+
+int framed_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t1, real *t23);
 
 // The parameter interval [t0, t1] of the ray inside the primitive (t0 may be -inf, t1 +inf).
 // `self`: the ray starts on this primitive's surface; its crossing there is known by identity
 // and left out, and which side the ray goes to decides its status at the start.
-inline int prim_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t1) {
+// (t23: where a torus puts its second interval; NULL for callers that take one interval only.)
+inline int prim_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t1, real *t23 = 0) {
     switch (q.kind) {
     case O_SPHERE: {
         R3 oc = ray.o - q.p;
@@ -2522,7 +2802,7 @@ inline int prim_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t
         }
         return SPAN;
     }
-    default: {  // cylinder
+    case O_CYLINDER: {
         R3 oc = ray.o - q.p;
         R3 op = oc - q.n * dot(oc, q.n);
         R3 dp = ray.d - q.n * dot(ray.d, q.n);
@@ -2544,6 +2824,309 @@ inline int prim_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t
         *t1 = tc + h;
         return SPAN;
     }
+    default: return framed_span(q, ray, self, t0, t1, t23);
+    }
+}
+
+// ---- primitives in a frame: the ray mapped into it (its direction no longer a unit vector;
+// the parameter t is the same in both) ----
+inline R3 to_local(const PrimFrame &f, R3 x) {
+    R3 v = x - f.t;
+    return r3(dot(f.inv[0], v), dot(f.inv[1], v), dot(f.inv[2], v));
+}
+inline R3 dir_local(const PrimFrame &f, R3 d) { return r3(dot(f.inv[0], d), dot(f.inv[1], d), dot(f.inv[2], d)); }
+inline R3 dir_world(const PrimFrame &f, R3 d) { return r3(dot(f.fwd[0], d), dot(f.fwd[1], d), dot(f.fwd[2], d)); }
+// A local normal n as a world one: by the inverse transpose, which keeps it on the outer side
+// also when the frame mirrors.
+inline R3 normal_world(const PrimFrame &f, R3 n) { return unit(f.inv[0] * n.x + f.inv[1] * n.y + f.inv[2] * n.z); }
+
+// [t0, t1] of the ray within lo <= o + t d <= hi along one direction (o, d: along it); false
+// when empty. The bounds are exclusive as a half-space's are: a ray in the plane is outside.
+inline bool slab(real o, real d, real lo, real hi, real *t0, real *t1) {
+    if (d == 0) return o > lo && o < hi;
+    real a = (lo - o) / d, b = (hi - o) / d;
+    if (a > b) {
+        real x = a;
+        a = b;
+        b = x;
+    }
+    if (a > *t0) *t0 = a;
+    if (b < *t1) *t1 = b;
+    return *t0 <= *t1;
+}
+
+// The interval where A t^2 + 2 B t + C <= 0 that lies within [*t0, *t1] (narrowed to it); the
+// quadric's other piece when it has two (A < 0) is the one that meets less of [*t0, *t1].
+int quadric_span(real A, real B, real C, real *t0, real *t1) {
+    real lo = *t0, hi = *t1, a, b;
+    if (A == 0) {  // 2 B t + C <= 0
+        if (B == 0) return C <= 0 ? SPAN : SPAN_NONE;
+        real t = -C / (2 * B);
+        if (B > 0) a = -REAL_INF, b = t;
+        else a = t, b = REAL_INF;
+    } else {
+        real disc = B * B - A * C;
+        if (disc < 0) return A < 0 ? SPAN : SPAN_NONE;
+        real sq = (real)sqrt((double)disc);
+        real k = B > 0 ? -(B + sq) : -B + sq;  // no cancellation: the roots are k / A and C / k
+        real r0 = k / A, r1 = k != 0 ? C / k : r0;
+        if (r0 > r1) {
+            real x = r0;
+            r0 = r1;
+            r1 = x;
+        }
+        if (A > 0) a = r0, b = r1;
+        else {  // (-inf, r0] and [r1, inf)
+            real l0 = (r0 < hi ? r0 : hi) - lo, l1 = hi - (r1 > lo ? r1 : lo);
+            if (l0 >= l1) a = -REAL_INF, b = r0;
+            else a = r1, b = REAL_INF;
+        }
+    }
+    if (a > lo) *t0 = a;
+    if (b < hi) *t1 = b;
+    return *t0 <= *t1 ? SPAN : SPAN_NONE;
+}
+
+// The real roots of the depressed quartic x^4 + c2 x^2 + c1 x + c0 where it changes sign, in
+// increasing order: 0, 2 or 4 of them, where it turns negative and positive again in turn.
+// Each lies alone between two extremes (roots of the derivative, a cubic solved in closed form
+// and polished), where it is bracketed and refined by Newton steps kept in the bracket.
+int quartic_roots(double c2, double c1, double c0, double *root) {
+    // the extremes: 4 x^3 + 2 c2 x + c1 = 0, i.e. x^3 + P x + Q = 0
+    double P = c2 / 2, Q = c1 / 4, ext[3];
+    int ne;
+    double D = (Q / 2) * (Q / 2) + (P / 3) * (P / 3) * (P / 3);
+    if (D > 0) {
+        double A = cbrt_pos(fabs(Q) / 2 + sqrt(D));
+        if (Q > 0) A = -A;
+        ext[0] = A != 0 ? A - P / (3 * A) : 0;
+        ne = 1;
+    } else {
+        double m = 2 * sqrt(-P / 3), c = m > 0 ? 3 * Q / (P * m) : 0;
+        double th = acos(c > 1 ? 1 : c < -1 ? -1 : c) / 3;
+        for (int k = 0; k < 3; k++) ext[k] = m * cos(th - 2.0943951023931954923 * k);
+        ne = 3;
+    }
+    for (int k = 0; k < ne; k++)
+        for (int it = 0; it < 2; it++) {  // polish
+            double x = ext[k], g = 3 * x * x + P;
+            if (g != 0) ext[k] = x - ((x * x + P) * x + Q) / g;
+        }
+    for (int i = 1; i < ne; i++)  // sort
+        for (int j = i; j > 0 && ext[j] < ext[j - 1]; j--) {
+            double x = ext[j];
+            ext[j] = ext[j - 1];
+            ext[j - 1] = x;
+        }
+    double B = 1 + (fabs(c2) > fabs(c1) ? fabs(c2) : fabs(c1));
+    if (fabs(c0) + 1 > B) B = fabs(c0) + 1;
+    double pts[5];
+    int np = 0;
+    pts[np++] = -B;
+    for (int k = 0; k < ne; k++)
+        if (ext[k] > -B && ext[k] < B) pts[np++] = ext[k];
+    pts[np++] = B;
+    int n = 0;
+    for (int i = 0; i + 1 < np; i++) {
+        double lo = pts[i], hi = pts[i + 1];
+        double flo = ((lo * lo + c2) * lo + c1) * lo + c0, fhi = ((hi * hi + c2) * hi + c1) * hi + c0;
+        if ((flo < 0) == (fhi < 0)) continue;
+        bool down = flo >= 0;  // f falls through the root: entering
+        double x = (lo + hi) / 2;
+        for (int it = 0; it < 200; it++) {
+            double fx = ((x * x + c2) * x + c1) * x + c0;
+            if (fx == 0) break;
+            if ((fx < 0) == down) hi = x;
+            else lo = x;
+            double g = (4 * x * x + 2 * c2) * x + c1, y = g != 0 ? x - fx / g : lo;
+            if (!(y > lo && y < hi)) y = lo + (hi - lo) / 2;  // Newton left the bracket: halve it
+            if (y == x || !(hi - lo > 0) || y == lo || y == hi) {
+                x = y;
+                break;
+            }
+            x = y;
+        }
+        root[n++] = x;
+    }
+    return n & ~1;  // (in pairs: the quartic is positive far out on both sides)
+}
+
+// The torus: centre p, unit axis n, radius r to the tube's centre line, tube radius f.rt. The
+// ray is taken in units of r from its point nearest the centre, so that the quartic's
+// coefficients are of order 1 whatever the torus' size and distance; a ray that passes farther
+// than r + rt from the centre misses. `self`: the crossing nearest the origin is the ray's start.
+int torus_span(const Prim &q, R3 o, R3 d, bool self, real *t) {
+    const PrimFrame &f = *q.fr;
+    double R = (double)q.r, rt = (double)f.rt / R;
+    double dv[3] = {(double)d.x, (double)d.y, (double)d.z}, ov[3], nv[3] = {(double)q.n.x, (double)q.n.y, (double)q.n.z};
+    R3 oc = o - q.p;
+    ov[0] = (double)oc.x / R;
+    ov[1] = (double)oc.y / R;
+    ov[2] = (double)oc.z / R;
+    double dl = sqrt(dv[0] * dv[0] + dv[1] * dv[1] + dv[2] * dv[2]);
+    if (!(dl > 0)) return SPAN_NONE;
+    for (int i = 0; i < 3; i++) dv[i] /= dl;  // x = o + s d, t = (s + sc) R / dl
+    double sc = -(ov[0] * dv[0] + ov[1] * dv[1] + ov[2] * dv[2]);
+    for (int i = 0; i < 3; i++) ov[i] += sc * dv[i];
+    double oo = ov[0] * ov[0] + ov[1] * ov[1] + ov[2] * ov[2];
+    if (oo >= (1 + rt) * (1 + rt)) return SPAN_NONE;
+    double on = ov[0] * nv[0] + ov[1] * nv[1] + ov[2] * nv[2], dn = dv[0] * nv[0] + dv[1] * nv[1] + dv[2] * nv[2];
+    double k = oo + 1 - rt * rt;
+    // (s^2 + k)^2 = 4 |(o + s d) across the axis|^2, with o.d = 0
+    double c2 = 2 * k - 4 * (1 - dn * dn), c1 = 8 * on * dn, c0 = k * k - 4 * (oo - on * on);
+    double root[4];
+    int n = quartic_roots(c2, c1, c0, root);
+    if (n == 0) return SPAN_NONE;
+    double scale = R / dl;
+    real tt[4];
+    for (int i = 0; i < n; i++) tt[i] = (real)((root[i] + sc) * scale);
+    if (self) {  // the root nearest 0 is the start: the ray is inside after it when it enters there
+        int b = 0;
+        for (int i = 1; i < n; i++)
+            if (fabs((double)tt[i]) < fabs((double)tt[b])) b = i;
+        tt[b] = 0;
+        for (int i = 0; i < n; i++)  // (rounding may leave an earlier root just past 0)
+            if (i < b && tt[i] > 0) tt[i] = 0;
+    }
+    if (n == 4 && !(tt[1] < tt[2])) {  // intervals that touch (a ray grazing the hole's rim): one
+        tt[1] = tt[3];
+        n = 2;
+    }
+    for (int i = 0; i < n; i++) t[i] = tt[i];
+    return n == 2 ? SPAN : SPAN2;
+}
+
+int framed_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t1, real *t23) {
+    const PrimFrame &f = *q.fr;
+    R3 o = ray.o, d = ray.d;
+    if (!f.plain) o = to_local(f, o), d = dir_local(f, d);
+    if (q.kind == O_TORUS) {
+        real t[4];
+        int k = torus_span(q, o, d, self, t);
+        *t0 = t[0];
+        *t1 = t[1];
+        if (k == SPAN2 && t23) {
+            t23[0] = t[2];
+            t23[1] = t[3];
+        }
+        return k;
+    }
+    int k = SPAN;
+    *t0 = -REAL_INF;
+    *t1 = REAL_INF;
+    switch (q.kind) {
+    case O_BOX:
+        if (!slab(o.x, d.x, f.lo.x, f.hi.x, t0, t1) || !slab(o.y, d.y, f.lo.y, f.hi.y, t0, t1) ||
+            !slab(o.z, d.z, f.lo.z, f.hi.z, t0, t1))
+            k = SPAN_NONE;
+        break;
+    case P_ELLIPSOID:
+    case P_ECYLINDER:
+    case O_ROD:
+    case O_CONE: {
+        // along the local direction made a unit vector (t = s / dl), so that the quadric's
+        // coefficients neither overflow nor underflow
+        real dl = (real)sqrt((double)dot(d, d));
+        if (!(dl > 0)) return SPAN_NONE;
+        d = d * ((real)1 / dl);
+        R3 oc = o - q.p;
+        real so = 0, sd = 0;
+        if (q.kind != P_ELLIPSOID) {
+            so = dot(oc, q.n);
+            sd = dot(d, q.n);
+            oc = oc - q.n * so;
+            d = d - q.n * sd;
+        }
+        if ((q.kind == O_ROD || q.kind == O_CONE) && !slab(so, sd, 0, f.h, t0, t1)) {
+            k = SPAN_NONE;
+            break;
+        }
+        real ro = q.r, rd = 0;  // the radius at the origin's level, and its change along t
+        if (q.kind == O_CONE) {
+            ro = q.r + f.k * so;
+            rd = f.k * sd;
+        }
+        // |oc + s d|^2 - (ro + s rd)^2 <= 0 (d across the axis is taken as 0 where its square
+        // would lose its precision: a ray along the axis)
+        const real DD_MIN = sizeof(real) < sizeof(double) ? (real)1e-30 : (real)1e-290;
+        real dd = dot(d, d);
+        if (dd < DD_MIN) dd = 0;
+        if (dd == 0 && rd == 0) {
+            if (!(dot(oc, oc) < ro * ro)) k = SPAN_NONE;
+            else if (q.kind == P_ECYLINDER) k = SPAN_ALL;
+        } else
+            k = quadric_span(dd - rd * rd, dot(oc, d) - ro * rd, dot(oc, oc) - ro * ro, t0, t1);
+        *t0 /= dl;
+        *t1 /= dl;
+        break;
+    }
+    default: k = SPAN_NONE; break;
+    }
+    if (self) {  // the span's end at the ray's origin is its crossing there: inward or not
+        if (k != SPAN || !(*t1 > -*t0)) return SPAN_NONE;
+        *t0 = 0;
+    }
+    return k;
+}
+
+// Whether world point x lies inside a primitive in a frame (strictly, as its spans count it);
+// false for the torus, which is not convex (so its corners say nothing of a box between them).
+bool framed_inside(const Prim &q, R3 x) {
+    const PrimFrame &f = *q.fr;
+    R3 l = to_local(f, x), v = l - q.p;
+    switch (q.kind) {
+    case O_BOX: return l.x > f.lo.x && l.x < f.hi.x && l.y > f.lo.y && l.y < f.hi.y && l.z > f.lo.z && l.z < f.hi.z;
+    case P_ELLIPSOID: return dot(v, v) < q.r2;
+    case P_ECYLINDER:
+    case O_ROD:
+    case O_CONE: {
+        real s = dot(v, q.n), r = q.kind == O_CONE ? q.r + f.k * s : q.r;
+        R3 perp = v - q.n * s;
+        return (q.kind == P_ECYLINDER || (s > 0 && s < f.h)) && dot(perp, perp) < r * r;
+    }
+    default: return false;  // (a torus is not convex)
+    }
+}
+
+// Outward unit normal of a primitive in a frame at local point x on its surface: of the part
+// of its surface that x is nearest to.
+R3 framed_normal(const Prim &q, R3 x) {
+    const PrimFrame &f = *q.fr;
+    switch (q.kind) {
+    case O_BOX: {
+        real best = REAL_INF;
+        R3 n = r3(0, 0, 0);
+        for (int i = 0; i < 3; i++) {
+            real v = comp(x, i), dl = (real)fabs((double)(v - comp(f.lo, i))), dh = (real)fabs((double)(v - comp(f.hi, i)));
+            if (dl < best) best = dl, n = r3(i == 0 ? -1 : 0, i == 1 ? -1 : 0, i == 2 ? -1 : 0);
+            if (dh < best) best = dh, n = r3(i == 0 ? 1 : 0, i == 1 ? 1 : 0, i == 2 ? 1 : 0);
+        }
+        return n;
+    }
+    case P_ELLIPSOID: return x - q.p;
+    case P_ECYLINDER:
+    case O_ROD:
+    case O_CONE: {
+        R3 v = x - q.p;
+        real s = dot(v, q.n);
+        R3 perp = v - q.n * s;
+        if (q.kind == P_ECYLINDER) return perp;
+        real r = q.kind == O_CONE ? q.r + f.k * s : q.r, k = q.kind == O_CONE ? f.k : 0;
+        // distance to the side along its normal, against the caps'
+        real side = ((real)sqrt((double)dot(perp, perp)) - r) / (real)sqrt((double)(1 + k * k));
+        side = (real)fabs((double)side);
+        real c0 = (real)fabs((double)s), c1 = (real)fabs((double)(s - f.h));
+        if (c0 <= c1 && c0 < side) return q.n * (real)-1;
+        if (c1 < c0 && c1 < side) return q.n;
+        R3 n = unit(perp) - q.n * k;
+        return dot(n, n) > 0 ? n : q.n * (real)(s < f.h / 2 ? -1 : 1);
+    }
+    default: {  // torus: away from the nearest point of the tube's centre line
+        R3 v = x - q.p;
+        R3 rho = v - q.n * dot(v, q.n);
+        real l = (real)sqrt((double)dot(rho, rho));
+        return l > 0 ? v - rho * (q.r / l) : q.n * (real)(dot(v, q.n) < 0 ? -1 : 1);
+    }
     }
 }
 
@@ -2552,10 +3135,11 @@ R3 prim_normal(const Prim &q, R3 x) {
     switch (q.kind) {
     case O_SPHERE: return unit(x - q.p);
     case O_PLANE: return q.n;
-    default: {
+    case O_CYLINDER: {
         R3 v = x - q.p;
         return unit(v - q.n * dot(v, q.n));
     }
+    default: return normal_world(*q.fr, framed_normal(q, to_local(*q.fr, x)));
     }
 }
 
@@ -2618,6 +3202,7 @@ struct Scratch {
     // per ray, stamped with the ray number (thesis 3.5: no explicit unfreezing)
     unsigned ray;
     Span *span;                     // per primitive: its interval along the ray, once per ray
+    real *span2;                    // per primitive: a torus' second interval (NULL without tori)
     unsigned *nfrozen;              // frozen for this ray: an ancestor's status is fixed
     unsigned *nfixed;               // status known for the rest of this ray ...
     unsigned char *nfixval;         // ... and its value
@@ -2643,7 +3228,8 @@ void *thread_alloc(pray_ctx *c, size_t n) { return mem_zalloc(c, n + LINE_SLACK)
 bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     memset(w, 0, sizeof *w);
     size_t np = (size_t)s->prims.n + 1, nn = (size_t)s->nodes.n + 1;
-    w->cross = (Cross *)thread_alloc(c, sizeof(Cross) * 2 * np);
+    w->cross = (Cross *)thread_alloc(c, sizeof(Cross) * 2 * (np + (size_t)s->tori));
+    if (s->tori) w->span2 = (real *)thread_alloc(c, sizeof(real) * 2 * np);
     w->hull = (Hull *)thread_alloc(c, sizeof(Hull) * nn);
     w->pstat = (unsigned char *)thread_alloc(c, np);
     w->nstat = (unsigned char *)thread_alloc(c, nn);
@@ -2655,12 +3241,13 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->nfixval = (unsigned char *)thread_alloc(c, nn);
     w->blocker = (int *)thread_alloc(c, sizeof(int) * 3 * (size_t)(s->lights.n + 1));
     if (w->blocker) shadow_cache_clear(s, w);
-    return w->blocker && w->cross && w->hull && w->pstat && w->nstat && w->nfirst && w->cnt && w->span &&
+    return w->blocker && w->cross && (w->span2 || !s->tori) && w->hull && w->pstat && w->nstat && w->nfirst && w->cnt && w->span &&
            w->nfrozen && w->nfixed && w->nfixval;
 }
 
 void scratch_release(pray_ctx *c, Scratch *w) {
     mem_free(c, w->span);
+    mem_free(c, w->span2);
     mem_free(c, w->nfrozen);
     mem_free(c, w->nfixed);
     mem_free(c, w->nfixval);
@@ -2750,24 +3337,20 @@ bool sweep_start(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
     }
     for (int i = 0; i < np; i++) {
         const Prim &q = s->prims[i];
-        real t0 = 0, t1 = 0;
+        real t[4] = {0, 0, 0, 0};
         w->k.tests += 1;
-        int k = prim_span(q, ray, twin(s, i, self), &t0, &t1);
+        int k = prim_span(q, ray, twin(s, i, self), &t[0], &t[1], &t[2]);
         bool in = false;
         if (k == SPAN_ALL) in = true;
-        else if (k == SPAN) {
-            in = t0 <= 0 && 0 < t1;
-            if (t0 > 0 && t0 < tmax) {
-                w->cross[nc].t = t0;
-                w->cross[nc].prim = i;
-                w->cross[nc].enter = 1;
-                nc++;
-            }
-            if (t1 > 0 && t1 < tmax) {
-                w->cross[nc].t = t1;
-                w->cross[nc].prim = i;
-                w->cross[nc].enter = 0;
-                nc++;
+        else if (k == SPAN || k == SPAN2) {
+            for (int j = 0; j < (k == SPAN2 ? 4 : 2); j++) {
+                in = in || (!(j & 1) && t[j] <= 0 && 0 < t[j + 1]);
+                if (t[j] > 0 && t[j] < tmax) {
+                    w->cross[nc].t = t[j];
+                    w->cross[nc].prim = i;
+                    w->cross[nc].enter = !(j & 1);
+                    nc++;
+                }
             }
         }
         w->pstat[i] = in;
@@ -3018,6 +3601,8 @@ inline int face_cell(const LightFace &F, real u, real v, real slack, int *cell) 
 }
 
 // ---- [9b.2] Building: action lists, plans, the region-to-list builder ----
+int classify_framed(const Prim &q, const real *lo, const real *hi);
+
 // Class of a primitive against a closed box.
 int classify_prim(const Prim &q, const real *lo, const real *hi) {
     real cen[3], half[3];
@@ -3027,6 +3612,7 @@ int classify_prim(const Prim &q, const real *lo, const real *hi) {
     }
     R3 c = r3(cen[0], cen[1], cen[2]);
     switch (q.kind) {
+    default: return classify_framed(q, lo, hi);
     case O_SPHERE: {
         real near2 = 0, far2 = 0;
         for (int i = 0; i < 3; i++) {
@@ -3047,7 +3633,7 @@ int classify_prim(const Prim &q, const real *lo, const real *hi) {
         if (sc + rad < 0) return CL_IN;
         return CL_BD;
     }
-    default: {  // cylinder: exact inside (convex: all corners), conservative outside
+    case O_CYLINDER: {  // exact inside (convex: all corners), conservative outside
         bool all_in = true;
         for (int k = 0; k < 8 && all_in; k++) {
             R3 x = r3(k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]) - q.p;
@@ -3063,6 +3649,16 @@ int classify_prim(const Prim &q, const real *lo, const real *hi) {
         return CL_BD;
     }
     }
+}
+
+// Class of a primitive in a frame against a closed box: outside when clear of its bounds,
+// inside when it is convex and holds every corner.
+int classify_framed(const Prim &q, const real *lo, const real *hi) {
+    for (int i = 0; i < 3; i++)
+        if (hi[i] < q.box.lo[i] || q.box.hi[i] < lo[i]) return CL_OUT;
+    for (int k = 0; k < 8; k++)
+        if (!framed_inside(q, r3(k & 1 ? hi[0] : lo[0], k & 2 ? hi[1] : lo[1], k & 4 ? hi[2] : lo[2]))) return CL_BD;
+    return CL_IN;
 }
 
 // Builds action lists from the classes of the primitives a region touches; all others are
@@ -3366,6 +3962,7 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
     group.init();
     gsolid.init();
     bool mem = np == 0 || (plan->push(c, 0) && plan->push(c, 0) && plan->push(c, 0)), ok = np > 0 && mem;
+    for (int i = 0; ok && s->tori && i < np; i++) ok = s->prims[prims[i]].kind != O_TORUS;  // (two intervals)
     for (int i = 0; ok && i < np; i++) {
         int path[PLAN_DEPTH], n = 0;  // the ancestors, the root last
         for (int p = s->prims[prims[i]].parent; ok && p >= 0; p = s->nodes[p].parent) {
@@ -3818,7 +4415,7 @@ int classify_zone(const Prim &q, const Box &bx, const Zone &z) {
         in = in && (z.r == 0 || sc < -z.r);
         break;
     }
-    default: {  // cylinder
+    case O_CYLINDER: {
         for (int k = 0; k < z.nv && in; k++) {
             R3 x = z.v[k] - q.p;
             R3 perp = x - q.n * dot(x, q.n);
@@ -3827,7 +4424,11 @@ int classify_zone(const Prim &q, const Box &bx, const Zone &z) {
         R3 x = z.c - q.p;
         R3 perp = x - q.n * dot(x, q.n);
         in = in && (z.r == 0 || (real)sqrt((double)dot(perp, perp)) + z.r < q.r);
+        break;
     }
+    default:  // in a frame: inside when convex and holding every vertex (no ball)
+        for (int k = 0; k < z.nv && in; k++) in = framed_inside(q, z.v[k]);
+        in = in && z.r == 0;
     }
     if (out && out_ball) return CL_OUT;
     return in ? CL_IN : CL_BD;
@@ -4461,7 +5062,7 @@ inline const Span &span_get(const Scene *s, Scratch *w, const Ray &ray, int p, i
     if (sp.stamp != w->ray) {
         sp.stamp = w->ray;
         w->k.tests += 1;
-        sp.kind = prim_span(s->prims[p], ray, twin(s, p, self), &sp.t0, &sp.t1);
+        sp.kind = prim_span(s->prims[p], ray, twin(s, p, self), &sp.t0, &sp.t1, w->span2 ? w->span2 + 2 * p : NULL);
     }
     return sp;
 }
@@ -4780,8 +5381,23 @@ bool eval_full(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
         int kind = sp.kind;
         real t0 = sp.t0, t1 = sp.t1;
         bool in = kind == SPAN_ALL || (kind == SPAN && t0 <= a && a < t1);
+        if (kind == SPAN2) {  // a torus: two intervals; it settles after the second (settle_prim)
+            const real *t23 = w->span2 + 2 * p;
+            in = (t0 <= a && a < t1) || (t23[0] <= a && a < t23[1]);
+            real t[4] = {t0, t1, t23[0], t23[1]};
+            for (int j = 0; j < 4; j++)
+                if (t[j] > a && t[j] <= b && t[j] < tmax) {
+                    w->cross[nc].t = t[j];
+                    w->cross[nc].prim = p;
+                    w->cross[nc].enter = !(j & 1);
+                    nc++;
+                }
+            kind = SPAN;
+            t0 = t23[0];
+            t1 = t23[1];
+        }
         w->pstat[p] = in;
-        if (kind == SPAN) {
+        if (kind == SPAN && sp.kind == SPAN) {
             if (t0 > a && t0 <= b && t0 < tmax) {
                 w->cross[nc].t = t0;
                 w->cross[nc].prim = p;
@@ -4823,7 +5439,10 @@ bool eval_full(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
                 root = !root;
                 last = i;
             }
-            if (A->freeze && (s->prims[x.prim].settles & (st ? 2 : 1)) && (!st || w->span[x.prim].t1 >= REAL_INF))
+            // (a torus left for good: at the end of its second interval)
+            const Span &sp = w->span[x.prim];
+            if (A->freeze && (s->prims[x.prim].settles & (st ? 2 : 1)) &&
+                (!st ? sp.kind != SPAN2 || x.t >= w->span2[2 * x.prim + 1] : sp.t1 >= REAL_INF))
                 settle(s, w, 2 * x.prim, st);
         }
         if (root != before && last >= 0) {
@@ -6251,11 +6870,19 @@ struct Tracer {
 
 // ---- textured surfaces ----
 // Texture coordinates of point x on primitive q, and the unit directions in which s and t grow.
+// (A primitive in a frame: at x's place in the frame, with the directions mapped to the world.)
 void tex_coords(const Prim &q, R3 x, double *s, double *t, R3 *ds, R3 *dt) {
     const double PI = 3.14159265358979323846;
     *s = *t = 0;
     *ds = *dt = r3(0, 0, 0);
-    if (q.map == MAP_PLANE) {
+    if (q.fr && q.map != MAP_NONE) {
+        Prim l = q;
+        l.fr = NULL;
+        l.n = unit(framed_normal(q, to_local(*q.fr, x)));  // (where a planemap's directions are projected)
+        tex_coords(l, to_local(*q.fr, x), s, t, ds, dt);
+        *ds = unit(dir_world(*q.fr, *ds));
+        *dt = unit(dir_world(*q.fr, *dt));
+    } else if (q.map == MAP_PLANE) {
         R3 d = x - q.p, mu = q.tm->u, mv = q.tm->v;
         *s = (double)dot(d, mu) / (double)dot(mu, mu);
         *t = (double)dot(d, mv) / (double)dot(mv, mv);
@@ -6671,6 +7298,7 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     memset(s, 0, sizeof *s);
     s->prims.init();
     s->maps.init();
+    s->frames.init();
     s->nodes.init();
     s->lights.init();
     s->kids.init();
@@ -7370,6 +7998,15 @@ bool prim_same(const Prim &a, const Prim &b) {
         return false;
     if (a.tm && (!same_r3(a.tm->u, b.tm->u) || !same_r3(a.tm->v, b.tm->v) || a.tm->mirrored != b.tm->mirrored))
         return false;
+    if (!a.fr != !b.fr) return false;
+    if (a.fr) {  // (a solid turned within its own box: the same box, another frame)
+        const PrimFrame &f = *a.fr, &g = *b.fr;
+        for (int k = 0; k < 3; k++)
+            if (!same_r3(f.inv[k], g.inv[k]) || !same_r3(f.fwd[k], g.fwd[k])) return false;
+        if (!same_r3(f.t, g.t) || !same_r3(f.lo, g.lo) || !same_r3(f.hi, g.hi) || !same_real(f.h, g.h) ||
+            !same_real(f.k, g.k) || !same_real(f.rt, g.rt) || f.plain != g.plain)
+            return false;
+    }
     return model_same(a.mat, b.mat);
 }
 
@@ -8481,6 +9118,86 @@ pray_object *pray_cylinder(pray_ctx *c, pray_model *m, pray_vec point, pray_vec 
     return o;
 }
 
+namespace {
+// A primitive of the version-2 kinds: in its own frame (the world's, to begin with), with the
+// texture coordinates of a planemap at p along X and Y.
+pray_object *framed_new(pray_ctx *c, int kind, pray_model *m, pray_vec p, pray_vec v, double r, double r2) {
+    pray_object *o = obj_new(c, kind, m);
+    if (!o) return NULL;
+    o->p = p;
+    o->v = v;
+    o->r = r;
+    o->r2 = r2;
+    o->fr = (Xform *)mem_alloc(c, sizeof(Xform));
+    if (!o->fr || !obj_map(c, o, MAP_PLANE, vmake(1, 0, 0), vmake(0, 1, 0), 0)) {
+        release_handle(c, o);
+        return NULL;
+    }
+    *o->fr = xf_identity();
+    return o;
+}
+// The ends of an axis: finite, and far enough apart for its direction to be known.
+bool bad_axis(pray_ctx *c, pray_vec p1, pray_vec p2, const char *what) {
+    if (bad_vec(c, p1, what, false) || bad_vec(c, p2, what, false)) return true;
+    pray_vec a = vsub(p2, p1);
+    if (!vfinite(a)) {
+        fail(c, PRAY_ERR_ARG, "%s: the axis is longer than the range of numbers", what);
+        return true;
+    }
+    if (vmaxabs(a) <= 1e-12 * (vmaxabs(p1) + vmaxabs(p2))) {
+        fail(c, PRAY_ERR_ARG, "%s: the two points must be distinct", what);
+        return true;
+    }
+    return false;
+}
+} // namespace
+
+pray_object *pray_box(pray_ctx *c, pray_model *m, pray_vec p1, pray_vec p2) {
+    if (!c || !model_ok(c, m, "pray_box") || bad_vec(c, p1, "box", false) || bad_vec(c, p2, "box", false)) return NULL;
+    pray_vec d = vsub(p2, p1);
+    double e[3] = {fabs(d.x), fabs(d.y), fabs(d.z)}, a[3] = {fabs(p1.x) + fabs(p2.x), fabs(p1.y) + fabs(p2.y), fabs(p1.z) + fabs(p2.z)};
+    for (int i = 0; i < 3; i++)
+        if (!(e[i] > 1e-12 * a[i]) || !finite_num(e[i])) {
+            double u = i == 0 ? p1.x : i == 1 ? p1.y : p1.z;
+            if (e[i] == 0) fail(c, PRAY_ERR_ARG, "box: the corners must differ in every coordinate (both have %c = %g)", "xyz"[i], u);
+            else if (finite_num(e[i]))
+                fail(c, PRAY_ERR_ARG, "box: the corners are too close in %c to tell apart (%g apart at %g)", "xyz"[i], e[i], u);
+            else fail(c, PRAY_ERR_ARG, "box: the extent in %c is beyond the range of numbers", "xyz"[i]);
+            return NULL;
+        }
+    return framed_new(c, O_BOX, m, p1, p2, 0, 0);
+}
+
+pray_object *pray_rod(pray_ctx *c, pray_model *m, pray_vec p1, pray_vec p2, double r) {
+    if (!c || !model_ok(c, m, "pray_rod") || bad_axis(c, p1, p2, "rod") || bad_radius(c, r, "rod")) return NULL;
+    return framed_new(c, O_ROD, m, p1, p2, r, r);
+}
+
+pray_object *pray_cone(pray_ctx *c, pray_model *m, pray_vec p1, double r1, pray_vec p2, double r2) {
+    if (!c || !model_ok(c, m, "pray_cone") || bad_axis(c, p1, p2, "cone")) return NULL;
+    if (!finite_num(r1) || !finite_num(r2) || r1 < 0 || r2 < 0 || (r1 == 0 && r2 == 0)) {
+        fail(c, PRAY_ERR_ARG, "cone: the radii must be numbers >= 0, not both 0, not %g and %g", nan_clean(r1),
+             nan_clean(r2));
+        return NULL;
+    }
+    return framed_new(c, O_CONE, m, p1, p2, r1, r2);
+}
+
+pray_object *pray_torus(pray_ctx *c, pray_model *m, pray_vec centre, pray_vec axis, double R, double r) {
+    if (!c || !model_ok(c, m, "pray_torus") || bad_vec(c, centre, "torus", false) || bad_vec(c, axis, "torus axis", true))
+        return NULL;
+    if (!finite_num(R) || !finite_num(r) || !(r > 0) || !(R > r)) {
+        fail(c, PRAY_ERR_ARG, "torus: the radii must be numbers with R > r > 0, not R = %g and r = %g", nan_clean(R),
+             nan_clean(r));
+        return NULL;
+    }
+    if (!finite_num(R + r)) {
+        fail(c, PRAY_ERR_ARG, "torus: R + r is beyond the range of numbers");
+        return NULL;
+    }
+    return framed_new(c, O_TORUS, m, centre, vunit(axis), R, r);
+}
+
 pray_object *pray_one(pray_ctx *c, pray_model *m) {
     return c && model_ok(c, m, "pray_one") ? obj_new(c, O_ONE, m) : NULL;
 }
@@ -8793,6 +9510,14 @@ pray_object *pray_translate(pray_ctx *c, pray_object *a, pray_vec v) {
 pray_object *pray_rotate(pray_ctx *c, pray_object *a, pray_vec deg) {
     if (!c || !object_ok(c, a, "pray_rotate") || bad_vec(c, deg, "rotation", false)) return NULL;
     return obj_transform(c, a, xf_rotate(deg));
+}
+pray_object *pray_stretch(pray_ctx *c, pray_object *a, pray_vec v) {
+    if (!c || !object_ok(c, a, "pray_stretch") || bad_vec(c, v, "stretch", false)) return NULL;
+    if (v.x == 0 || v.y == 0 || v.z == 0) {
+        fail(c, PRAY_ERR_ARG, "stretch: the factors must not be 0, not <%g, %g, %g>", v.x, v.y, v.z);
+        return NULL;
+    }
+    return obj_stretch(c, a, v);
 }
 int pray_object_primitives(const pray_object *a) {
     return a ? (a->nprims > INT_MAX ? INT_MAX : (int)a->nprims) : 0;
@@ -10670,6 +11395,35 @@ pray_status bi_cylinder(Interp &I, const Expr *call, Value *a, Value *out) {
     return made(I, call, V_OBJECT,
                 pray_cylinder(I.c, (pray_model *)a[0].ref, vec_of(a[1]), vec_of(a[2]), a[3].v[0]), out);
 }
+pray_status bi_box(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_MODEL) || want(I, call, a, 1, V_POINT) || want(I, call, a, 2, V_POINT))
+        return I.c->status;
+    return made(I, call, V_OBJECT, pray_box(I.c, (pray_model *)a[0].ref, vec_of(a[1]), vec_of(a[2])), out);
+}
+pray_status bi_cone(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_MODEL) || want(I, call, a, 1, V_POINT) || want(I, call, a, 2, V_NUM) ||
+        want(I, call, a, 3, V_POINT) || want(I, call, a, 4, V_NUM))
+        return I.c->status;
+    return made(I, call, V_OBJECT,
+                pray_cone(I.c, (pray_model *)a[0].ref, vec_of(a[1]), a[2].v[0], vec_of(a[3]), a[4].v[0]), out);
+}
+pray_status bi_rod(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_MODEL) || want(I, call, a, 1, V_POINT) || want(I, call, a, 2, V_POINT) ||
+        want(I, call, a, 3, V_NUM))
+        return I.c->status;
+    return made(I, call, V_OBJECT, pray_rod(I.c, (pray_model *)a[0].ref, vec_of(a[1]), vec_of(a[2]), a[3].v[0]), out);
+}
+pray_status bi_stretch(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_OBJECT) || want(I, call, a, 1, V_VECTOR)) return I.c->status;
+    return made(I, call, V_OBJECT, pray_stretch(I.c, (pray_object *)a[0].ref, vec_of(a[1])), out);
+}
+pray_status bi_torus(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_MODEL) || want(I, call, a, 1, V_POINT) || want(I, call, a, 2, V_VECTOR) ||
+        want(I, call, a, 3, V_NUM) || want(I, call, a, 4, V_NUM))
+        return I.c->status;
+    return made(I, call, V_OBJECT,
+                pray_torus(I.c, (pray_model *)a[0].ref, vec_of(a[1]), vec_of(a[2]), a[3].v[0], a[4].v[0]), out);
+}
 pray_status bi_dirlight(Interp &I, const Expr *call, Value *a, Value *out) {
     if (want(I, call, a, 0, V_INTENS) || want(I, call, a, 1, V_VECTOR)) return I.c->status;
     return made(I, call, V_LIGHT, pray_dirlight(I.c, rgb_of(a[0]), vec_of(a[1])), out);
@@ -10828,8 +11582,9 @@ pray_status bi_text(Interp &I, const Expr *call, Value *a, Value *out) {
 const Builtin BUILTINS[] = {
     {"abs", 1, 1, bi_abs},           {"arccos", 1, 1, bi_arccos},
     {"arcsin", 1, 1, bi_arcsin},     {"arctan", 1, 1, bi_arctan},
-    {"arctan2", 2, 2, bi_arctan2},   {"ceil", 1, 1, bi_ceil},
-    {"color", 1, 1, bi_color},
+    {"arctan2", 2, 2, bi_arctan2},   {"box", 3, 3, bi_box},
+    {"ceil", 1, 1, bi_ceil},         {"color", 1, 1, bi_color},
+    {"cone", 5, 5, bi_cone},
     {"cos", 1, 1, bi_cos},           {"cylinder", 4, 4, bi_cylinder},
     {"directionlight", 2, 2, bi_dirlight}, {"dirlight", 2, 2, bi_dirlight},
     {"exp", 1, 1, bi_exp},           {"floor", 1, 1, bi_floor},
@@ -10839,11 +11594,13 @@ const Builtin BUILTINS[] = {
     {"norm", 1, 1, bi_norm},         {"one", 1, 1, bi_one},
     {"phong", 3, 4, bi_phong},       {"plane", 3, 3, bi_plane},
     {"planemap", 5, 5, bi_planemap}, {"pointlight", 2, 2, bi_pointlight},
-    {"round", 1, 1, bi_round},
+    {"rod", 4, 4, bi_rod},           {"round", 1, 1, bi_round},
     {"sin", 1, 1, bi_sin},           {"sphere", 3, 3, bi_sphere},
     {"spheremap", 5, 5, bi_spheremap}, {"sqrt", 1, 1, bi_sqrt},
+    {"stretch", 2, 2, bi_stretch},
     {"tan", 1, 1, bi_tan},           {"text", 8, 8, bi_text},
     {"tiff", 3, 3, bi_tiff},         {"tiffbump", 3, 3, bi_tiffbump},
+    {"torus", 5, 5, bi_torus},
     {"transparent", 2, 2, bi_transparent},
 };
 const int NBUILTINS = (int)(sizeof BUILTINS / sizeof BUILTINS[0]);

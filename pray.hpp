@@ -267,6 +267,16 @@ pray_object *pray_plane(pray_ctx *ctx, pray_model *m, pray_vec point, pray_vec n
 pray_object *pray_cylinder(pray_ctx *ctx, pray_model *m, pray_vec point, pray_vec axis,
                            double radius);
 pray_object *pray_one(pray_ctx *ctx, pray_model *m);
+/* Language version 2 (see the manual: box, rod, cone): an axis-aligned box with opposite corners
+   p1 and p2 (each extent > 0); a finite cylinder with flat caps; a truncated cone from the disc
+   of radius r1 around p1 to that of radius r2 around p2 (r1, r2 >= 0, not both 0); a torus with
+   centre, axis, radius R to the tube's centre line and tube radius r (R > r > 0). Their texture
+   coordinates are a planemap's at their first point along X and Y, carried along by every
+   transformation. */
+pray_object *pray_box(pray_ctx *ctx, pray_model *m, pray_vec p1, pray_vec p2);
+pray_object *pray_rod(pray_ctx *ctx, pray_model *m, pray_vec p1, pray_vec p2, double radius);
+pray_object *pray_cone(pray_ctx *ctx, pray_model *m, pray_vec p1, double r1, pray_vec p2, double r2);
+pray_object *pray_torus(pray_ctx *ctx, pray_model *m, pray_vec centre, pray_vec axis, double R, double r);
 /* A half-space and a ball with texture coordinates (see the language manual: planemap,
    spheremap). */
 pray_object *pray_planemap(pray_ctx *ctx, pray_model *m, pray_vec point, pray_vec normal, pray_vec u,
@@ -294,6 +304,9 @@ pray_object *pray_complement(pray_ctx *ctx, pray_object *a);
 pray_object *pray_scale(pray_ctx *ctx, pray_object *a, double s);
 pray_object *pray_translate(pray_ctx *ctx, pray_object *a, pray_vec offset);
 pray_object *pray_rotate(pray_ctx *ctx, pray_object *a, pray_vec degrees);
+/* `stretch`: a scaled by the components of `factors` along the world axes X, Y, Z (none 0; a
+   negative one mirrors). */
+pray_object *pray_stretch(pray_ctx *ctx, pray_object *a, pray_vec factors);
 /* Primitives in the tree (what `print` shows as "object (N primitives)"); 0 for NULL. */
 int pray_object_primitives(const pray_object *a);
 

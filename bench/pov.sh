@@ -1,5 +1,5 @@
 #!/bin/sh
-# bench/pov.sh - pray against POV-Ray 3.7: the Cube, Room, Fractal and CSG scenes rendered by
+# bench/pov.sh - pray against POV-Ray 3.7: the Cube, Room, Fractal, CSG and Chess scenes rendered by
 # both programs (bench/pov/*.pov are the POV-Ray versions), one thread, no anti-aliasing, at
 # 256x256 and 1024x1024. Prints a table of CPU and wall times and their ratios, then the share
 # of pixels where the two disagree about which object is visible (both rendered with flat
@@ -16,7 +16,7 @@ case $QUICK in
   *) echo "usage: bench/pov.sh [quick]" >&2; exit 2 ;;
 esac
 if [ "$QUICK" = quick ]; then SIZES=256; RUNS=${RUNS:-1}; else SIZES="256 1024"; RUNS=${RUNS:-3}; fi
-SCENES="cube room fractal csg"
+SCENES="cube room fractal csg chess"
 PY=/usr/bin/python3
 [ -x $PY ] || PY=python3
 

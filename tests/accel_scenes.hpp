@@ -88,6 +88,53 @@ struct BoxRec {           // a box made of six half-spaces (axis-aligned or tilt
     }
 };
 
+// A point on a primitive's surface and a direction tangent to it there: along an edge of a box,
+// a rod's side or a cap's rim, a cone's side line, an ellipsoid's silhouette, a torus' outline.
+struct Graze {
+    pray_vec p, d;
+};
+
+// An affine map x -> m x + t, as the generator builds the version-2 primitives' placements.
+struct Aff {
+    double m[3][3];
+    pray_vec t;
+    pray_vec dir(pray_vec d) const {
+        return V(m[0][0] * d.x + m[0][1] * d.y + m[0][2] * d.z, m[1][0] * d.x + m[1][1] * d.y + m[1][2] * d.z,
+                 m[2][0] * d.x + m[2][1] * d.y + m[2][2] * d.z);
+    }
+    pray_vec pt(pray_vec p) const { return add(dir(p), t); }
+};
+inline Aff aff_id() {
+    Aff a = {{{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, {0, 0, 0}};
+    return a;
+}
+// f after a
+inline Aff aff_then(const Aff &a, const Aff &f) {
+    Aff h;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) h.m[i][j] = f.m[i][0] * a.m[0][j] + f.m[i][1] * a.m[1][j] + f.m[i][2] * a.m[2][j];
+    h.t = f.pt(a.t);
+    return h;
+}
+inline Aff aff_diag(pray_vec v) {
+    Aff a = aff_id();
+    a.m[0][0] = v.x;
+    a.m[1][1] = v.y;
+    a.m[2][2] = v.z;
+    return a;
+}
+// Rotation by degrees about X, then Y, then Z, as pray_rotate turns.
+inline Aff aff_rot(pray_vec deg) {
+    const double k = 3.14159265358979323846 / 180;
+    double sx = std::sin(deg.x * k), cx = std::cos(deg.x * k), sy = std::sin(deg.y * k), cy = std::cos(deg.y * k),
+           sz = std::sin(deg.z * k), cz = std::cos(deg.z * k);
+    Aff f = {{{cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx},
+              {sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx},
+              {-sy, cy * sx, cy * cx}},
+             {0, 0, 0}};
+    return f;
+}
+
 struct Scene {
     std::string label;  // what it is and its seed
     pray_object *root = nullptr;
@@ -95,6 +142,7 @@ struct Scene {
     std::vector<Cylinder> cylinders;
     std::vector<Plane> planes;
     std::vector<BoxRec> boxes;
+    std::vector<Graze> grazes;  // of the version-2 primitives, stretched ones and tori
     int nprims = 0;
     double scale = 1;         // the scene's unit (1, or far from 1 for the scaled scenes)
     pray_vec offset{0, 0, 0};  // ... and its placement
@@ -241,7 +289,9 @@ public:
         return V(coord(focus.x + a * spread, focus.x + b * spread), coord(focus.y + a * spread, focus.y + b * spread),
                  coord(focus.z + a * spread, focus.z + b * spread));
     }
+    double shapes = 0;  // the share of leaves that are version-2 primitives (shape)
     pray_object *leaf() {
+        if (shapes > 0 && rng.chance(shapes)) return shape();
         int k = rng.below(16);
         if (k < 5) return sphere(point(-1, 1), radius(0.1, 0.7));
         if (k < 7) {  // axis-aligned cube or box
@@ -284,6 +334,104 @@ public:
         pray_object *s = sphere(cc, r);
         pray_vec a = rng.chance(0.5) ? axis_vec(rng.below(3), 1) : rng.dir();
         return pray_csg(c_, PRAY_DIFFERENCE, s, cylinder(cc, a, r * rng.range(0.2, 0.7)));
+    }
+
+    // A version-2 primitive (box, rod, cone, torus) or a stretched sphere or capped cylinder,
+    // placed by random stretches (negative ones mirror), rotations, scales and translations, in
+    // that order or with a stretch after a rotation (which shears); its grazing rays recorded.
+    pray_object *shape() {
+        int k = rng.below(6);
+        std::vector<Graze> loc;
+        pray_object *o = nullptr;
+        pray_vec p1 = point(-0.6, 0.6);
+        auto side = [&](pray_vec a) {  // a unit vector perpendicular to unit a
+            pray_vec u = cross(a, rng.dir());
+            return unit(u);
+        };
+        auto axis = [&]() { return rng.chance(0.5) ? axis_vec(rng.below(3), rng.sign()) : rng.dir(); };
+        if (k == 0) {  // box, its corners in any order
+            pray_vec p2 = add(p1, V(rng.sign() * radius(0.1, 0.8), rng.sign() * radius(0.1, 0.8), rng.sign() * radius(0.1, 0.8)));
+            o = pray_box(c_, m_, p1, p2);
+            for (int i = 0; i < 4; i++) {
+                pray_vec c = V(rng.chance(0.5) ? p1.x : p2.x, rng.chance(0.5) ? p1.y : p2.y, rng.chance(0.5) ? p1.z : p2.z);
+                pray_vec d = axis_vec(rng.below(3), rng.sign());
+                if (i == 3) d = V(rng.sign(), rng.sign(), 0);  // across a face, through the corner
+                loc.push_back(Graze{c, d});
+            }
+        } else if (k == 1 || k == 2) {  // rod, cone (sometimes pointed at either end)
+            pray_vec a = axis();
+            double h = radius(0.2, 1.2), r1 = radius(0.05, 0.5), r2 = k == 1 ? r1 : radius(0.05, 0.5);
+            if (k == 2 && rng.chance(0.3)) (rng.chance(0.5) ? r1 : r2) = 0;
+            pray_vec p2 = add(p1, mul(a, h));
+            o = k == 1 ? pray_rod(c_, m_, p1, p2, r1) : pray_cone(c_, m_, p1, r1, p2, r2);
+            for (int i = 0; i < 4; i++) {
+                pray_vec u = side(a), w = cross(a, u);
+                pray_vec e1 = add(p1, mul(u, r1)), e2 = add(p2, mul(u, r2));
+                if (i == 0) loc.push_back(Graze{e1, sub(e2, e1)});                      // the side line
+                if (i == 1) loc.push_back(Graze{rng.chance(0.5) ? e1 : e2, w});         // a rim
+                if (i == 2) loc.push_back(Graze{add(mul(e1, 0.5), mul(e2, 0.5)), w});  // the side
+                if (i == 3) loc.push_back(Graze{rng.chance(0.5) ? p1 : p2, add(u, mul(w, rng.range(-1, 1)))});  // a cap
+            }
+        } else if (k == 3) {  // a sphere, stretched below into an ellipsoid
+            double r = radius(0.1, 0.6);
+            o = pray_sphere(c_, m_, p1, r);
+            for (int i = 0; i < 3; i++) {
+                pray_vec u = rng.dir();
+                loc.push_back(Graze{add(p1, mul(u, r)), side(u)});
+            }
+        } else if (k == 4) {  // a capped cylinder, stretched below
+            pray_vec a = axis();
+            double r = radius(0.08, 0.5), h = radius(0.1, 0.6);
+            o = pray_csg(c_, PRAY_INTERSECTION, pray_cylinder(c_, m_, p1, a, r),
+                         pray_csg(c_, PRAY_INTERSECTION, pray_plane(c_, m_, add(p1, mul(a, h)), a),
+                                  pray_plane(c_, m_, sub(p1, mul(a, h)), mul(a, -1))));
+            sc.nprims += 2;
+            pray_vec u = side(a);
+            loc.push_back(Graze{add(p1, mul(u, r)), a});
+            loc.push_back(Graze{add(add(p1, mul(u, r)), mul(a, h)), cross(a, u)});
+        } else {  // torus
+            pray_vec a = axis();
+            double R = radius(0.2, 0.6), r = R * rng.range(0.1, 0.9);
+            o = pray_torus(c_, m_, p1, a, R, r);
+            pray_vec u = side(a), w = cross(a, u);
+            loc.push_back(Graze{add(p1, mul(u, R + r)), w});                   // the outline
+            loc.push_back(Graze{add(p1, mul(u, R - r)), w});                   // the hole's rim
+            loc.push_back(Graze{add(add(p1, mul(u, R)), mul(a, r)), u});      // across the top
+            loc.push_back(Graze{add(add(p1, mul(u, R)), mul(a, r)), w});      // along the top
+            loc.push_back(Graze{add(p1, mul(a, r)), u});                      // over the hole
+        }
+        sc.nprims++;
+        Aff f = aff_id();
+        auto stretch = [&]() {
+            static const double fs[] = {0.5, 2, -1, 1.5, -0.7, 3, 0.25, -2};
+            pray_vec v = V(fs[rng.below(8)], fs[rng.below(8)], fs[rng.below(8)]);
+            if (rng.chance(0.3)) set_comp(v, rng.below(3), 1);
+            o = pray_stretch(c_, o, v);
+            f = aff_then(f, aff_diag(v));
+        };
+        if (k == 3 || k == 4 || rng.chance(0.6)) stretch();
+        if (rng.chance(0.5)) {
+            pray_vec deg = V(rng.range(-180, 180), rng.range(-180, 180), rng.range(-180, 180));
+            if (rng.chance(0.3)) deg = V(90 * rng.below(4), 90 * rng.below(4), 0);
+            o = pray_rotate(c_, o, deg);
+            f = aff_then(f, aff_rot(deg));
+            if (rng.chance(0.3)) stretch();
+        }
+        if (rng.chance(0.2)) {
+            double s = rng.chance(0.5) ? 0.5 : -0.8;
+            o = pray_scale(c_, o, s);
+            f = aff_then(f, aff_diag(V(s, s, s)));
+        }
+        if (sc.scale != 1 || rng.chance(0.3)) {  // to the scene's scale and place (as P and L do)
+            o = pray_scale(c_, o, sc.scale);
+            f = aff_then(f, aff_diag(V(sc.scale, sc.scale, sc.scale)));
+            o = pray_translate(c_, o, sc.offset);
+            Aff t = aff_id();
+            t.t = sc.offset;
+            f = aff_then(f, t);
+        }
+        for (const Graze &g : loc) sc.grazes.push_back(Graze{f.pt(g.p), f.dir(g.d)});
+        return o;
     }
 
     // A random tree: n-ary unions, intersections and differences (chains of pray_csg),
@@ -341,6 +489,7 @@ inline void aim_region(Scene &s) {
         for (int k = 0; k < 8; k++) grow(b.corner(k), 0);
     for (const Cylinder &q : s.cylinders) grow(q.p, q.r);
     for (const Plane &q : s.planes) grow(q.p, 0);
+    for (const Graze &q : s.grazes) grow(q.p, 0);
     if (!(lo.x <= hi.x)) {
         lo = s.offset;
         hi = s.offset;
@@ -358,11 +507,12 @@ enum Kind {
     K_BLOCKS,       // axis-aligned unit-fraction cubes sharing faces, with differences
     K_FLOOR,        // an unbounded floor with spheres and boxes on it (lists outside the grid)
     K_SCALED,       // a random tree scaled far from 1 and moved far from the origin
-    K_CLUSTER       // a dense cluster of small solids and a few far away (nested grids)
+    K_CLUSTER,      // a dense cluster of small solids and a few far away (nested grids)
+    K_SHAPES        // a random tree of version-2 primitives and stretched ones with the others
 };
 
 inline const char *kind_name(int k) {
-    static const char *names[] = {"random", "many", "lattice", "blocks", "floor", "scaled", "cluster"};
+    static const char *names[] = {"random", "many", "lattice", "blocks", "floor", "scaled", "cluster", "shapes"};
     return names[k];
 }
 
@@ -458,6 +608,17 @@ inline Scene make_scene(pray_ctx *c, int kind, uint64_t seed) {
             if (!root) root = s;
             else root = pray_csg(c, r.chance(0.5) ? PRAY_UNION : r.chance(0.6) ? PRAY_DIFFERENCE : PRAY_INTERSECTION, root, s);
         }
+        break;
+    }
+    case K_SHAPES: {
+        // mostly at unit scale; some scenes scaled far from 1 and moved far from the origin
+        static const double scales[] = {1, 1, 1, 1e-3, 1e3, 1e5};
+        g.sc.scale = scales[r.below(6)];
+        if (g.sc.scale != 1) g.sc.offset = mul(V(1, -0.5, 0.25), g.sc.scale * (r.chance(0.5) ? 0 : 1e3));
+        g.shapes = 0.6;
+        g.max_prims = 40;
+        root = g.tree(2 + r.below(3));
+        if (r.chance(0.5)) root = pray_csg(c, PRAY_UNION, root, g.shape());
         break;
     }
     case K_CLUSTER: {

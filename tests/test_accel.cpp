@@ -107,7 +107,7 @@ bool apply(pray_ctx *c, const Opts &o) {
 enum RayKind {
     R_RANDOM, R_AXIS, R_GRID_EDGE, R_GRID_FACE, R_GRID_CORNER, R_GRID_SLOPE, R_FRACTION, R_BOX_CORNER,
     R_IN_GRID, R_ON_BOX, R_IN_SOLID, R_TANGENT_SPHERE, R_TANGENT_CYL, R_ALONG_CYL, R_IN_FACE, R_TMAX,
-    R_TMAX_HIT, R_NEAR_AXIS, R_TMAX_GRID, R_GRID_EXIT, R_NKINDS
+    R_TMAX_HIT, R_NEAR_AXIS, R_TMAX_GRID, R_GRID_EXIT, R_GRAZE, R_NKINDS
 };
 const char *ray_kind_name(int k) {
     static const char *n[] = {"random", "axis-parallel", "along grid edge", "in grid face", "grid corner diagonal",
@@ -115,7 +115,8 @@ const char *ray_kind_name(int k) {
                               "starting inside grid", "starting on box boundary", "starting inside solid",
                               "tangent to sphere", "tangent to cylinder", "along cylinder surface",
                               "in a plane face", "tmax limit", "tmax at a hit", "nearly axis-parallel",
-                              "tmax at a grid corner", "crossing a face where it leaves the grid"};
+                              "tmax at a grid corner", "crossing a face where it leaves the grid",
+                              "grazing an edge, a rim, a side or an outline"};
     return n[k];
 }
 
@@ -388,6 +389,14 @@ std::vector<RayCase> make_rays(const Scene &s, Rng &rng) {
         if (rng.chance(0.5)) set_comp(o, a, comp(C, a) - comp(d, a) * far);
         push(o, d, R_NEAR_AXIS);
     }
+    // grazing the version-2 primitives (and stretched ones): along an edge or a side line,
+    // tangent to a rim, a side or an outline; from far, from the point, or a hair beside it
+    for (int i = 0; i < 24 && !s.grazes.empty(); i++) {
+        const Graze &g = s.grazes[rng.below((int)s.grazes.size())];
+        pray_vec o = g.p;
+        if (rng.chance(0.2)) o = add(o, mul(rng.dir(), 1e-9 * s.scale));
+        push(rng.chance(0.3) ? o : sub(o, mul(unit(g.d), far)), g.d, R_GRAZE);
+    }
     // tmax limits (shadow-like)
     size_t n0 = v.size();
     for (int i = 0; i < 14 && n0; i++) {
@@ -613,6 +622,9 @@ TEST_CASE("accel hits: blocks sharing faces, on quarter units (20 seeds)") { run
 TEST_CASE("accel hits: an unbounded floor with solids on it (15 seeds)") { run_kind(K_FLOOR, 1, 15, g_total); }
 TEST_CASE("accel hits: dense clusters of small solids with a few far away, where grids nest (5 seeds)") {
     run_kind(K_CLUSTER, 1, 5, g_total);
+}
+TEST_CASE("accel hits: boxes, rods, cones, tori, stretched and mirrored solids with the others, grazed (60 seeds)") {
+    run_kind(K_SHAPES, 1, 60, g_total);
 }
 TEST_CASE("accel hits: scenes scaled from 1e-3 to 1e6 and moved far from the origin (20 seeds)") {
     run_kind(K_SCALED, 1, 20, g_total);
@@ -892,7 +904,7 @@ TEST_CASE("accel images: random scenes at 40 x 40, every grid x freeze x merge x
           "--brute; freezing never adds intersection tests") {
     const Pick picks[] = {{K_RANDOM, 3}, {K_RANDOM, 17}, {K_RANDOM, 42}, {K_RANDOM, 77}, {K_RANDOM, 101},
                           {K_MANY, 2},   {K_MANY, 5},    {K_LATTICE, 1}, {K_LATTICE, 4}, {K_BLOCKS, 3},
-                          {K_BLOCKS, 12}, {K_FLOOR, 2},  {K_FLOOR, 9}};
+                          {K_BLOCKS, 12}, {K_FLOOR, 2},  {K_FLOOR, 9},   {K_SHAPES, 3},  {K_SHAPES, 8}};
     auto t0 = std::chrono::steady_clock::now();
     long renders = 0, image_mismatches = 0, freeze_violations = 0;
     std::vector<std::string> problems;
@@ -1195,7 +1207,7 @@ TEST_CASE("accel light buffers: lightbuffer=0 and 1 give the reference's image, 
           "the objects; a field of spheres under the sun and a lamp") {
     const Pick picks[] = {{K_RANDOM, 5},  {K_RANDOM, 23}, {K_RANDOM, 64}, {K_MANY, 1},   {K_MANY, 7},
                           {K_LATTICE, 2}, {K_LATTICE, 9}, {K_BLOCKS, 4},  {K_FLOOR, 3},  {K_FLOOR, 11},
-                          {K_SCALED, 2},  {K_SCALED, 6},  {K_SCALED, 13}};
+                          {K_SCALED, 2},  {K_SCALED, 6},  {K_SCALED, 13}, {K_SHAPES, 5}};
     SwitchTally t;
     // (128 x 128 and coarse grids: a buffer is built for images with enough pixels per voxel)
     shadow_switch_picks(picks, &Opts::lightbuffer, "lightbuffer", &pray_stats::rays_lightbuf, &pray_stats::lightbuf_voxels,
@@ -1215,7 +1227,8 @@ TEST_CASE("accel light buffers: lightbuffer=0 and 1 give the reference's image, 
 TEST_CASE("accel shadow cache: shadowcache=0 and 1 give the reference's image, through glass and with lights amid "
           "the objects; a table and a pane of glass over a field of spheres") {
     const Pick picks[] = {{K_RANDOM, 30}, {K_RANDOM, 41}, {K_RANDOM, 64}, {K_RANDOM, 66}, {K_MANY, 4},  {K_LATTICE, 3},
-                          {K_BLOCKS, 7},  {K_FLOOR, 5},   {K_FLOOR, 12},  {K_SCALED, 2},  {K_SCALED, 6}};
+                          {K_BLOCKS, 7},  {K_FLOOR, 5},   {K_FLOOR, 12},  {K_SCALED, 2},  {K_SCALED, 6},
+                          {K_SHAPES, 11}};
     SwitchTally t;
     // (the lamps amid the objects end their shadow rays in voxels that hold surfaces beyond them)
     shadow_switch_picks(picks, &Opts::shadowcache, "shadowcache", &pray_stats::rays_shadowcache, nullptr, {3, 8}, 64, t);
@@ -1293,7 +1306,7 @@ TEST_CASE("accel threads: the counts of a render are the same for 1, 2, 3 and 8 
 TEST_CASE("accel eye buffer: eyebuffer=0 and 1 give the reference's image from eyes outside, inside, on the edge of "
           "and far from the grid's box; a field of spheres; none for a parallel camera") {
     const Pick picks[] = {{K_RANDOM, 4},  {K_RANDOM, 31}, {K_MANY, 3},   {K_MANY, 8},   {K_LATTICE, 5},
-                          {K_BLOCKS, 6},  {K_FLOOR, 4},   {K_FLOOR, 13}, {K_SCALED, 3}, {K_SCALED, 9}};
+                          {K_BLOCKS, 6},  {K_FLOOR, 4},   {K_FLOOR, 13}, {K_SCALED, 3}, {K_SCALED, 9}, {K_SHAPES, 6}};
     SwitchTally t;
     each_pick(picks, [&](pray_ctx *c, const Scene &s) {
         pray_light *lights = some_lights(c);

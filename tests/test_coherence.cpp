@@ -164,6 +164,15 @@ TEST_CASE("coherence: a part turning inside a difference, and parts added in fro
                     "rendertiff Extra | Floor | Wall | Lens | Ball | (Box - Slot), Lamp, Sun"));
 }
 
+TEST_CASE("coherence: solids of version 2 turning within their own boxes, textured") {
+    // the boxes the cube and the ring fill stay the same from frame to frame; their frames and
+    // so their texture coordinates do not
+    check_all(scene("Cube = box(Check, [-0.4, -0.4, -0.4], [0.4, 0.4, 0.4]) . <0, 0, 90*F> . [0, -1.5, 0.2]\n"
+                    "Ring = torus(Check, [0, 0, 0], <0, 0, 1>, 0.6, 0.2) . <0, 0, 45*F> . [-1, -2, 0.5]\n"
+                    "Egg = stretch(sphere(Check, [0, 0, 0], 0.3), <1, 1 + 0.25*F, 1>) . [1.2, -2, 0.6]\n"
+                    "rendertiff Room | Cube | Ring | Egg, Lamp, Sun"));
+}
+
 TEST_CASE("coherence: a light, the camera or an option that changes: the frame is traced in full") {
     std::string p = scene("if F = 1 then\n"
                           "  Lamp = pointlight({0.8}, [2, -3, 4.5])\n"

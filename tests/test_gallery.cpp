@@ -31,9 +31,10 @@ std::vector<testkit::Frame> render(const std::string &path, bool brute) {
 } // namespace
 
 TEST_CASE("gallery: every example renders, and equals the brute-force reference") {
-    const char *scenes[] = {"anim",   "csg",     "cube",     "fractal", "glass",  "glassab", "holes",
-                            "loop",   "machine", "maketex",  "mirror",  "models", "parallel", "pc",
-                            "rabbit", "redsph",  "room",     "roomball", "sign",  "street",  "textures"};
+    const char *scenes[] = {"anim",    "chess",  "csg",      "cube",   "fractal", "glass",    "glassab",
+                            "holes",   "loop",   "machine",  "maketex", "mirror", "models",   "parallel",
+                            "pc",      "rabbit", "redsph",   "room",   "roomball", "sign",    "street",
+                            "textures"};
     const char *dir = std::getenv("PRAY_EXAMPLES");
     for (const char *n : scenes) {
         std::string path = std::string(dir ? dir : "examples/") + n + ".ray";

@@ -1230,3 +1230,197 @@ TEST_CASE("every error starts with name:line:col: error: ") {
     // a successful run leaves no message
     CHECK(testkit::run("print 1\n").error == "");
 }
+
+// ---------------------------------------------------------------------------------------------
+// Language version 2: box, rod, cone, torus, stretch.
+// ---------------------------------------------------------------------------------------------
+namespace {
+// A white solid (its own light) on black, seen from eye E towards the origin, 96 x 72 pixels;
+// every length multiplied by `s`.
+std::vector<bool> silhouette(const std::string &solid, double s = 1, int *count = nullptr) {
+    char cam[400];
+    std::snprintf(cam, sizeof cam,
+                  "option \"width\", 96\noption \"height\", 72\nS = %.17g\n"
+                  "perspective <2.4 * S, 0, 0>, <0, 0, -1.8 * S>, [0.3 * S, -7 * S, 0.2 * S], [0, 0, 0]\n"
+                  "M = color({1})\n",
+                  s);
+    testkit::Result r = testkit::run(std::string(cam) + "rendertiff (" + solid + ") . S, dirlight({1}, <0, 1, 0>)\n");
+    std::vector<bool> m;
+    if (r.status != PRAY_OK || r.frames.empty()) {
+        FAIL_CHECK(r.error);
+        return m;
+    }
+    const testkit::Frame &f = r.frames[0];
+    int n = 0;
+    for (int y = 0; y < f.height; y++)
+        for (int x = 0; x < f.width; x++) {
+            m.push_back(f.at(x, y, 0) > 0.5f);
+            n += m.back();
+        }
+    if (count) *count = n;
+    return m;
+}
+int differing(const std::vector<bool> &a, const std::vector<bool> &b) {
+    int n = 0;
+    for (size_t i = 0; i < a.size() && i < b.size(); i++) n += a[i] != b[i];
+    return a.size() == b.size() ? n : 1 << 30;
+}
+} // namespace
+
+TEST_CASE("version 2: box, rod, cone and torus are one primitive each; stretch keeps the count") {
+    const std::string m = "M = color({1})\n";
+    CHECK_PRINTS(m + "print box(M, [0, 0, 0], [1, 2, 3]), rod(M, [0, 0, 0], [0, 0, 1], 1)\n",
+                 "object (1 primitive) object (1 primitive)\n");
+    CHECK_PRINTS(m + "print cone(M, [0, 0, 0], 1, [0, 0, 1], 0), torus(M, [0, 0, 0], <0, 0, 1>, 1, 0.5)\n",
+                 "object (1 primitive) object (1 primitive)\n");
+    CHECK_PRINTS(m + "print stretch(sphere(M, [0, 0, 0], 1) | plane(M, [0, 0, 0], <1, 1, 0>), <1, 2, -3>)\n",
+                 "object (2 primitives)\n");
+}
+
+TEST_CASE("version 2: a box, a rod and a cone look as the solids they stand for") {
+    int n = 0;
+    // corners in any order
+    std::vector<bool> box = silhouette("box(M, [-1, -0.5, -0.7], [0.8, 0.6, 0.9])", 1, &n);
+    CHECK(n > 500);
+    CHECK(differing(box, silhouette("box(M, [0.8, -0.5, 0.9], [-1, 0.6, -0.7])")) == 0);
+    std::vector<bool> planes = silhouette(
+        "plane(M, [-1, 0, 0], <-1, 0, 0>) & plane(M, [0.8, 0, 0], <1, 0, 0>) & plane(M, [0, -0.5, 0], <0, -1, 0>) & "
+        "plane(M, [0, 0.6, 0], <0, 1, 0>) & plane(M, [0, 0, -0.7], <0, 0, -1>) & plane(M, [0, 0, 0.9], <0, 0, 1>)");
+    CHECK(differing(box, planes) <= 2);
+    std::vector<bool> rod = silhouette("rod(M, [-0.5, -0.2, -0.6], [0.7, 0.4, 0.8], 0.4)", 1, &n);
+    CHECK(n > 300);
+    std::vector<bool> capped = silhouette(
+        "cylinder(M, [-0.5, -0.2, -0.6], <1.2, 0.6, 1.4>, 0.4) & plane(M, [0.7, 0.4, 0.8], <1.2, 0.6, 1.4>) & "
+        "plane(M, [-0.5, -0.2, -0.6], <-1.2, -0.6, -1.4>)");
+    CHECK(differing(rod, capped) <= 4);
+    // a cone with equal radii is a rod; a pointed one is smaller than its frustum
+    CHECK(differing(rod, silhouette("cone(M, [-0.5, -0.2, -0.6], 0.4, [0.7, 0.4, 0.8], 0.4)")) <= 4);
+    int pointed = 0, frustum = 0;
+    silhouette("cone(M, [0, 0, -1], 0.8, [0, 0, 1], 0)", 1, &pointed);
+    silhouette("cone(M, [0, 0, -1], 0.8, [0, 0, 1], 0.3)", 1, &frustum);
+    CHECK(pointed > 200);
+    CHECK(pointed < frustum);
+}
+
+TEST_CASE("version 2: stretch mirrors without turning normals in, and keeps boxes and half-spaces exact") {
+    // a ball and a box symmetric about the origin, mirrored: the same picture, lit the same way
+    const std::string lit = "option \"width\", 48\noption \"height\", 36\n"
+                            "perspective <2.4, 0, 0>, <0, 0, -1.8>, [0.3, -7, 0.2], [0, 0, 0]\n"
+                            "M = phong({0.8, 0.3, 0.1}, {0.4}, {0.1}, 20)\n";
+    for (const char *solid : {"sphere(M, [0, 0, 0], 1)", "box(M, [-1, -1, -1], [1, 1, 1])",
+                              "torus(M, [0, 0, 0], <0, 0, 1>, 1, 0.4)"}) {
+        testkit::Result a = testkit::run(lit + "rendertiff " + solid + ", dirlight({1}, <1, 2, -1>)\n");
+        testkit::Result b = testkit::run(lit + "rendertiff stretch(" + solid + ", <-1, 1, -1>), dirlight({1}, <1, 2, -1>)\n");
+        REQUIRE(a.status == PRAY_OK);
+        REQUIRE(b.status == PRAY_OK);
+        double worst = 0;
+        for (size_t i = 0; i < a.frames[0].pixels.size(); i++)
+            worst = std::max(worst, (double)std::fabs(a.frames[0].pixels[i] - b.frames[0].pixels[i]));
+        INFO(solid);
+        CHECK(worst < 1e-3);
+    }
+    // a stretched ball is the ellipsoid; a stretched box the box of the stretched corners; a
+    // stretched slab the slab between the stretched planes
+    CHECK(differing(silhouette("stretch(sphere(M, [0, 0, 0], 0.5), <2, 1.5, 0.8>)"),
+                    silhouette("stretch(sphere(M, [0, 0, 0], 0.5), <-2, 1.5, -0.8>)")) <= 2);
+    CHECK(differing(silhouette("stretch(box(M, [-0.5, -0.5, -0.5], [0.5, 0.25, 0.5]), <2, -1, 1.5>)"),
+                    silhouette("box(M, [-1, -0.25, -0.75], [1, 0.5, 0.75])")) == 0);
+    CHECK(differing(silhouette("stretch(plane(M, [0, 0, 0.5], <0, 1, 1>) & plane(M, [0, 0, -0.5], <0, -1, -1>) & "
+                               "sphere(M, [0, 0, 0], 1.2), <1, 1, 1>)"),
+                    silhouette("plane(M, [0, 0, 0.5], <0, 1, 1>) & plane(M, [0, 0, -0.5], <0, -1, -1>) & "
+                               "sphere(M, [0, 0, 0], 1.2)")) == 0);
+    int ell = 0, ball = 0;
+    silhouette("stretch(sphere(M, [0, 0, 0], 0.5), <2, 1, 1>)", 1, &ell);
+    silhouette("sphere(M, [0, 0, 0], 0.5)", 1, &ball);
+    CHECK(std::fabs(ell - 2.0 * ball) < 0.06 * ball);  // twice as wide, as high
+}
+
+TEST_CASE("version 2: a torus looks the same from 1e-4 to 1e5 of its size") {
+    const std::string solid = "torus(M, [0.1, 0, 0], <0.2, 0.5, 1>, 1, 0.3) - torus(M, [0.1, 0, 0], <0, 0, 1>, 1, 0.25) . [0.9, 0, 0]";
+    int n = 0;
+    std::vector<bool> unit = silhouette(solid, 1, &n);
+    CHECK(n > 400);
+    for (double s : {1e-4, 1e-2, 1e3, 1e5}) {
+        INFO("scale " << s);
+        CHECK(differing(unit, silhouette(solid, s)) <= 3);
+    }
+}
+
+TEST_CASE("version 2: the API refuses infinities, NaNs and degenerate sizes of the new makers") {
+    const double inf = HUGE_VAL, nan = HUGE_VAL - HUGE_VAL;
+    const pray_vec o = {0, 0, 0}, z = {0, 0, 1}, far = {inf, 0, 0}, odd = {0, nan, 0};
+    pray_ctx *c = pray_new();
+    pray_model *m = pray_color(c, pray_rgb{1, 1, 1});
+    auto refused = [&](const void *made, const std::string &message) {
+        CHECK(made == nullptr);
+        CHECK(std::string(pray_error(c)) == "error: " + message);
+    };
+    refused(pray_box(c, m, o, far), "box: coordinates are not finite");
+    refused(pray_box(c, m, odd, z), "box: coordinates are not finite");
+    refused(pray_box(c, m, o, pray_vec{1, 1, 0}), "box: the corners must differ in every coordinate (both have z = 0)");
+    refused(pray_rod(c, m, o, z, nan), "rod: radius must be a positive number, not nan");
+    refused(pray_rod(c, m, o, far, 1), "rod: coordinates are not finite");
+    refused(pray_cone(c, m, o, inf, z, 1), "cone: the radii must be numbers >= 0, not both 0, not inf and 1");
+    refused(pray_cone(c, m, o, 1, z, nan), "cone: the radii must be numbers >= 0, not both 0, not 1 and nan");
+    refused(pray_torus(c, m, o, z, inf, 1), "torus: the radii must be numbers with R > r > 0, not R = inf and r = 1");
+    refused(pray_torus(c, m, o, z, 1, nan), "torus: the radii must be numbers with R > r > 0, not R = 1 and r = nan");
+    refused(pray_torus(c, m, o, odd, 1, 0.5), "torus axis: coordinates are not finite");
+    pray_object *s = pray_sphere(c, m, o, 1);
+    REQUIRE(s);
+    refused(pray_stretch(c, s, far), "stretch: coordinates are not finite");
+    refused(pray_stretch(c, s, pray_vec{1, nan, 1}), "stretch: coordinates are not finite");
+    refused(pray_stretch(c, s, pray_vec{1, 1, 0}), "stretch: the factors must not be 0, not <1, 1, 0>");
+    // (frames stay within what the renderer's precision holds)
+    const double big = std::strstr(pray_features(), "real=float") ? 1e25 : 1e200;
+    pray_object *e = pray_stretch(c, s, pray_vec{big, 1, 1});
+    REQUIRE(e);
+    refused(pray_scale(c, e, big), "the transformation takes a primitive out of the range of numbers");
+    pray_release(c, e);
+    pray_release(c, s);
+    pray_release(c, m);
+    pray_free(c);
+}
+
+TEST_CASE("version 2: a box's texture coordinates are a planemap's at its first corner, and stretch carries both alike") {
+    // a 2 x 2 checker, seen straight from above: the top face of the box against a planemap
+    // through the first corner's X and Y, at the box's top, cutting a taller box
+    auto render = [](const std::string &solid) {
+        pray_ctx *c = pray_new();
+        float rgb[12] = {0, 0, 0, 1, 1, 1, 1, 1, 1, 0, 0, 0};
+        pray_texture *t = pray_texture_rgb(c, 2, 2, rgb, "checker");
+        REQUIRE(pray_texture_register(c, "checker", t) == PRAY_OK);
+        pray_release(c, t);
+        std::vector<testkit::Frame> frames;
+        pray_set_frame(c, testkit::frame_sink, &frames);
+        std::string prog = "option \"width\", 64\noption \"height\", 64\n"
+                           "parallel <2, 0, 0>, <0, -2, 0>, [0.1, 0.1, 9], [0.1, 0.1, 0]\n"
+                           "T = tiff(color({0.1}), color({0.9}), \"checker\")\nG = color({0.5})\n"
+                           "rendertiff " + solid + ", none\n";
+        pray_status st = pray_run_string(c, "tex.ray", prog.data(), prog.size());
+        CHECK_MESSAGE(st == PRAY_OK, pray_error(c));
+        pray_free(c);
+        return frames.empty() ? testkit::Frame() : frames[0];
+    };
+    const std::string box = "box(T, [-0.7, 0.6, 0.5], [0.9, -0.4, -0.3])";
+    const std::string map = "(planemap(T, [-0.7, 0.6, 0.5], <0, 0, 1>, <1, 0, 0>, <0, 1, 0>) & box(G, [-0.7, -0.4, -0.3], [0.9, 0.6, 2]))";
+    for (const char *how : {"", " . <0, 0, 30>", " . 0.5", " . [0.3, -0.2, 0]"}) {
+        for (const char *st : {"", "<2, 1.5, 1>", "<-1.2, 0.7, 1>"}) {
+            auto wrap = [&](const std::string &o) {
+                std::string x = *st ? "stretch(" + o + ", " + st + ")" : o;
+                return "(" + x + how + ")";
+            };
+            testkit::Frame a = render(wrap(box)), b = render(wrap(map));
+            REQUIRE(a.width == 64);
+            REQUIRE(b.width == 64);
+            int differ = 0, textured = 0;
+            for (int i = 0; i < 64 * 64; i++) {
+                float va = a.pixels[3 * i], vb = b.pixels[3 * i];
+                textured += va > 0.05f && va < 0.95f;
+                differ += std::fabs(va - vb) > 1e-4f;
+            }
+            INFO("stretch " << std::string(st) << ", then" << std::string(how));
+            CHECK(textured > 40);
+            CHECK(differ <= (*st || *how ? 12 : 0));  // (pixels on the checker's edges, by rounding)
+        }
+    }
+}

@@ -243,10 +243,10 @@ TEST_CASE("preparation is linear: chains built at either end, unions that pruned
 }
 
 TEST_CASE("every function name is known as one (names are looked up by halving an ordered table)") {
-    const char *names[] = {"abs", "arccos", "arcsin", "arctan", "arctan2", "color", "cos", "cylinder",
+    const char *names[] = {"abs", "arccos", "arcsin", "arctan", "arctan2", "box", "color", "cone", "cos", "cylinder",
                            "directionlight", "dirlight", "exp", "log", "mirror", "move", "norm", "one",
-                           "phong", "plane", "planemap", "pointlight", "sin", "sphere", "spheremap", "sqrt",
-                           "tan", "text", "tiff", "tiffbump", "transparent"};
+                           "phong", "plane", "planemap", "pointlight", "rod", "sin", "sphere", "spheremap", "sqrt",
+                           "stretch", "tan", "text", "tiff", "tiffbump", "torus", "transparent"};
     for (const char *n : names) {
         CAPTURE(n);
         CHECK(testkit::error_of(std::string("X = ") + n + "\n") ==

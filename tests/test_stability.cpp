@@ -2060,3 +2060,94 @@ TEST_CASE("stability (PRAY_STABILITY_WIDE): switches against --brute at extreme 
     }
     MESSAGE("switches against --brute (" << std::string(fl ? "float" : "double") << "):" << report);
 }
+
+// ---------------------------------------------------------------------------------------------
+// The torus at every scale: its quartic is solved in units of its radius from the ray's point
+// nearest its centre, so that neither its size nor its distance from the origin nor the ray's
+// origin costs accuracy. Each hit is checked against the torus' own equation in long double
+// (its distance from the tube's centre line minus the tube's radius), and rays aimed through
+// the tube's centre line must hit, those passing beside the torus' outer circle must not.
+// ---------------------------------------------------------------------------------------------
+TEST_CASE("stability: torus hits lie on the torus, R = 1e-4 .. 1e6, far from the origin, from near and far") {
+    const bool fl = float_build();
+    const double tol = fl ? 3e-5 : 1e-10;  // of the torus' size R
+    double worst = 0;
+    long rays = 0, hits = 0, missed = 0, false_hits = 0;
+    uint64_t seed = 12345;
+    auto uni = [&]() {
+        seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+        return (double)(seed >> 11) / 9007199254740992.0;
+    };
+    for (double R : {1e-4, 1e-2, 1.0, 1e3, 1e6}) {
+        for (double off : {0.0, 1e3, 1e6}) {
+            if (fl && off > 0 && off / R > 1e4) continue;  // float: the torus smaller than the rounding of its place
+            for (double ratio : {0.05, 0.3, 0.9}) {
+                pray_ctx *c = pray_new();
+                pray_model *m = pray_color(c, pray_rgb{1, 1, 1});
+                double r = R * ratio;
+                pray_vec C = {off, -off / 2, off / 3}, A = {0.3, -0.5, 1};
+                double al = std::sqrt(0.09 + 0.25 + 1);
+                double a[3] = {0.3 / al, -0.5 / al, 1 / al};
+                // two unit vectors across the axis
+                double u[3] = {1, 0, -a[0] / a[2]}, ul = std::sqrt(1 + u[2] * u[2]);
+                for (double &x : u) x /= ul;
+                double w[3] = {a[1] * u[2] - a[2] * u[1], a[2] * u[0] - a[0] * u[2], a[0] * u[1] - a[1] * u[0]};
+                pray_object *t = pray_torus(c, m, C, A, R, r);
+                REQUIRE(t);
+                pray_scene *q = pray_prepare(c, t);
+                REQUIRE(q);
+                for (int i = 0; i < 200; i++) {
+                    // a target: on the tube's centre line (must hit), or beyond the outer circle
+                    double ang = 2 * 3.141592653589793 * uni();
+                    bool far = i % 4 == 3;
+                    double rad = far ? R + r * (1.0 + 1e-3 + uni()) : R;
+                    double T[3], dir[3];
+                    for (int k = 0; k < 3; k++)
+                        T[k] = (&C.x)[k] + rad * (std::cos(ang) * u[k] + std::sin(ang) * w[k]);
+                    // from near (a few R) or far (1e4 R), in a random direction; beside the outer
+                    // circle, along its tangent so that the ray stays outside
+                    double dist = R * (i % 2 ? 3 + 5 * uni() : 1e4);
+                    double d[3] = {uni() - 0.5, uni() - 0.5, uni() - 0.5};
+                    if (far)
+                        for (int k = 0; k < 3; k++) d[k] = -std::sin(ang) * u[k] + std::cos(ang) * w[k];
+                    double dl = std::sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+                    for (int k = 0; k < 3; k++) dir[k] = d[k] / dl;
+                    pray_vec o = {T[0] - dist * dir[0], T[1] - dist * dir[1], T[2] - dist * dir[2]};
+                    pray_vec dv = {dir[0], dir[1], dir[2]};
+                    pray_hit h[8];
+                    int n = pray_intersect(c, q, o, dv, HUGE_VAL, h, 8);
+                    rays++;
+                    if (far) {
+                        false_hits += n > 0;
+                        continue;
+                    }
+                    missed += n == 0;
+                    for (int k = 0; k < n && k < 8; k++) {
+                        hits++;
+                        long double x[3];
+                        for (int l = 0; l < 3; l++) x[l] = (long double)(&o.x)[l] + (long double)h[k].t * (&dv.x)[l] - (&C.x)[l];
+                        long double ax = x[0] * a[0] + x[1] * a[1] + x[2] * a[2];
+                        long double px[3] = {x[0] - ax * a[0], x[1] - ax * a[1], x[2] - ax * a[2]};
+                        long double rho = std::sqrt(px[0] * px[0] + px[1] * px[1] + px[2] * px[2]);
+                        long double e = std::fabs(std::sqrt((rho - R) * (rho - R) + ax * ax) - r);
+                        // (beside its own accuracy, the rounding of the place of the hit in the world)
+                        double rel = (double)(e / (R + 64 * real_eps() / tol * (std::fabs(off) + (fl ? dist : 0))));
+                        worst = std::max(worst, rel);
+                        if (!(rel <= tol)) {
+                            CHECK_MESSAGE(rel <= tol, "R " << R << " r " << r << " offset " << off << " ray " << i
+                                                           << ": hit " << k << " off the surface by " << rel << " R");
+                        }
+                    }
+                }
+                pray_scene_free(c, q);
+                pray_release(c, t);
+                pray_release(c, m);
+                pray_free(c);
+            }
+        }
+    }
+    MESSAGE("torus (" << std::string(fl ? "float" : "double") << "): " << rays << " rays, " << hits << " hits, largest distance from the surface "
+                      << worst << " R; missed " << missed << ", hit beside it " << false_hits);
+    CHECK(missed == 0);
+    CHECK(false_hits == 0);
+}

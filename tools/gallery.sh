@@ -91,6 +91,7 @@ examples/loop.ray|Loops
 examples/models.ray|Lighting models
 examples/anim.ray|Animation
 examples/redsph.ray|The red sphere
+examples/chess.ray|Chess
 examples/redsphx.ray|The red sphere as printed|The red sphere of the thesis' appendix A exactly as printed, slips included.
 EOF
 # every example must be in the list
