@@ -15,7 +15,10 @@ NAME is a variable of SCENE.ray. If the .ray defines NAME as a lighting model
 (`NAME = phong(...)`), the definition becomes `NAME = color({r, g, b})`; if it defines NAME
 as a primitive (`NAME = plane(White, ...)`), the primitive's model argument becomes that
 colour. Every model of the .ray must get a colour and every colour must be used, so the two
-files cannot drift apart. The background becomes black, as on POV-Ray's side. The lights
+files cannot drift apart. A line may end in a comment `// ray: TEXT`: a name TEXT is the .ray's
+variable (for a name POV-Ray cannot take, such as Flat); any other TEXT is a model written
+inline in the .ray, such as `phong({0.9, 0.2, 0.2}, {0.3}, 20)`, and each place where it
+occurs becomes the colour. The background becomes black, as on POV-Ray's side. The lights
 stay: color() surfaces ignore them.
 """
 import re
@@ -26,14 +29,23 @@ TOLERANCE = 24  # per channel, out of 255: the colours are 51 apart, quantisatio
 
 
 def flat_colours(pov):
+    """The colours of the named models, and those of the inline ones (text: colour)."""
     cols = {}
+    inline = {}
     for line in open(pov):
-        m = re.match(r"\s*#declare\s+(\w+)\s*=\s*FlatColour\(<([^>]*)>\)", line)
+        m = re.match(r"\s*#declare\s+(\w+)\s*=\s*FlatColour\(<([^>]*)>\)\s*(?://\s*ray:\s*(.*\S))?", line)
         if m:
-            cols[m.group(1)] = ", ".join(x.strip() for x in m.group(2).split(","))
-    if not cols:
+            col = ", ".join(x.strip() for x in m.group(2).split(","))
+            text = m.group(3)
+            if text is None:
+                cols[m.group(1)] = col
+            elif re.match(r"\w+$", text):
+                cols[text] = col
+            else:
+                inline[text] = col
+    if not cols and not inline:
         sys.exit("helper.py: no FlatColour lines in %s" % pov)
-    return cols
+    return cols, inline
 
 
 def first_argument_end(text, start):
@@ -51,10 +63,14 @@ def first_argument_end(text, start):
 
 
 def flat_ray(ray, pov):
-    cols = flat_colours(pov)
+    cols, inline = flat_colours(pov)
     used = set()
     out = []
     for n, line in enumerate(open(ray), 1):
+        for text, col in inline.items():
+            if text in line:
+                line = line.replace(text, "color({%s})" % col)
+                used.add(text)
         m = re.match(r"(\s*)(\w+)(\s*=\s*)(\w+)\s*\(", line)
         if re.match(r"\s*background\b", line):
             line = "background {0}\n"
@@ -71,7 +87,7 @@ def flat_ray(ray, pov):
         elif m and m.group(4) in MAKERS:
             sys.exit("%s:%d: the model %s has no FlatColour in %s" % (ray, n, m.group(2), pov))
         out.append(line)
-    missing = sorted(set(cols) - used)
+    missing = sorted((set(cols) | set(inline)) - used)
     if missing:
         sys.exit("helper.py: %s defines no %s" % (ray, ", ".join(missing)))
     sys.stdout.write("".join(out))

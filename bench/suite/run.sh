@@ -68,8 +68,10 @@ PRAY=$(pwd)/pray
 OUT=$(mktemp -d)
 trap 'rm -rf "$OUT"' EXIT
 $PY bench/suite/gen.py "$OUT"
-# POV-Ray reads and writes only where its I/O restrictions allow: it runs inside $OUT
-cp bench/pov/pray.inc "$OUT"
+# POV-Ray reads and writes only where its I/O restrictions allow: it runs inside $OUT, with the
+# twins' include files and a copy of the examples' textures (tex/, which some twins read)
+cp bench/pov/*.inc "$OUT"
+mkdir "$OUT/tex" && cp examples/tex/*.tif "$OUT/tex"
 for f in examples/*.ray; do
   n=$(basename "$f" .ray)
   case $n in redsphx|maketex) continue ;; esac
