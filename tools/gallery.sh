@@ -90,6 +90,8 @@ examples/holes.ray|Holes
 examples/loop.ray|Loops
 examples/models.ray|Lighting models
 examples/anim.ray|Animation
+examples/roomball.ray|A ball rolling through the Room (image-sequence coherence)
+examples/machine.ray|A turning flywheel (image-sequence coherence)
 examples/redsph.ray|The red sphere
 examples/chess.ray|Chess
 examples/redsphx.ray|The red sphere as printed|The red sphere of the thesis' appendix A exactly as printed, slips included.
