@@ -133,8 +133,12 @@ def sphere(m, c, r):
             "sphere { <%s>, %s material { %s } }" % (vec(c), r, m))
 
 
-def box(m, lo, hi):
-    """Six half-spaces in PRAY, a box in POV-Ray: lo and hi are the lowest and highest corners."""
+def box(m, lo, hi, maker=False):
+    """Six half-spaces in PRAY (maker: PRAY's box), a box in POV-Ray: lo and hi are the lowest and
+    highest corners."""
+    if maker:
+        return ("box(%s, [%s], [%s])" % (m, vec(lo), vec(hi)),
+                "box { <%s>, <%s> material { %s } }" % (vec(lo), vec(hi), m))
     x0, y0, z0 = (str(v) for v in lo)
     x1, y1, z1 = (str(v) for v in hi)
     ray = ("(plane({m}, [{x1}, 0, 0], <1, 0, 0>) & plane({m}, [{x0}, 0, 0], <-1, 0, 0>)"
@@ -300,15 +304,18 @@ def csg_wide(n, rmin, rmax):
     return t
 
 
-def keyboard():
-    t = Twin("boxes-1k", "a keyboard: 1000 keys on a board, each key a box of six half-spaces")
+def keyboard(maker=False):
+    """maker: the boxes made by PRAY's box instead of six half-spaces each (boxes-1k-box)."""
+    t = Twin("boxes-1k" + ("-box" if maker else ""), "a keyboard: 1000 keys on a board, each key %s"
+             % ("a box" if maker else "a box of six half-spaces"))
     t.camera((0, -35, 25), (0, 0, 0), 23)
     t.background((0.2, 0.25, 0.35))
     palette(t, ("Red",))
     t.sun(1, (1, 2, -3))
-    t.add(box("Grey", (-21, -13.5, -1), (21, 13.5, 0)), 6)
+    per = 1 if maker else 6
+    t.add(box("Grey", (-21, -13.5, -1), (21, 13.5, 0), maker), per)
     for name, m in (("KeyA", "White"), ("KeyB", "Red")):
-        b = box(m, (-0.4, -0.4, 0), (0.4, 0.4, 0.4))
+        b = box(m, (-0.4, -0.4, 0), (0.4, 0.4, 0.4), maker)
         t.put("%s = %s" % (name, b[0]), "#declare %s = %s" % (name, b[1]))
 
     def column():
@@ -317,13 +324,14 @@ def keyboard():
             t.add(placed("B", ["-19.5 + I", "-12 + J", "0"]), 0)
         t.loop("J", 25, key)
     t.loop("I", 40, column)
-    t.prims += 6 * 1000
+    t.prims += per * 1000
     return t
 
 
-def shelves():
-    t = Twin("boxes-10k", "bookshelves: 20 shelves of 500 books, each book and board a box of "
-             "six half-spaces")
+def shelves(maker=False):
+    """maker: the boxes made by PRAY's box instead of six half-spaces each (boxes-10k-box)."""
+    t = Twin("boxes-10k" + ("-box" if maker else ""), "bookshelves: 20 shelves of 500 books, each book "
+             "and board %s" % ("a box" if maker else "a box of six half-spaces"))
     t.camera((-12, -26, 13), (28, 0, 10), 12)
     t.background((0.2, 0.25, 0.35))
     palette(t)
@@ -333,18 +341,18 @@ def shelves():
 
     def shelf():
         t.let("Z", "1.2*L")
-        t.add(box("White", ["-0.2", "0", "Z - 0.1"], ["62", "0.8", "Z"]), 0)
+        t.add(box("White", ["-0.2", "0", "Z - 0.1"], ["62", "0.8", "Z"], maker), 0)
         t.let("X", "0")
 
         def book():
             t.rand("A", "B", "C")
             t.pick("M", "N + L", ["Red", "Gold", "Green", "Blue"])
             t.let("W", "0.06 + 0.12*A")
-            t.add(box("M", ["X", "0.05", "Z"], ["X + W", "0.5 + 0.25*C", "Z + 0.6 + 0.4*B"]), 0)
+            t.add(box("M", ["X", "0.05", "Z"], ["X + W", "0.5 + 0.25*C", "Z + 0.6 + 0.4*B"], maker), 0)
             t.let("X", "X + W + 0.003")
         t.loop("N", 500, book)
     t.loop("L", 20, shelf)
-    t.prims += 6 * (20 + 10000)
+    t.prims += (1 if maker else 6) * (20 + 10000)
     return t
 
 
@@ -428,7 +436,9 @@ def scenes():
     yield csg_wide(100, 0.3, 0.8)
     yield csg_wide(1000, 0.12, 0.3)
     yield keyboard()
+    yield keyboard(True)
     yield shelves()
+    yield shelves(True)
     yield glass()
     yield lights_scene("lights-2k", True)
     yield lights_scene("sun-2k", False)
