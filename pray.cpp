@@ -8216,7 +8216,7 @@ int pair_cmp(const void *pa, const void *pb) {
 // whether a shadow ray leaving one ignores another must not change.
 bool coh_twins(CohDiff &d) {
     int n = d.pairs.n / 2;
-    for (int pass = 0; pass < 2; pass++) {
+    for (int pass = 0; n > 1 && pass < 2; pass++) {  // (no pairs: the array may have no storage)
         qsort(d.pairs.p, (size_t)n, 2 * sizeof(int), pair_cmp);
         for (int i = 1; i < n; i++)
             if (d.pairs[2 * i] == d.pairs[2 * i - 2] && d.pairs[2 * i + 1] != d.pairs[2 * i - 1]) return false;

@@ -173,6 +173,11 @@ TEST_CASE("coherence: solids of version 2 turning within their own boxes, textur
                     "rendertiff Room | Cube | Ring | Egg, Lamp, Sun"));
 }
 
+TEST_CASE("coherence: frames of nothing") {
+    // (no primitive to pair between the frames)
+    same_frames("rendertiff nothing, none\nrendertiff nothing, none\nrendertiff one, none\n", {"width=8", "height=8"});
+}
+
 TEST_CASE("coherence: a light, the camera or an option that changes: the frame is traced in full") {
     std::string p = scene("if F = 1 then\n"
                           "  Lamp = pointlight({0.8}, [2, -3, 4.5])\n"
