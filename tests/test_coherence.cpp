@@ -175,7 +175,7 @@ TEST_CASE("coherence: solids of version 2 turning within their own boxes, textur
 
 TEST_CASE("coherence: frames of nothing") {
     // (no primitive to pair between the frames)
-    same_frames("rendertiff nothing, none\nrendertiff nothing, none\nrendertiff one, none\n", {"width=8", "height=8"});
+    same_frames("rendertiff nothing, none\nrendertiff nothing, none\nrendertiff nothing, none\n", {"width=8", "height=8"});
 }
 
 TEST_CASE("coherence: a light, the camera or an option that changes: the frame is traced in full") {
