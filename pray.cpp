@@ -60,7 +60,7 @@
 #include <string.h>
 #include <time.h>
 
-#if PRAY_VERSION_MAJOR != 0 || PRAY_VERSION_MINOR != 3
+#if PRAY_VERSION_MAJOR != 0 || PRAY_VERSION_MINOR != 4
 #error "pray.cpp and pray.hpp are from different versions"
 #endif
 

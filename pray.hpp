@@ -9,9 +9,9 @@
 #define PRAY_HPP
 
 #define PRAY_VERSION_MAJOR 0
-#define PRAY_VERSION_MINOR 3
+#define PRAY_VERSION_MINOR 4
 #define PRAY_VERSION_PATCH 0
-#define PRAY_VERSION_STRING "0.3.0"
+#define PRAY_VERSION_STRING "0.4.0"
 
 /* ---------------------------------------------------------------------------------------------
    Configuration. Every macro is optional; define it on the command line or in a header named by
@@ -54,7 +54,7 @@ typedef enum pray_status {
 
 /* The text of a status code ("ok", "out of memory", ...). Never NULL. */
 const char *pray_status_text(pray_status s);
-/* "0.3.0". */
+/* "0.4.0". */
 const char *pray_version(void);
 /* The configuration compiled in, e.g. "interp stdio png threads real=double". */
 const char *pray_features(void);
