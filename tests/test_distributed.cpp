@@ -6,6 +6,7 @@
 
 #include "../pray.hpp"
 #include "testkit.hpp"
+#include "tempfiles.hpp"
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -23,40 +24,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Dir {
-    std::string path;
-    Dir() {
-        std::string t = (fs::temp_directory_path() / "pray_dist_XXXXXX").string();
-        std::vector<char> buf(t.begin(), t.end());
-        buf.push_back(0);
-        if (mkdtemp(buf.data())) path = buf.data();
-    }
-    ~Dir() {
-        std::error_code ec;
-        if (!path.empty()) fs::remove_all(path, ec);
-    }
-    std::string operator/(const std::string &name) const { return path + "/" + name; }
-    std::string listing() const {
-        std::vector<std::string> names;
-        for (const fs::directory_entry &e : fs::directory_iterator(path)) names.push_back(e.path().filename().string());
-        std::sort(names.begin(), names.end());
-        std::string s;
-        for (size_t i = 0; i < names.size(); i++) s += (i ? " " : "") + names[i];
-        return s;
-    }
-};
-
-std::string file(const std::string &path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-void put(const std::string &path, const std::string &text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-}
+typedef testkit::TempDir Dir;
+using testkit::slurp;
+using testkit::spit;
 
 std::string q(const std::string &s) {
     std::string r = "'";
@@ -243,7 +213,7 @@ TEST_CASE("parts: pray_image_new, pray_set_error and notes in image files") {
     // a note changes the header only: TIFF gets an ImageDescription, PPM a comment line
     REQUIRE(pray_write_image(c, &img, (d / "a.tif").c_str(), 16) == PRAY_OK);
     REQUIRE(pray_write_image_note(c, &img, (d / "b.tif").c_str(), 16, "hello there") == PRAY_OK);
-    std::string a = file(d / "a.tif"), b = file(d / "b.tif");
+    std::string a = slurp(d / "a.tif"), b = slurp(d / "b.tif");
     CHECK(b.size() == a.size() + 12 + 12);
     CHECK(a.substr(a.size() - 120) == b.substr(b.size() - 120));
     CHECK(b.find(std::string("hello there\0", 12)) != std::string::npos);
@@ -254,7 +224,7 @@ TEST_CASE("parts: pray_image_new, pray_set_error and notes in image files") {
     }
     REQUIRE(pray_write_image(c, &img, (d / "a.ppm").c_str(), 8) == PRAY_OK);
     REQUIRE(pray_write_image_note(c, &img, (d / "b.ppm").c_str(), 8, "rows 0:4") == PRAY_OK);
-    CHECK(file(d / "b.ppm") == "P6\n# rows 0:4\n" + file(d / "a.ppm").substr(3));
+    CHECK(slurp(d / "b.ppm") == "P6\n# rows 0:4\n" + slurp(d / "a.ppm").substr(3));
     // what a note cannot be
     CHECK(pray_write_image_note(c, &img, (d / "c.ppm").c_str(), 8, "two\nlines") == PRAY_ERR_ARG);
     CHECK(std::string(pray_error(c)) == "error: a note must be printable ASCII of at most 1000 characters");
@@ -285,7 +255,7 @@ TEST_CASE("parts: pray_image_new, pray_set_error and notes in image files") {
 TEST_CASE("command line: --rows and --part of every frame, --join gives the bytes of the whole render") {
     REQUIRE_MESSAGE(have_pray(), "./pray or examples/ missing: run from the repository root after make");
     Dir d;
-    put(d / "scene.ray", SCENE);
+    spit(d / "scene.ray", SCENE);
     std::string opts = "-s 48x36 -D antialias=2 -D adaptive=0.05 ", out;
     REQUIRE(sh(pray_cmd(opts + "-o " + q(d / "w.tif") + " " + q(d / "scene.ray")), &out) == 0);
     // uneven bands by --rows, in TIFF; then 4 equal bands by --part, in 16-bit PPM
@@ -297,8 +267,8 @@ TEST_CASE("command line: --rows and --part of every frame, --join gives the byte
     for (int k = 1; k <= 4; k++)
         REQUIRE(sh(pray_cmd(opts + "-D bits=16 --part " + std::to_string(k) + "/4 -o " +
                             q(d / ("p" + std::to_string(k) + ".ppm")) + " " + q(d / "scene.ray")), &out) == 0);
-    CHECK(file(d / "r1.tif").find("pray-part rows=5:17 height=36 frame=0 id=") != std::string::npos);
-    CHECK(file(d / "p2_0002.ppm").substr(0, 39) == "P6\n# pray-part rows=9:18 height=36 fram");
+    CHECK(slurp(d / "r1.tif").find("pray-part rows=5:17 height=36 frame=0 id=") != std::string::npos);
+    CHECK(slurp(d / "p2_0002.ppm").substr(0, 39) == "P6\n# pray-part rows=9:18 height=36 fram");
     for (const char *f : {"", "_0001", "_0002"}) {
         std::string sfx = f;
         // given in any order
@@ -306,17 +276,17 @@ TEST_CASE("command line: --rows and --part of every frame, --join gives the byte
                    " " + q(d / ("r0" + sfx + ".tif")) + " " + q(d / ("r2" + sfx + ".tif")) + " " +
                    q(d / ("r1" + sfx + ".tif")), &out) == 0);
         CHECK(out == "");
-        CHECK(file(d / ("j" + sfx + ".tif")) == file(d / ("w" + sfx + ".tif")));
+        CHECK(slurp(d / ("j" + sfx + ".tif")) == slurp(d / ("w" + sfx + ".tif")));
         REQUIRE(sh(testkit::pray_shell() + " --join " + q(d / ("j" + sfx + ".ppm")) + " " + q(d / ("p1" + sfx + ".ppm")) +
                    " " + q(d / ("p2" + sfx + ".ppm")) + " " + q(d / ("p3" + sfx + ".ppm")) + " " +
                    q(d / ("p4" + sfx + ".ppm")), &out) == 0);
-        CHECK(file(d / ("j" + sfx + ".ppm")) == file(d / ("w" + sfx + ".ppm")));
+        CHECK(slurp(d / ("j" + sfx + ".ppm")) == slurp(d / ("w" + sfx + ".ppm")));
     }
     // 8-bit parts joined into another format: the bytes pray writes in that format
     REQUIRE(sh(testkit::pray_shell() + " --join " + q(d / "x.ppm") + " " + q(d / "r0.tif") + " " + q(d / "r1.tif") + " " +
                q(d / "r2.tif") + " " + q(d / "r3.tif"), &out) == 0);
     REQUIRE(sh(pray_cmd(opts + "-o " + q(d / "w8.ppm") + " " + q(d / "scene.ray")), &out) == 0);
-    CHECK(file(d / "x.ppm") == file(d / "w8.ppm"));
+    CHECK(slurp(d / "x.ppm") == slurp(d / "w8.ppm"));
 }
 
 TEST_CASE("command line: --frames writes the frames asked for, under the names of the whole run") {
@@ -327,11 +297,11 @@ TEST_CASE("command line: --frames writes the frames asked for, under the names o
     REQUIRE(sh(pray_cmd(opts + "--frames 1:2 -o " + q(d / "b###.tif") + " examples/anim.ray"), &out) == 0);
     CHECK(out.find("frame 2 turned") != std::string::npos);  // every statement ran
     CHECK(d.listing() == "a000.tif a001.tif a002.tif b001.tif");
-    CHECK(file(d / "b001.tif") == file(d / "a001.tif"));
+    CHECK(slurp(d / "b001.tif") == slurp(d / "a001.tif"));
     // --frames with --part: rows of the frames asked for
     REQUIRE(sh(pray_cmd(opts + "--frames 2:9 --part 2/2 -o " + q(d / "c###.tif") + " examples/anim.ray"), &out) == 0);
     CHECK(d.listing() == "a000.tif a001.tif a002.tif b001.tif c002.tif");
-    CHECK(file(d / "c002.tif").find("pray-part rows=24:48 height=48 frame=2 id=") != std::string::npos);
+    CHECK(slurp(d / "c002.tif").find("pray-part rows=24:48 height=48 frame=2 id=") != std::string::npos);
     // no frame at all in the range: an error
     CHECK(sh(pray_cmd(opts + "--frames 3:5 -o " + q(d / "e###.tif") + " examples/anim.ray"), &out) == 1);
     CHECK(out.find("pray: error: --frames 3:5 selects no frame: the program renders frames 0:3\n") != std::string::npos);
@@ -389,7 +359,7 @@ TEST_CASE("command line: bad splits and parts that do not belong together: a cle
     REQUIRE(sh(pray_cmd("-s 32x40 --part 4/4 -o " + q(d / "tall.tif") + csg), &out) == 0);
     REQUIRE(sh(pray_cmd("-s 32x32 --part 4/4 -o " + q(d / "f###.tif") + " examples/anim.ray >/dev/null"), &out) == 0);
     REQUIRE(sh(pray_cmd("-s 32x32 -o " + q(d / "plain.tif") + csg), &out) == 0);
-    put(d / "junk.tif", "II*\0 not much of a TIFF");
+    spit(d / "junk.tif", "II*\0 not much of a TIFF");
     std::string p123 = " " + q(d / "p1.tif") + " " + q(d / "p2.tif") + " " + q(d / "p3.tif");
     std::string before = d.listing();
     struct Join {
@@ -439,5 +409,5 @@ TEST_CASE("command line: bad splits and parts that do not belong together: a cle
     // and the good join, for contrast
     CHECK(sh(testkit::pray_shell() + " --join " + q(d / "out.tif") + p123 + " " + q(d / "p4.tif"), &out) == 0);
     REQUIRE(sh(pray_cmd("-s 32x32 -o " + q(d / "whole.tif") + csg), &out) == 0);
-    CHECK(file(d / "out.tif") == file(d / "whole.tif"));
+    CHECK(slurp(d / "out.tif") == slurp(d / "whole.tif"));
 }

@@ -6,6 +6,7 @@
 
 #include "../pray.hpp"
 #include "testkit.hpp"
+#include "tempfiles.hpp"
 
 #include <signal.h>
 #include <sys/stat.h>
@@ -29,42 +30,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A fresh temporary directory, removed with everything in it at the end of the scope.
-struct TempDir {
-    std::string path;
-    TempDir() {
-        std::string t = (fs::temp_directory_path() / "pray_test_XXXXXX").string();
-        std::vector<char> buf(t.begin(), t.end());
-        buf.push_back(0);
-        if (mkdtemp(buf.data())) path = buf.data();
-    }
-    ~TempDir() {
-        std::error_code ec;
-        if (!path.empty()) fs::remove_all(path, ec);
-    }
-    std::string operator/(const std::string &name) const { return path + "/" + name; }
-    // Names of the files in the directory, sorted, "a b c".
-    std::string listing() const {
-        std::vector<std::string> names;
-        for (const fs::directory_entry &e : fs::directory_iterator(path)) names.push_back(e.path().filename().string());
-        std::sort(names.begin(), names.end());
-        std::string s;
-        for (size_t i = 0; i < names.size(); i++) s += (i ? " " : "") + names[i];
-        return s;
-    }
-};
-
-std::string slurp(const std::string &path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-
-void spit(const std::string &path, const std::string &text) {
-    std::ofstream out(path, std::ios::binary);
-    out << text;
-}
+using testkit::TempDir;
+using testkit::slurp;
+using testkit::spit;
 
 bool starts(const std::string &s, const std::string &prefix) { return s.compare(0, prefix.size(), prefix) == 0; }
 

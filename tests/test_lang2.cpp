@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include "testkit.hpp"
+#include "tempfiles.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -43,31 +44,10 @@ Run run_warned(const std::string &program, const char *name = "test.ray", int w 
 }
 
 // A directory of its own for the files a test writes, removed with what it holds.
-struct Dir {
-    std::string path;
-    std::vector<std::string> files;
-    Dir() {
-        char tmpl[] = "/tmp/pray_lang2_XXXXXX";
-        const char *d = mkdtemp(tmpl);
-        REQUIRE(d != nullptr);
-        path = d;
-    }
-    ~Dir() {
-        for (size_t i = files.size(); i-- > 0;) std::remove(files[i].c_str());
-        rmdir(path.c_str());
-    }
-    std::string operator/(const std::string &name) const { return path + "/" + name; }
-    void mkdir(const std::string &name) {
-        REQUIRE(::mkdir((*this / name).c_str(), 0700) == 0);
-        files.insert(files.begin(), *this / name);  // removed last
-    }
-    void write(const std::string &name, const std::string &text) {
-        FILE *f = std::fopen((*this / name).c_str(), "wb");
-        REQUIRE(f != nullptr);
-        std::fwrite(text.data(), 1, text.size(), f);
-        std::fclose(f);
-        files.push_back(*this / name);
-    }
+struct Dir : testkit::TempDir {
+    Dir() { REQUIRE(!path.empty()); }
+    void mkdir(const std::string &name) { REQUIRE(std::filesystem::create_directory(*this / name)); }
+    void write(const std::string &name, const std::string &text) { testkit::spit(*this / name, text); }
 };
 
 // A program file run as pray_run_file runs it.
@@ -478,7 +458,6 @@ TEST_CASE("include: an untrusted program's includes are confined like its textur
     CHECK(r.printed == "b\n");
     // links are not followed
     REQUIRE(symlink((d / "sub/b.ray").c_str(), (d / "link.ray").c_str()) == 0);
-    d.files.push_back(d / "link.ray");
     d.write("viaLink.ray", "include \"link.ray\"\n");
     r = run_file(d / "viaLink.ray", true);
     CHECK(r.error == d / "viaLink.ray" + ":1:9: error: untrusted program: 'link.ray' is a symbolic link; files are read from "

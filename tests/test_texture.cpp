@@ -17,6 +17,7 @@
 #include <doctest/doctest.h>
 
 #include "testkit.hpp"
+#include "tempfiles.hpp"
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -77,40 +78,9 @@ struct Ctx {
     operator pray_ctx *() const { return c; }
 };
 
-// A fresh temporary directory, removed with everything in it at the end of the scope.
-struct TempDir {
-    std::string path;
-    TempDir() {
-        std::string t = (fs::temp_directory_path() / "pray_tex_XXXXXX").string();
-        std::vector<char> buf(t.begin(), t.end());
-        buf.push_back(0);
-        if (mkdtemp(buf.data())) path = buf.data();
-    }
-    ~TempDir() {
-        std::error_code ec;
-        if (!path.empty()) fs::remove_all(path, ec);
-    }
-    std::string operator/(const std::string &name) const { return path + "/" + name; }
-    std::string listing() const {
-        std::vector<std::string> names;
-        for (const fs::directory_entry &e : fs::directory_iterator(path)) names.push_back(e.path().filename().string());
-        std::sort(names.begin(), names.end());
-        std::string s;
-        for (size_t i = 0; i < names.size(); i++) s += (i ? " " : "") + names[i];
-        return s;
-    }
-};
-
-std::string slurp(const std::string &path) {
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream s;
-    s << in.rdbuf();
-    return s.str();
-}
-void spit(const std::string &path, const std::string &bytes) {
-    std::ofstream out(path, std::ios::binary);
-    out << bytes;
-}
+using testkit::TempDir;
+using testkit::slurp;
+using testkit::spit;
 bool contains(const std::string &s, const std::string &part) { return s.find(part) != std::string::npos; }
 
 // Run a shell command; its exit status (-1 when it did not exit normally) and its output.
