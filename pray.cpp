@@ -759,6 +759,36 @@ struct Text {
     const char *str() const { return a.p ? a.p : ""; }
 };
 
+// Sort n items by `less` (a strict weak order; items it leaves unordered keep their order),
+// with tmp (room for n) as scratch: a merge sort of runs sorted by insertion, the comparison
+// inlined. For the large sorts of preparation, where qsort's comparison through a pointer cost
+// more than the sorting itself.
+template <class T, class Less> void sort_items(T *a, T *tmp, size_t n, Less less) {
+    const size_t RUN = 16;
+    for (size_t i = 0; i < n; i += RUN) {
+        size_t e = i + RUN < n ? i + RUN : n;
+        for (size_t j = i + 1; j < e; j++) {
+            T x = a[j];
+            size_t k = j;
+            for (; k > i && less(x, a[k - 1]); k--) a[k] = a[k - 1];
+            a[k] = x;
+        }
+    }
+    T *src = a, *dst = tmp;
+    for (size_t w = RUN; w < n; w *= 2) {
+        for (size_t lo = 0; lo < n; lo += 2 * w) {
+            size_t mid = n - lo > w ? lo + w : n, hi = n - lo > 2 * w ? lo + 2 * w : n, i = lo, j = mid, k = lo;
+            while (i < mid && j < hi) dst[k++] = less(src[j], src[i]) ? src[j++] : src[i++];
+            while (i < mid) dst[k++] = src[i++];
+            while (j < hi) dst[k++] = src[j++];
+        }
+        T *t = src;
+        src = dst;
+        dst = t;
+    }
+    for (size_t i = 0; src != a && i < n; i++) a[i] = src[i];
+}
+
 // =============================================================================================
 // [SECTION] 4 Vector math and the `.` transformations
 // =============================================================================================
@@ -2357,14 +2387,14 @@ struct SnapKey {
     double v[8];  // kind, then the canonical parameters
 };
 
-int snap_cmp(const void *pa, const void *pb) {
-    const SnapKey *a = (const SnapKey *)pa, *b = (const SnapKey *)pb;
-    for (int i = 0; i < 8; i++) {
-        if (a->v[i] < b->v[i]) return -1;
-        if (a->v[i] > b->v[i]) return 1;
+// Keys in order of their components, then of their primitives' numbers.
+struct SnapKeyLess {
+    bool operator()(const SnapKey &a, const SnapKey &b) const {
+        for (int i = 0; i < 8; i++)
+            if (a.v[i] != b.v[i]) return a.v[i] < b.v[i];
+        return a.prim < b.prim;
     }
-    return a->prim - b->prim;
-}
+};
 
 void snap_key(const Prim &q, SnapKey *k) {
     double n[3] = {q.n.x, q.n.y, q.n.z}, p[3] = {q.p.x, q.p.y, q.p.z};
@@ -2428,12 +2458,13 @@ struct SnapComp {
     double kind, v;
     int prim;
 };
-int snap_comp_cmp(const void *pa, const void *pb) {
-    const SnapComp *a = (const SnapComp *)pa, *b = (const SnapComp *)pb;
-    if (a->kind != b->kind) return a->kind < b->kind ? -1 : 1;
-    if (a->v != b->v) return a->v < b->v ? -1 : 1;
-    return a->prim - b->prim;
-}
+struct SnapCompLess {
+    bool operator()(const SnapComp &a, const SnapComp &b) const {
+        if (a.kind != b.kind) return a.kind < b.kind;
+        if (a.v != b.v) return a.v < b.v;
+        return a.prim < b.prim;
+    }
+};
 
 bool same_key(const SnapKey &a, const SnapKey &b) {
     for (int i = 0; i < 8; i++)
@@ -2451,7 +2482,7 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
     if (n == 1) s->prims[0].surf = 0;
     if (n < 2) return PRAY_OK;
     SnapKey *k = (SnapKey *)mem_alloc(c, sizeof(SnapKey) * (size_t)n);
-    SnapComp *o = (SnapComp *)mem_alloc(c, sizeof(SnapComp) * (size_t)n);
+    SnapComp *o = (SnapComp *)mem_alloc(c, sizeof(SnapComp) * 2 * (size_t)n);  // (and the sort's scratch)
     double *scale = (double *)mem_alloc(c, sizeof(double) * (size_t)n);
     if (!k || !o || !scale) {
         mem_free(c, k);
@@ -2471,7 +2502,7 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
             o[i].v = k[i].v[comp];
             o[i].prim = i;
         }
-        qsort(o, (size_t)n, sizeof(SnapComp), snap_comp_cmp);
+        sort_items(o, o + n, (size_t)n, SnapCompLess());
         for (int i = 0; i < n;) {
             const SnapComp &a = o[i];
             int j = i + 1;
@@ -2485,7 +2516,17 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
             i = j;
         }
     }
-    qsort(k, (size_t)n, sizeof(SnapKey), snap_cmp);
+    mem_free(c, o);
+    mem_free(c, scale);
+    o = NULL;
+    scale = NULL;
+    SnapKey *tmp = (SnapKey *)mem_alloc(c, sizeof(SnapKey) * (size_t)n);
+    if (!tmp) {
+        mem_free(c, k);
+        return c->status;
+    }
+    sort_items(k, tmp, (size_t)n, SnapKeyLess());
+    mem_free(c, tmp);
     for (int i = 0; i < n;) {
         const Prim &a = s->prims[k[i].prim];
         int j = i + 1;
@@ -2504,8 +2545,6 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
         i = j;
     }
     mem_free(c, k);
-    mem_free(c, o);
-    mem_free(c, scale);
     return PRAY_OK;
 }
 

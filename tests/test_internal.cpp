@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -460,6 +461,28 @@ std::string t_compare_ray(TScene &B, const RefTree &T, const std::vector<pray_mo
 // =============================================================================================
 // Ray/primitive intersection
 // =============================================================================================
+namespace {
+struct PairLess {  // by key only: items of one key must keep their order
+    bool operator()(const std::pair<int, int> &a, const std::pair<int, int> &b) const { return a.first < b.first; }
+};
+} // namespace
+
+TEST_CASE("sort_items: the order of std::stable_sort, for every length up to 300 and a long one, few keys and many") {
+    std::mt19937 rng(7);
+    std::vector<size_t> lengths;
+    for (size_t n = 0; n <= 300; n++) lengths.push_back(n);
+    lengths.push_back(100003);
+    for (size_t n : lengths)
+        for (int keys : {3, 1000000}) {
+            std::vector<std::pair<int, int>> a(n), tmp(n);
+            for (size_t i = 0; i < n; i++) a[i] = std::make_pair((int)(rng() % keys), (int)i);
+            std::vector<std::pair<int, int>> want = a;
+            std::stable_sort(want.begin(), want.end(), PairLess());
+            sort_items(a.data(), tmp.data(), n, PairLess());
+            REQUIRE_MESSAGE(a == want, "length " << n << ", keys " << keys);
+        }
+}
+
 TEST_CASE("prim_span: sphere, exact roots") {
     TCtx k;
     pray_object *s = pray_sphere(k.c, k.mat(1), t_vec(0, 0, 0), 2);
