@@ -2497,6 +2497,9 @@ pray_status snap_coincident(pray_ctx *c, Scene *s) {
         s->prims[i].surf = i;
     }
     for (int comp = 1; comp < 8; comp++) {
+        bool one = true;  // (one value for all, such as a sphere's 0 after its radius: nothing to round)
+        for (int i = 1; i < n && one; i++) one = k[i].v[comp] == k[0].v[comp];
+        if (one) continue;
         for (int i = 0; i < n; i++) {
             o[i].kind = k[i].v[0];
             o[i].v = k[i].v[comp];

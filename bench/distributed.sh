@@ -6,6 +6,7 @@
 # seconds and the CPU seconds of all the processes of each way.
 #   bench/distributed.sh [SCENE [SIZE [ANTIALIAS]]]   default examples/room.ray 1024x1024 2
 # Needs ./pray, ./pray-mpi (make mpi) and GNU parallel. Best of REPEAT runs (default 2).
+# bench/distributed.py draws the table and the cost model for many nodes from this output.
 set -e
 cd "$(dirname "$0")/.."
 SCENE=${1:-examples/room.ray}
@@ -55,4 +56,6 @@ for np in 2 3 5; do
     row "pray-mpi, rank 0 + $((np - 1)) worker(s)" "$np" "$t" "$tmp/mpi$np.tif"
 done
 echo
+# the parts of one thread's time that every process pays again (docs/distributed.md)
+./pray $opts --threads 1 --stats -o "$tmp/stats.tif" "$SCENE" 2>&1 | sed -n 's/^time: /pray --stats, one thread: /p'
 echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
