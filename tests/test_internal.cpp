@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <random>
 #include <string>
 #include <vector>
@@ -481,6 +482,38 @@ TEST_CASE("sort_items: the order of std::stable_sort, for every length up to 300
             sort_items(a.data(), tmp.data(), n, PairLess());
             REQUIRE_MESSAGE(a == want, "length " << n << ", keys " << keys);
         }
+}
+
+TEST_CASE("decimal_exact: the bits of strtod for every number it converts, on random numbers of every shape") {
+    std::mt19937_64 rng(11);
+    auto same = [](const std::string &t) {
+        double v = -1;
+        if (!decimal_exact(t.c_str(), &v)) return true;  // (strtod's)
+        double w = strtod(t.c_str(), nullptr);
+        return std::memcmp(&v, &w, sizeof v) == 0;
+    };
+    const char *fixed[] = {"0", "0.0", "000.000", "1", "0.1", "0.3", ".5", "5.", "123456789012345", "1234567890123456",
+                           "0.000000000000000000001", "1e22", "1e23", "9e22", "999999999999999e22", "1e-22",
+                           "123456789012345e-22", "4.9e-324", "1.7976931348623157e308", "0.0000012345e+5", "7E-0",
+                           "9007199254740993", "0.1e1", "100000000000000000000000", "3.141592653589793"};
+    for (const char *t : fixed) CHECK_MESSAGE(same(t), t);
+    int converted = 0;
+    for (int i = 0; i < 200000; i++) {
+        std::string t;
+        int lead = (int)(rng() % 3), intd = (int)(rng() % 12), fracd = (int)(rng() % 12);
+        for (int k = 0; k < lead; k++) t += '0';
+        for (int k = 0; k < intd; k++) t += (char)('0' + rng() % 10);
+        if (t.empty() || rng() % 2) {
+            t += '.';
+            for (int k = 0; k < fracd; k++) t += (char)('0' + rng() % 10);
+            if (fracd == 0) t += '0';
+        }
+        if (rng() % 2) t += (rng() % 2 ? "e-" : "e") + std::to_string(rng() % 30);
+        double v;
+        converted += decimal_exact(t.c_str(), &v);
+        REQUIRE_MESSAGE(same(t), t);
+    }
+    if (DOUBLE_ROUNDS_ONCE) CHECK(converted > 100000);  // (so that the comparisons above compare something)
 }
 
 TEST_CASE("prim_span: sphere, exact roots") {
