@@ -7962,8 +7962,8 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
 // A program's frame with the camera, lights, image and options of the frame before takes over
 // every pixel whose rays cannot have met anything that changed. While a pixel is traced, the
 // ray driver notes in the pixel's record the regions of space its rays crossed (region_note,
-// 9b.8): cells of a fine grid over the scene's finite parts, of a coarse grid around it, and
-// bit 0 for all space beyond. The next frame compares its prepared scene with the frame
+// 9b.8): cells of a grid over the scene's finite parts, and bit 0 for all space outside the
+// grid's box. The next frame compares its prepared scene with the frame
 // before's, by value (coh_diff), and marks the cells that the boxes of what changed reach, in
 // both scenes (coh_mark). A pixel whose record meets no marked cell has the same rays and the
 // same colour; the others are traced again. With undersampling the unit is the band of rows
@@ -8416,7 +8416,7 @@ pray_status coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
             box_hull(&b, h->hull);
             if (!box_empty(next) && box_finite(next)) box_hull(&b, next);
         }
-        // (a sample's fine grid reaches further: it tells whether the next frame is worth
+        // (a sample's grid reaches further: it tells whether the next frame is worth
         // recording, also when something moves out of this frame's box)
         Regions g;
         memset(&g, 0, sizeof g);
