@@ -5866,7 +5866,8 @@ inline int region_cell(double x, int n) { return !(x >= 0) ? 0 : x >= n ? n - 1 
 // Set the bits of the grid's cells that the part [ta, tb] (inside its box) of the ray crosses,
 // cell by cell (Amanatides and Woo's walk) from the cell at ta to the cell at tb. The steps
 // along each axis are counted out beforehand, so that a step needs no test of the grid's
-// bounds or of tb, and rounding can never take the walk out of the grid. Returns the cells set.
+// bounds or of tb, and rounding can never take the walk out of the grid. Returns the number of
+// cells set.
 int region_walk(const RegionGrid &g, const double *o, const double *d, const double *inv, double ta, double tb,
                 unsigned *bits) {
     int n = g.n, id = g.base, steps = 0, left[3], move[3];
