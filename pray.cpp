@@ -3198,15 +3198,21 @@ struct Cross {
 };
 
 // Image sequences (10b): while a pixel is traced, the regions of space its rays cross are set in
-// its record: bits over the cells of a grid over the scene's finite parts, then over the cells
-// of a coarse grid around it, for what lies outside the first, and bit 0 for all beyond both.
+// its record: bits over the cells of a grid over the scene's finite parts (and where they go),
+// and bit 0 for all space outside the grid's box.
+// A frame's records lie interleaved: word i of the records of COH_BLOCK units in a row (so that
+// the next frame reads the words it needs only, a block of units after another), and a unit's
+// record is written there while its rays are traced, word i at i * COH_BLOCK (coh_word).
+const size_t COH_BLOCK = 32;
 struct RegionGrid {
     double lo[3], hi[3], h[3];  // the box, and the sides of a cell
+    double inv[3];              // 1 / h
     int n, base;                // cells along each axis; the bit of the first
 };
 struct Regions {
-    RegionGrid g[2];  // the fine grid, and the coarse one around it
+    RegionGrid g;
     int words;        // unsigned words of a record
+    double round[3];  // what rounding may move a ray's point by, at most (coh_mark)
 };
 
 struct Counters {
@@ -3216,6 +3222,7 @@ struct Counters {
     double lbuf;  // shadow rays answered by a light buffer
     double ebuf;  // primary rays answered by the eye's buffer
     double cache; // shadow rays answered by the shadow cache
+    double notes, cells;  // image sequences: rays and region cells noted in records (10b)
 };
 enum { RAY_PRIMARY, RAY_SHADOW, RAY_REFLECT, RAY_REFRACT };
 
@@ -5876,14 +5883,14 @@ bool drive_lists(const Scene *s, Scratch *w, const Ray &ray, real tmax, const So
     return tb < tmax && out(A->outer, tb, tmax);
 }
 
-// The part [*ta, *tb] of the ray inside the grid's box; false when none.
-bool region_clip(const RegionGrid &g, const double *o, const double *d, double *ta, double *tb) {
+// The part [*ta, *tb] of the ray inside the grid's box; false when none. (inv: 1 / d)
+bool region_clip(const RegionGrid &g, const double *o, const double *d, const double *inv, double *ta, double *tb) {
     for (int a = 0; a < 3; a++) {
         if (d[a] == 0) {
             if (o[a] < g.lo[a] || o[a] > g.hi[a]) return false;
             continue;
         }
-        double t0 = (g.lo[a] - o[a]) / d[a], t1 = (g.hi[a] - o[a]) / d[a];
+        double t0 = (g.lo[a] - o[a]) * inv[a], t1 = (g.hi[a] - o[a]) * inv[a];
         if (t0 > t1) {
             double x = t0;
             t0 = t1;
@@ -5895,52 +5902,54 @@ bool region_clip(const RegionGrid &g, const double *o, const double *d, double *
     return *ta <= *tb;
 }
 
+// The cell along an axis of grid coordinate x (in cells from the grid's low side), clamped.
+inline int region_cell(double x, int n) { return !(x >= 0) ? 0 : x >= n ? n - 1 : (int)x; }
+
 // Set the bits of the grid's cells that the part [ta, tb] (inside its box) of the ray crosses,
-// cell by cell (Amanatides and Woo's walk).
-void region_walk(const RegionGrid &g, const double *o, const double *d, double ta, double tb, unsigned *bits) {
-    int n = g.n, c[3], step[3];
+// cell by cell (Amanatides and Woo's walk) from the cell at ta to the cell at tb. The steps
+// along each axis are counted out beforehand, so that a step needs no test of the grid's
+// bounds or of tb, and rounding can never take the walk out of the grid. Returns the number of
+// cells set.
+int region_walk(const RegionGrid &g, const double *o, const double *d, const double *inv, double ta, double tb,
+                unsigned *bits) {
+    int n = g.n, id = g.base, steps = 0, left[3], move[3];
     double next[3], delta[3];
-    for (int a = 0; a < 3; a++) {
-        double f = floor((o[a] + d[a] * ta - g.lo[a]) / g.h[a]);
-        c[a] = f < 0 ? 0 : f >= n ? n - 1 : (int)f;
-        step[a] = d[a] > 0 ? 1 : d[a] < 0 ? -1 : 0;
-        next[a] = step[a] ? (g.lo[a] + (c[a] + (step[a] > 0)) * g.h[a] - o[a]) / d[a] : HUGE_VAL;
-        delta[a] = step[a] ? g.h[a] / fabs(d[a]) : 0;
+    for (int a = 0, stride = 1; a < 3; a++, stride *= n) {
+        double O = (o[a] - g.lo[a]) * g.inv[a], D = d[a] * g.inv[a], dt = g.h[a] * inv[a];  // (dt: 1 / D)
+        int c0 = region_cell(O + D * ta, n), c1 = region_cell(O + D * tb, n);
+        id += c0 * stride;
+        if (D > 0) left[a] = c1 - c0, move[a] = stride, next[a] = (c0 + 1 - O) * dt, delta[a] = dt;
+        else left[a] = c0 - c1, move[a] = -stride, next[a] = (c0 - O) * dt, delta[a] = -dt;
+        if (!(left[a] > 0)) left[a] = 0, next[a] = HUGE_VAL;  // (also an axis the ray is parallel to)
+        steps += left[a];
     }
+    int cells = steps + 1;
     for (;;) {
-        int id = g.base + c[0] + n * (c[1] + n * c[2]);
-        bits[id >> 5] |= 1u << (id & 31);
+        bits[(id >> 5) * COH_BLOCK] |= 1u << (id & 31);
+        if (!steps--) break;
         int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
-        if (!(next[a] <= tb)) break;
-        c[a] += step[a];
-        if (c[a] < 0 || c[a] >= n) break;
-        next[a] += delta[a];
+        id += move[a];
+        next[a] = --left[a] ? next[a] + delta[a] : HUGE_VAL;
     }
+    return cells;
 }
 
 // Image sequences (10b): set in the record of the pixel being traced the regions that the
-// part (0, end] of the ray crosses: the fine grid's cells where it is in the fine grid's box,
-// the coarse grid's cells where it is in the coarse grid's box only, and bit 0 where it is
-// outside both. A walk rounded past a corner of cells misses a sliver of a cell there; the boxes
-// of what changed are widened by more than that (coh_mark).
+// part (0, end] of the ray crosses: the grid's cells where it is in the grid's box, and bit 0
+// where it is outside. A walk rounded past a corner of cells misses a sliver of a cell there;
+// the boxes of what changed are widened by more than that (coh_mark).
 void region_note(Scratch *w, const Ray &ray, real end) {
-    const Regions &R = *w->rg;
+    const RegionGrid &g = w->rg->g;
     unsigned *bits = w->rbits;
     double o[3] = {(double)ray.o.x, (double)ray.o.y, (double)ray.o.z};
     double d[3] = {(double)ray.d.x, (double)ray.d.y, (double)ray.d.z};
-    double a1 = 0, b1 = (double)end, a0, b0;
-    bool in1 = region_clip(R.g[1], o, d, &a1, &b1);
-    if (!in1 || a1 > 0 || b1 < (double)end) bits[0] |= 1u;
-    if (!in1) return;
-    a0 = a1;
-    b0 = b1;
-    if (!region_clip(R.g[0], o, d, &a0, &b0)) {
-        region_walk(R.g[1], o, d, a1, b1, bits);
-        return;
-    }
-    region_walk(R.g[0], o, d, a0, b0, bits);
-    if (a1 < a0) region_walk(R.g[1], o, d, a1, a0, bits);
-    if (b0 < b1) region_walk(R.g[1], o, d, b0, b1, bits);
+    double inv[3];
+    for (int a = 0; a < 3; a++) inv[a] = d[a] != 0 ? 1 / d[a] : 0;
+    double ta = 0, tb = (double)end;
+    w->k.notes += 1;
+    bool in = region_clip(g, o, d, inv, &ta, &tb);
+    if (!in || ta > 0 || tb < (double)end) bits[0] |= 1u;
+    if (in) w->k.cells += region_walk(g, o, d, inv, ta, tb, bits);
 }
 
 // The one way a ray reaches the accelerated scene (drive_lists); a pixel being traced for an
@@ -7394,7 +7403,6 @@ struct Job;
 // them (every 8th pixel of every 8th row; every 4th band with undersampling) that tells the
 // next frame whether recording all is worth it.
 enum { COH_NONE, COH_ALL, COH_SAMPLE };
-const size_t COH_BLOCK = 32;  // units whose records lie interleaved, word by word
 // Word i of unit u's record, in records of `words` words.
 inline size_t coh_word(size_t u, int i, int words) {
     return (u / COH_BLOCK * (size_t)words + (size_t)i) * COH_BLOCK + u % COH_BLOCK;
@@ -7417,8 +7425,7 @@ struct Worker {
     Array<Sample> cache;  // undersampling: the samples of the current tile
     pray_status st;
     double kept, traced;  // image sequences: pixels taken over from the frame before, and traced
-    unsigned *rtemp;      // ... the record of the unit being traced
-    size_t unit;          // ... and its number
+    double units, recorded;  // ... units traced, and recorded
 };
 
 
@@ -7446,30 +7453,28 @@ struct Job {
 };
 
 // Image sequences (10b): unit u of the image (a pixel; a band with undersampling) is taken over
-// from the frame before (true); else it is traced, into its record emptied (when kept).
+// from the frame before (true); else it is traced, and recorded when its record is kept: its
+// rays set their regions' bits in place, in the records of the image (coh_word), emptied first
+// (a frame that takes units over keeps the records of those).
 bool unit_kept(Worker &k, size_t u) {
     const Job *job = k.job;
     if (job->redo && !job->redo[u]) return true;
     k.w.rbits = NULL;
+    k.units++;
     if (job->rec && (!job->sample || coh_sampled(u, job->s->width, job->adaptive > 0))) {
-        k.w.rbits = k.rtemp;
-        k.unit = u;
-        memset(k.rtemp, 0, sizeof(unsigned) * (size_t)job->rg->words);
+        size_t slot = job->sample ? coh_slot(u, job->s->width, job->adaptive > 0) : u;
+        int nw = job->rg->words;
+        unsigned *r = k.w.rbits = job->rec + coh_word(slot, 0, nw);
+        int i = 0;
+        for (; i + 4 <= nw; i += 4, r += 4 * COH_BLOCK)  // (four words a step: it is done for every unit)
+            r[0] = r[COH_BLOCK] = r[2 * COH_BLOCK] = r[3 * COH_BLOCK] = 0;
+        for (; i < nw; i++, r += COH_BLOCK) *r = 0;
+        k.recorded++;
     }
     return false;
 }
 
-// The unit traced is recorded: its record goes into the records of the image, which hold word
-// i of the records of COH_BLOCK units together (so that a frame reads the words it needs
-// only, a block of units after another; coh_word).
-void unit_done(Worker &k) {
-    const Job *job = k.job;
-    if (!k.w.rbits) return;
-    int nw = job->rg->words;
-    size_t u = job->sample ? coh_slot(k.unit, job->s->width, job->adaptive > 0) : k.unit;
-    for (int i = 0; i < nw; i++) job->rec[coh_word(u, i, nw)] = k.rtemp[i];
-    k.w.rbits = NULL;
-}
+void unit_done(Worker &k) { k.w.rbits = NULL; }
 
 // Undersampling works on the image's samples (antialias x antialias per pixel, in one lattice
 // over the whole image): a coarse lattice of them is traced, every 4th pixel, or with antialias
@@ -7844,9 +7849,30 @@ void worker_main(void *arg) {
 
 Worker &worker_at(char *buf, size_t stride, int i) { return *(Worker *)(buf + LINE_SLACK + (size_t)i * stride); }
 
+// Image sequences (10b) weigh what tracing and recording a unit take by the operations counted
+// while it is traced (Counters), each at the instructions it takes on average (x86-64, -O3,
+// measured with callgrind over the example scenes; within a fifth on each): a ray (with its
+// pixel and shading), an intersection test, a voxel step, an action of a list; a ray noted in
+// a record (with its walk's setting out), a cell of the grid it crosses, a word of a record
+// emptied; taking a unit over, and testing one word of its record for change.
+const double COH_RAY_WORK = 530, COH_TEST_WORK = 100, COH_STEP_WORK = 100, COH_ACTION_WORK = 25;
+const double COH_NOTE_WORK = 200, COH_CELL_WORK = 10, COH_WORD_WORK = 2;
+const double COH_KEEP_WORK = 30, COH_HIT_WORK = 4;
+// Recording pays only when the next frame saves this many times what it costs (coh_plan): the
+// weights are good to a fifth, and the share of units to trace again is the frame before's.
+const double COH_MARGIN = 1.5;
+
+double trace_work(const Counters &k) {
+    double rays = k.rays[0] + k.rays[1] + k.rays[2] + k.rays[3];
+    return COH_RAY_WORK * rays + COH_TEST_WORK * k.tests + COH_STEP_WORK * k.steps +
+           COH_ACTION_WORK * (k.set_in + k.set_out + k.checks);
+}
+double record_work(const Counters &k) { return COH_NOTE_WORK * k.notes + COH_CELL_WORK * k.cells; }
+
 // What a frame of an image sequence takes over from the frame before (10b): per unit of the image
 // (a pixel; with undersampling a band of rows) whether it is traced again (redo NULL: all
 // are), its record (rec NULL: none is kept) over the regions rg, and the frame before's pixels.
+// The render driver adds what the frame's tracing and recording took (coh_keep).
 struct CohPlan {
     unsigned char *redo;
     unsigned *rec;
@@ -7855,6 +7881,8 @@ struct CohPlan {
     int sample;  // only a sample of the units is recorded (coh_sampled)
     int record;  // what is recorded: COH_NONE, COH_ALL, COH_SAMPLE (10b)
     size_t units;
+    double traced, work;     // units traced, and their work (trace_work)
+    double recorded, rwork;  // units recorded, and the work of recording them (record_work)
 };
 
 // The rows of a band of the render driver: a band of tiles with undersampling.
@@ -7867,7 +7895,7 @@ int band_rows_of(const pray_ctx *c, const Scene *s, bool rgb) {
 // Render the rectangle r of the image into the buffers (stride set); `plan`: what an image
 // sequence's frame takes over from the one before (NULL: nothing).
 pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const pray_buffers &out,
-                         const CohPlan *plan) {
+                         CohPlan *plan) {
     int nt = opt_int(c, OPT_THREADS);
     if (nt <= 0) nt = cpu_count();
     if (!PRAY_HAS_THREADS || nt < 1) nt = 1;
@@ -7922,7 +7950,6 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         k.tr.s = s;
         k.tr.w = &k.w;
         k.w.rg = job.rg;
-        if (job.rec && !(k.rtemp = (unsigned *)thread_alloc(c, sizeof(unsigned) * (size_t)job.rg->words))) st = c->status;
         args[made] = &k;
     }
     if (st == PRAY_OK) {
@@ -7954,8 +7981,13 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
             c->stats.pixels_reused += worker_at(wbuf, stride, i).kept;
             c->stats.pixels_retraced += worker_at(wbuf, stride, i).traced;
         }
+        if (plan) {  // (what tracing and recording took, for the next frame's plan)
+            plan->work += trace_work(k);
+            plan->rwork += record_work(k);
+            plan->recorded += worker_at(wbuf, stride, i).recorded;
+            plan->traced += worker_at(wbuf, stride, i).units;
+        }
         scratch_release(c, &worker_at(wbuf, stride, i).w);
-        mem_free(c, worker_at(wbuf, stride, i).rtemp);
         worker_at(wbuf, stride, i).cache.release(c);
     }
     if (out.rgb) c->stats.rays_primary_full += (double)r.width * r.height * s->antialias * s->antialias;
@@ -7973,8 +8005,8 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
 // A program's frame with the camera, lights, image and options of the frame before takes over
 // every pixel whose rays cannot have met anything that changed. While a pixel is traced, the
 // ray driver notes in the pixel's record the regions of space its rays crossed (region_note,
-// 9b.8): cells of a fine grid over the scene's finite parts, of a coarse grid around it, and
-// bit 0 for all space beyond. The next frame compares its prepared scene with the frame
+// 9b.8): cells of a grid over the scene's finite parts, and bit 0 for all space outside the
+// grid's box. The next frame compares its prepared scene with the frame
 // before's, by value (coh_diff), and marks the cells that the boxes of what changed reach, in
 // both scenes (coh_mark). A pixel whose record meets no marked cell has the same rays and the
 // same colour; the others are traced again. With undersampling the unit is the band of rows
@@ -7989,6 +8021,7 @@ struct Coherence {
     Options opt;      // its options
     Box hull;         // the box of its finite parts
     int recorded;     // `rec` and `img` are the last frame's too: COH_ALL or COH_SAMPLE
+    double t, r;      // the work of tracing a unit, of recording one (coh_keep; trace_work)
     Regions rg;       // the cells its records are made of
     unsigned *rec;    // units x rg.words (coh_word)
     size_t units;     // pixels, or with undersampling bands
@@ -8171,17 +8204,16 @@ bool grid_mark(const RegionGrid &g, unsigned *dirty, const Box &b, const double 
     return inside;
 }
 
-// Mark the regions that box b within box `clip` reaches (an empty box is nothing): the fine
-// grid's cells, the coarse grid's when it reaches out of the fine grid's box, and bit 0 when
-// out of the coarse grid's box. The box is widened by an eighth of a fine cell and by rounding.
+// Mark the regions that box b within box `clip` reaches (an empty box is nothing): the grid's
+// cells, and bit 0 when it reaches out of the grid's box. The box is widened by an eighth of a
+// cell and by rounding.
 void coh_mark(const Regions &R, unsigned *dirty, const Box &box, const Box &clip) {
     Box b = box;
     box_clip(&b, clip);
     if (box_empty(b)) return;
     double eps[3];
-    for (int a = 0; a < 3; a++)
-        eps[a] = R.g[0].h[a] / 8 + 1024 * REAL_EPS * (fabs(R.g[1].lo[a]) + fabs(R.g[1].hi[a]));
-    if (!grid_mark(R.g[0], dirty, b, eps) && !grid_mark(R.g[1], dirty, b, eps)) dirty[0] |= 1u;
+    for (int a = 0; a < 3; a++) eps[a] = R.g.h[a] / 8 + R.round[a];
+    if (!grid_mark(R.g, dirty, b, eps)) dirty[0] |= 1u;
 }
 
 inline const Box *elem_box_or_all(const Scene *s, int e, Box *all) {
@@ -8304,47 +8336,55 @@ Box finite_hull(const Scene *s) {
     return h;
 }
 
-// Regions around box b: the fine grid over b grown by `slack` times its largest side, as many
-// cells as the budget COH_BYTES gives `units` records (false when fewer than 4 a side); the
-// coarse grid of 4 cells a side over b grown on every side by its size (by half its largest
-// side at least).
+// Regions around box b: the grid over b grown by `slack` times its largest side, as many cells
+// as the budget COH_BYTES gives `units` records (false when fewer than 4 a side). What rounding
+// may move a point by is taken for points as far out as b grown on every side by its size.
 bool coh_regions(Regions *R, Box b, size_t units, double slack) {
     if (box_empty(b))
         for (int l = 0; l < 3; l++) b.lo[l] = -1, b.hi[l] = 1;
     double m = 0;
     for (int l = 0; l < 3; l++) m = (double)b.hi[l] - b.lo[l] > m ? (double)b.hi[l] - b.lo[l] : m;
     if (!(m > 0)) m = 1;
-    const int COARSE = 4, BASE = 1 + COARSE * COARSE * COARSE;
     int n = COH_CELLS;
-    while (n >= 4 && (double)units * ((BASE + n * n * n + 31) / 32) * sizeof(unsigned) > COH_BYTES) n--;
+    while (n >= 4 && (double)units * ((1 + n * n * n + 31) / 32) * sizeof(unsigned) > COH_BYTES) n--;
     if (n < 4) return false;
-    R->words = (BASE + n * n * n + 31) / 32;
-    for (int k = 0; k < 2; k++) {
-        RegionGrid &g = R->g[k];
-        g.n = k ? COARSE : n;
-        g.base = k ? 1 : BASE;
-        for (int l = 0; l < 3; l++) {
-            double e = (double)b.hi[l] - b.lo[l], grow = k ? (e > m / 2 ? e : m / 2) : m * slack;
-            g.lo[l] = (double)b.lo[l] - grow;
-            g.hi[l] = (double)b.hi[l] + grow;
-            g.h[l] = (g.hi[l] - g.lo[l]) / g.n;
-            if (!(g.h[l] > 0) || !finite_num(g.h[l])) return false;
-        }
+    R->words = (1 + n * n * n + 31) / 32;
+    RegionGrid &g = R->g;
+    g.n = n;
+    g.base = 1;
+    for (int l = 0; l < 3; l++) {
+        double e = (double)b.hi[l] - b.lo[l], far = e > m / 2 ? e : m / 2;
+        g.lo[l] = (double)b.lo[l] - m * slack;
+        g.hi[l] = (double)b.hi[l] + m * slack;
+        g.h[l] = (g.hi[l] - g.lo[l]) / g.n;
+        if (!(g.h[l] > 0) || !finite_num(g.h[l])) return false;
+        g.inv[l] = 1 / g.h[l];
+        R->round[l] = 1024 * REAL_EPS * (fabs((double)b.lo[l] - far) + fabs((double)b.hi[l] + far));
     }
     return true;
 }
 
 // The plan of a program's frame (CohPlan). A frame like the one before in all but its scene
-// (the same camera, lights, image and options) compares the two scenes (coh_diff). When the
-// one before has records of every unit and no more than half of them meet what changed, the
-// frame takes the others over, and traces and records those. Else it is traced in full, and
-// recorded in full when the sample of the records of the frame before says that no more than
-// half of a frame would be traced again; otherwise (and in a frame unlike the one before) only
-// the sample is recorded, at a cost of a per cent or two of its rays. So an animation in which
-// everything moves, or the camera, and a program's single frame are never recorded in full.
-// A frame traced in full gets new cells, over this frame, the one before and where things go
-// on moving. Records that the budget (COH_BYTES) or the context's memory cap has no room for
-// (they may take half of what the cap leaves) are not made: the frame is traced in full. An
+// (the same camera, lights, image and options) compares the two scenes (coh_diff) and finds the
+// share p of units whose records meet what changed: among all units when the frame before
+// recorded every one, else among the sample's. What pays follows from a model of the work in
+// instructions, with no clock in it (so that runs are alike): t, tracing a unit, and r,
+// recording one, from what the frame before counted (trace_work, record_work; t of the last
+// frame traced in full), and k, taking a unit over with the test of its record's words marked.
+//   - With records of every unit the frame takes the others over when p t + k < t, and traces
+//     those again; else it is traced in full.
+//   - If the next frame finds the same share changed, it saves s = t - p (t + r) - k a unit.
+//     The frame records (every unit when it is traced in full, the units traced again when it
+//     takes the others over) when s is more than COH_MARGIN times what that recording costs
+//     now (r, or p r a unit): the next frame alone pays for it, so recording does not slow an
+//     animation down even when the animation ends there. Else a frame traced in full records
+//     only the sample, at a cost of a per cent or two of its rays, and one that takes units over
+//     records nothing (the next frame is traced in full, and records the sample).
+// So an animation in which everything moves, or the camera, a program's single frame and one
+// whose units cost little more to trace than to record are never recorded in full. A frame
+// traced in full gets new cells, over this frame, the one before and where things go on
+// moving. Records that the budget (COH_BYTES) or the context's memory cap has no room for (they
+// may take half of what the cap leaves) are not made: the frame is traced in full. An
 // allocation that fails is out of memory, as anywhere else.
 pray_status coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
     memset(plan, 0, sizeof *plan);
@@ -8395,11 +8435,17 @@ pray_status coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
         }
         for (size_t u = 0; u < n && hit; u++) again += hit[u];
         if (hit != plan->redo) mem_free(c, hit);
-        if (2 * again <= n) record = COH_ALL;
-        if (2 * again > n || !plan->redo) {  // (most of it: traced in full)
+        double p = n ? (double)again / n : 1, keep = COH_KEEP_WORK + COH_HIT_WORK * nd;
+        if (plan->redo && !(p * h->t + keep < h->t)) {  // (taking over would cost more: traced in full)
             mem_free(c, plan->redo);
             plan->redo = NULL;
         }
+        // the next frame, if it traces the same share again and records it, saves per unit
+        // what tracing costs less that share of tracing and recording and what taking over
+        // costs; this frame records every unit, or the units it traces again
+        double saved = h->t - p * (h->t + h->r) - keep, cost = plan->redo ? p * h->r : h->r;
+        if (saved > COH_MARGIN * cost) record = COH_ALL;
+        else if (plan->redo) record = COH_NONE;
     }
     mem_free(c, dirty);
     if (!plan->redo) {  // new cells: this frame, the one before and the next
@@ -8413,7 +8459,7 @@ pray_status coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
             box_hull(&b, h->hull);
             if (!box_empty(next) && box_finite(next)) box_hull(&b, next);
         }
-        // (a sample's fine grid reaches further: it tells whether the next frame is worth
+        // (a sample's grid reaches further: it tells whether the next frame is worth
         // recording, also when something moves out of this frame's box)
         Regions g;
         memset(&g, 0, sizeof g);
@@ -8439,20 +8485,23 @@ pray_status coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
     }
     h->recorded = COH_NONE;  // (until coh_keep)
     plan->record = record;
+    plan->prev = plan->redo ? h->img : NULL;
     if (record == COH_NONE) return PRAY_OK;
     plan->rec = h->rec;
     plan->units = units;
     plan->rg = &h->rg;
-    plan->prev = plan->redo ? h->img : NULL;
     plan->sample = record == COH_SAMPLE;
     return PRAY_OK;
 }
 
 // After a program's frame: keep its scene (taken from *s, without its acceleration structure)
 // and options for the next, and its pixels when it was recorded.
-pray_status coh_keep(pray_ctx *c, Scene *s, const float *img, int recorded) {
+pray_status coh_keep(pray_ctx *c, Scene *s, const float *img, const CohPlan *plan) {
     Coherence *h = c->coh;
     if (!h) return PRAY_OK;
+    int recorded = plan->record;
+    if (!plan->redo && plan->traced > 0) h->t = plan->work / plan->traced;
+    if (plan->recorded > 0) h->r = plan->rwork / plan->recorded + COH_WORD_WORK * h->rg.words;
     size_t n = (size_t)s->width * s->height * 3;
     if (recorded == COH_ALL && (!h->img || h->imgsize != n)) {
         mem_free(c, h->img);
@@ -9728,7 +9777,7 @@ pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, cons
         else coh_release(c);
         if (st == PRAY_OK) st = render_scene(c, &s, r, out, &plan);
         mem_free(c, plan.redo);
-        if (st == PRAY_OK && coh) st = coh_keep(c, &s, out.rgb, plan.record);
+        if (st == PRAY_OK && coh) st = coh_keep(c, &s, out.rgb, &plan);
         if (st != PRAY_OK || !coh) coh_release(c);
     }
     c->stats.time_prepare += t1 - t0;

@@ -225,6 +225,25 @@ TEST_CASE("coherence: where a small ball moves, most pixels are taken over") {
     }
 }
 
+TEST_CASE("coherence: a scene cheap to trace: frames recorded in full, in part, not at all, and sampled again") {
+    // A pixel of this scene costs little more to trace than to record. Frames 0 and 1 are alike
+    // (frame 1 is recorded in full), frames 2 and 3 move the small ball (they take pixels over
+    // and record those traced again), frame 4 moves the large one, which fills most of the
+    // records' cells (it takes pixels over but recording them would not pay), frame 5 is traced
+    // in full and sampled, frame 6 is recorded in full again.
+    std::ostringstream p;
+    p << "option \"width\", 80\noption \"height\", 60\n"
+         "perspective <2.4, 0, 0>, <0, 0, 1.8>, [0, -6, 1], [0, 0, 0]\nbackground {0.7, 0.8, 0.9}\n"
+         "Paint = phong({0.8, 0.3, 0.1}, {0.4}, 25)\nGround = phong({0.5, 0.55, 0.45}, {0}, 1)\n"
+         "Floor = plane(Ground, [0, 0, -1], <0, 0, 1>)\nSun = dirlight({1}, <0.5, 1, -1>)\n";
+    const double big[7] = {0, 0, 0, 0, 0.3, 0.3, 0.3}, small[7] = {0, 0, 0.3, 0.6, 0.6, 0.9, 1.2};
+    for (int f = 0; f < 7; f++)
+        p << "rendertiff Floor | sphere(Paint, [" << big[f] << ", 0, 0], 1) | sphere(Paint, [" << -2 + small[f]
+          << ", -1, -0.7], 0.3) | sphere(Ground, [3.5, 4, 0], 1) | sphere(Ground, [-4, 4, 2], 1), Sun\n";
+    for (int t = 1; t <= 2; t++) same_frames(p.str(), {"threads=" + std::to_string(t)});
+    same_frames(p.str(), {"adaptive=0.05"});
+}
+
 namespace {
 // A random animation: solids of random kinds and materials, some of which move, turn, change
 // material, appear or disappear from one frame to the next; now and then the lamp moves.
