@@ -4188,11 +4188,66 @@ struct GridPlan {
 // A voxel with more primitives to check than this gets a grid of its own (option nest: how many
 // levels deep). The nested grid covers the box that holds those primitives within the voxel,
 // with about 4 voxels per primitive to check (as auto_grid), at most 32 a side; the rest of the
-// voxel has the voxel's list without them (Grid::rest).
+// voxel has the voxel's list without them (Grid::rest). A primitive that crosses the whole voxel
+// along some axis (a floor, a wall, a long rod) is no part of a crowd: the box leaves it out,
+// and the rest of the voxel checks it, unless that would crowd the rest.
 const int NEST_CHECKS = 32;
 
 bool grid_lists(ListBuilder &b, Grid &G, GridPlan &gp, const Array<int> &cand, const Array<int> &start, double margin,
                 int steps, int depth);
+
+// Box bx widened by wid, within the voxel [v0, v1]: lo, hi; whether it crosses the voxel along
+// some axis.
+bool nest_clip(const Box &bx, double wid, const double *v0, const double *v1, double *lo, double *hi) {
+    bool crosses = false;
+    for (int l = 0; l < 3; l++) {
+        double a = (double)bx.lo[l] - wid, z = (double)bx.hi[l] + wid;
+        crosses = crosses || (a <= v0[l] && z >= v1[l]);
+        lo[l] = a > v0[l] ? a : v0[l];
+        hi[l] = z < v1[l] ? z : v1[l];
+    }
+    return crosses;
+}
+
+// Whether box bx widened by wid lies within [lo, hi] inside the voxel [v0, v1].
+bool nest_holds(const Box &bx, double wid, const double *v0, const double *v1, const double *lo, const double *hi) {
+    double plo[3], phi[3];
+    nest_clip(bx, wid, v0, v1, plo, phi);
+    for (int l = 0; l < 3; l++)
+        if (!(plo[l] >= lo[l] && phi[l] <= hi[l])) return false;
+    return true;
+}
+
+// The box of a nested grid in the voxel [v0, v1]: of the primitives to check (b.rprims, b.rcls)
+// whose boxes do not cross the voxel, when the others are few enough for the rest of the voxel
+// (at most NEST_CHECKS outside that box), else of them all. Their boxes are widened by wid; the
+// box is within the voxel, and false when it is empty.
+bool nest_box(const ListBuilder &b, const Box *eff, double wid, const double *v0, const double *v1, double *lo,
+              double *hi) {
+    double alo[3], ahi[3], plo[3], phi[3];
+    for (int l = 0; l < 3; l++) alo[l] = lo[l] = HUGE_VAL, ahi[l] = hi[l] = -HUGE_VAL;
+    int local = 0;
+    for (int i = 0; i < b.rprims.n; i++) {
+        if (b.rcls[i] != CL_BD) continue;
+        bool crosses = nest_clip(eff[b.rprims[i]], wid, v0, v1, plo, phi);
+        local += !crosses;
+        for (int l = 0; l < 3; l++) {
+            alo[l] = plo[l] < alo[l] ? plo[l] : alo[l];
+            ahi[l] = phi[l] > ahi[l] ? phi[l] : ahi[l];
+            lo[l] = !crosses && plo[l] < lo[l] ? plo[l] : lo[l];
+            hi[l] = !crosses && phi[l] > hi[l] ? phi[l] : hi[l];
+        }
+    }
+    int out = 0;
+    for (int i = 0; local > 0 && i < b.rprims.n; i++)
+        if (b.rcls[i] == CL_BD && !nest_holds(eff[b.rprims[i]], wid, v0, v1, lo, hi)) out++;
+    bool all = local == 0 || out > NEST_CHECKS;
+    for (int l = 0; l < 3; l++) {
+        if (all) lo[l] = alo[l], hi[l] = ahi[l];
+        if (!(hi[l] > lo[l])) return false;
+    }
+    return true;
+}
 
 // A grid of its own for voxel ix of G, whose candidates are ids[0 .. n) and which has `checks`
 // primitives to check (classed in the voxel: b.rprims, b.rcls): its index in Accel::nested; -1
@@ -4202,21 +4257,13 @@ int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const
     pray_ctx *c = b.c;
     // the box of the primitives to check, widened by the most a nested grid's margin can be
     // (m <= 32 below), within the voxel
-    double wid = (double)G.h * 1e-6 + gp.round * (steps + 36), lo[3], hi[3], ext = 0, vol = 1;
-    for (int l = 0; l < 3; l++) lo[l] = HUGE_VAL, hi[l] = -HUGE_VAL;
-    for (int i = 0; i < b.rprims.n; i++)
-        for (int l = 0; b.rcls[i] == CL_BD && l < 3; l++) {
-            const Box &bx = gp.eff[b.rprims[i]];
-            lo[l] = (double)bx.lo[l] - wid < lo[l] ? (double)bx.lo[l] - wid : lo[l];
-            hi[l] = (double)bx.hi[l] + wid > hi[l] ? (double)bx.hi[l] + wid : hi[l];
-        }
+    double wid = (double)G.h * 1e-6 + gp.round * (steps + 36), v0[3], v1[3], lo[3], hi[3], ext = 0, vol = 1;
     for (int l = 0; l < 3; l++) {
-        double v0 = (double)G.org[l] + ix[l] * (double)G.h, v1 = v0 + (double)G.h;
-        lo[l] = lo[l] > v0 ? lo[l] : v0;
-        hi[l] = hi[l] < v1 ? hi[l] : v1;
-        if (!(hi[l] > lo[l])) return -1;
-        ext = hi[l] - lo[l] > ext ? hi[l] - lo[l] : ext;
+        v0[l] = (double)G.org[l] + ix[l] * (double)G.h;
+        v1[l] = v0[l] + (double)G.h;
     }
+    if (!nest_box(b, gp.eff, wid, v0, v1, lo, hi)) return -1;
+    for (int l = 0; l < 3; l++) ext = hi[l] - lo[l] > ext ? hi[l] - lo[l] : ext;
     for (int l = 0; l < 3; l++) vol *= hi[l] - lo[l] > ext / 16 ? hi[l] - lo[l] : ext / 16;
     // cubic voxels, about 4 per primitive to check, fewer while the budget is short
     Grid S;
@@ -4244,7 +4291,8 @@ int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const
     steps += (m > S.n[2] ? m : S.n[2]) + 4;
     double margin = (double)S.h * 1e-6 + gp.round * steps;
     if (margin > (double)S.h / 4) return -1;  // (b.rprims and b.rcls left as they are)
-    // the rest of the voxel: what is inside it all, without the primitives to check
+    // the rest of the voxel: what is inside it all, and the primitives to check that reach
+    // out of the box
     Array<int> rp, cand, start;
     Array<unsigned char> rc;
     rp.init();
@@ -4253,7 +4301,8 @@ int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const
     start.init();
     bool ok = rp.reserve(c, b.rprims.n + 1) && rc.reserve(c, b.rprims.n + 1);
     for (int i = 0; ok && i < b.rprims.n; i++)
-        if (b.rcls[i] != CL_BD) rp.p[rp.n++] = b.rprims[i], rc.p[rc.n++] = b.rcls[i];
+        if (b.rcls[i] != CL_BD || !nest_holds(gp.eff[b.rprims[i]], wid, v0, v1, lo, hi))
+            rp.p[rp.n++] = b.rprims[i], rc.p[rc.n++] = b.rcls[i];
     S.rest = ok ? lb_list(b, rp.p, rc.p, rp.n) : -1;
     ok = S.rest >= 0;
     gp.budget -= nv;

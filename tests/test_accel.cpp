@@ -620,8 +620,8 @@ TEST_CASE("accel hits: many small spheres in a union minus a few solids (12 seed
 TEST_CASE("accel hits: lattices of touching spheres (15 seeds)") { run_kind(K_LATTICE, 1, 15, g_total); }
 TEST_CASE("accel hits: blocks sharing faces, on quarter units (20 seeds)") { run_kind(K_BLOCKS, 1, 20, g_total); }
 TEST_CASE("accel hits: an unbounded floor with solids on it (15 seeds)") { run_kind(K_FLOOR, 1, 15, g_total); }
-TEST_CASE("accel hits: dense clusters of small solids with a few far away, where grids nest (5 seeds)") {
-    run_kind(K_CLUSTER, 1, 5, g_total);
+TEST_CASE("accel hits: dense clusters of small solids with a few far away, a floor and rods, where grids nest (8 seeds)") {
+    run_kind(K_CLUSTER, 1, 8, g_total);
 }
 TEST_CASE("accel hits: boxes, rods, cones, tori, stretched and mirrored solids with the others, grazed (60 seeds)") {
     run_kind(K_SHAPES, 1, 60, g_total);
@@ -1050,6 +1050,49 @@ TEST_CASE("accel stats: a grid has voxels, lists and areas; merging moves throug
     // every primitive is tested on every ray by the reference
     CHECK(r.stats.intersection_tests >= r.stats.rays_primary * r.stats.primitives);
     pray_free(b);
+}
+
+TEST_CASE("accel stats: a layer of balls over a floor is divided as finely as without the floor") {
+    // 300 small balls in a flat layer in a corner of a voxel, which the floor crosses: the nested
+    // grid covers the layer's box, not the floor's, and has the voxels it has without the floor
+    const std::string program =
+        "M = phong({0.6}, {0.3}, {0.1}, 10)\n"
+        "All = sphere(M, [0.8, 0.8, 0.8], 0.15)\n"
+        "S = 7\n"
+        "N = 0\n"
+        "while N < 300\n"
+        "  S = (S*16807) % 2147483647\n"
+        "  X = S/2147483647\n"
+        "  S = (S*16807) % 2147483647\n"
+        "  Y = S/2147483647\n"
+        "  S = (S*16807) % 2147483647\n"
+        "  Z = S/2147483647\n"
+        "  All = All | sphere(M, [-0.9 + 0.5*X, -0.9 + 0.5*Y, -0.7 + 0.1*Z], 0.02)\n"
+        "  N = N + 1\n"
+        "endwhile\n"
+        "FLOOR\n"
+        "perspective <1, 0, 0>, <0, 0.8, 0.6>, [0, -3, 2.5], [0, 0, 0]\n"
+        "rendertiff All, dirlight({1}, <1, 2, -3>)\n";
+    const std::vector<std::string> options = {"grid=2", "nest=1", "width=64", "height=64"};
+    Run runs[2];
+    for (int floor = 0; floor < 2; floor++) {
+        std::string text = program;
+        text.replace(text.find("FLOOR"), 5, floor ? "All = All | plane(M, [0, 0, -0.75], <0, 0, 1>)" : "");
+        runs[floor] = run_program("layer.ray", text, options);
+        INFO("floor ", floor, ": ", stats_text(runs[floor].stats));
+        REQUIRE(runs[floor].status == PRAY_OK);
+        CHECK(runs[floor].stats.nested_grids > 0);
+    }
+    CHECK(runs[1].stats.nested_grids == runs[0].stats.nested_grids);
+    CHECK(runs[1].stats.nested_voxels == runs[0].stats.nested_voxels);
+    // and the image is the reference's
+    std::vector<std::string> brute = options;
+    brute.push_back("brute=1");
+    std::string text = program;
+    text.replace(text.find("FLOOR"), 5, "All = All | plane(M, [0, 0, -0.75], <0, 0, 1>)");
+    Run ref = run_program("layer.ray", text, brute);
+    REQUIRE(ref.status == PRAY_OK);
+    CHECK(frame_difference(ref.frames, runs[1].frames) == "");
 }
 
 TEST_CASE("accel stats: of a program run; parts that cannot matter are not kept") {
