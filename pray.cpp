@@ -3193,6 +3193,13 @@ struct Hull {
     int fixed;    // its node's status is fixed for the ray: 1 outside, 2 inside (plan_fixed)
 };
 
+// The shadow cache's voxel for a light (shadow_probe): a voxel of the grid, or of a grid nested
+// in it, as its box within the voxels above it, and its list; list -1: none.
+struct Blocker {
+    real lo[3], hi[3];
+    int list;
+};
+
 struct Scratch {
     Cross *cross;
     Hull *hull;  // per solid of a list with a plan (at most one per node)
@@ -3207,7 +3214,7 @@ struct Scratch {
     unsigned *nfixed;               // status known for the rest of this ray ...
     unsigned char *nfixval;         // ... and its value
     int root_fixed;                 // the root's status cannot change any more on this ray
-    int *blocker;                   // per light: the shadow cache's voxel, x y z; x -1: none (shadow_probe)
+    Blocker *blocker;               // per light: the shadow cache's voxel (shadow_probe)
     // image sequences (10b): the record of the pixel being traced (NULL: none kept) and its regions
     unsigned *rbits;
     const struct Regions *rg;
@@ -3216,7 +3223,7 @@ struct Scratch {
 // Empty the shadow cache. Each band of the image starts with it empty, so that what the cache
 // does (and so the statistics) does not depend on which thread rendered the band before.
 void shadow_cache_clear(const Scene *s, Scratch *w) {
-    for (int i = 0; i < s->lights.n; i++) w->blocker[3 * i] = -1;
+    for (int i = 0; i < s->lights.n; i++) w->blocker[i].list = -1;
 }
 
 // What threads write all the time stays off the cache lines of other threads' data: every
@@ -3239,7 +3246,7 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->nfrozen = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
     w->nfixed = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
     w->nfixval = (unsigned char *)thread_alloc(c, nn);
-    w->blocker = (int *)thread_alloc(c, sizeof(int) * 3 * (size_t)(s->lights.n + 1));
+    w->blocker = (Blocker *)thread_alloc(c, sizeof(Blocker) * (size_t)(s->lights.n + 1));
     if (w->blocker) shadow_cache_clear(s, w);
     return w->blocker && w->cross && (w->span2 || !s->tori) && w->hull && w->pstat && w->nstat && w->nfirst && w->cnt && w->span &&
            w->nfrozen && w->nfixed && w->nfixval;
@@ -5994,26 +6001,46 @@ void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, 
 // (ray_begin): it starts in the middle of the ray, where what was settled before is unknown.
 bool shadow_probe(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, ShadowHit &visit) {
     const Accel *A = s->accel;
-    const int *ix = w->blocker + 3 * light;
-    real lo[3], hi[3], inv[3], ta, tb;
-    for (int l = 0; l < 3; l++) {
-        lo[l] = A->g.org[l] + (real)ix[l] * A->g.h;
-        hi[l] = lo[l] + A->g.h;
-    }
+    const Blocker &bk = w->blocker[light];
+    real inv[3], ta, tb;
     ray_inverse(ray, inv);
-    if (!ray_box(ray, inv, lo, hi, &ta, &tb)) return false;
+    if (!ray_box(ray, inv, bk.lo, bk.hi, &ta, &tb)) return false;
     ta = ta > 0 ? ta : 0;
     tb = tb < tmax ? tb : tmax;
     if (!(ta < tb)) return false;
     ray_begin(s, w);
     ShadowHit probe = visit;
     probe.f = cmake(1, 1, 1);
-    eval_list(s, A, w, ray, A->g.voxel[voxel_index(A->g, ix)], ta, tb, tmax, self, probe);
+    eval_list(s, A, w, ray, bk.list, ta, tb, tmax, self, probe);
     if (!czero(probe.f)) return false;
     if (w->rbits) region_note(w, ray, tb);  // (the whole ray lets through no more than (ta, tb])
     w->k.cache += 1;
     visit.f = probe.f;
     return true;
+}
+
+// The voxel that holds point p in the deepest grid there, for the shadow cache: false when p is
+// outside the grid, or in the rest of a voxel around its nested grid's box (which is no box).
+// A nested grid's box may reach out of its voxel, where its lists do not hold: the box kept is
+// the voxel's within the voxels above it.
+bool blocker_of(const Accel *A, R3 p, Blocker *bk) {
+    const Grid *G = &A->g;
+    for (int l = 0; l < 3; l++) bk->lo[l] = -REAL_INF, bk->hi[l] = REAL_INF;
+    for (;;) {
+        int ix[3];
+        if (!voxel_of(*G, p, ix)) return false;
+        for (int l = 0; l < 3; l++) {
+            real lo = G->org[l] + (real)ix[l] * G->h, hi = lo + G->h;
+            bk->lo[l] = lo > bk->lo[l] ? lo : bk->lo[l];
+            bk->hi[l] = hi < bk->hi[l] ? hi : bk->hi[l];
+        }
+        int L = G->voxel[voxel_index(*G, ix)];
+        if (L >= 0) {
+            bk->list = L;
+            return true;
+        }
+        G = &A->nested[-1 - L];
+    }
 }
 
 // The hits along a shadow ray towards light `light`: the shadow cache's answer when it has one;
@@ -6024,17 +6051,15 @@ void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
         find_hits(s, w, ray, tmax, self, visit);
         return;
     }
-    int *ix = w->blocker + 3 * light;
-    if (A->cache && ix[0] >= 0 && shadow_probe(s, w, ray, tmax, self, light, visit)) return;
+    Blocker *bk = w->blocker + light;
+    if (A->cache && bk->list >= 0 && shadow_probe(s, w, ray, tmax, self, light, visit)) return;
     ZoneSource zone;
     zone.L = A->lbuf ? lightbuf_find(A->lbuf[light], A->outer, ray.o, tmax, &zone.ta, &zone.tb) : -1;
     if (zone.L >= 0) {  // (the outer list alone when the ray misses the grid's box)
         w->k.lbuf += 1;
         drive(s, w, ray, tmax, self, visit, &zone);
     } else find_hits(s, w, ray, tmax, self, visit);
-    // (a voxel with a nested grid has no list to probe)
-    if (A->cache && !(czero(visit.f) && voxel_of(A->g, ray.o + ray.d * visit.t, ix) && A->g.voxel[voxel_index(A->g, ix)] >= 0))
-        ix[0] = -1;
+    if (A->cache && !(czero(visit.f) && blocker_of(A, ray.o + ray.d * visit.t, bk))) bk->list = -1;
 }
 
 // The hits along a primary ray, which starts at the eye: through the cell of the eye's buffer

@@ -1268,10 +1268,10 @@ TEST_CASE("accel light buffers: lightbuffer=0 and 1 give the reference's image, 
 }
 
 TEST_CASE("accel shadow cache: shadowcache=0 and 1 give the reference's image, through glass and with lights amid "
-          "the objects; a table and a pane of glass over a field of spheres") {
+          "the objects; a table and a pane of glass over a field of spheres; a cluster in nested grids") {
     const Pick picks[] = {{K_RANDOM, 30}, {K_RANDOM, 41}, {K_RANDOM, 64}, {K_RANDOM, 66}, {K_MANY, 4},  {K_LATTICE, 3},
                           {K_BLOCKS, 7},  {K_FLOOR, 5},   {K_FLOOR, 12},  {K_SCALED, 2},  {K_SCALED, 6},
-                          {K_SHAPES, 11}};
+                          {K_SHAPES, 11}, {K_CLUSTER, 2}, {K_CLUSTER, 5}};
     SwitchTally t;
     // (the lamps amid the objects end their shadow rays in voxels that hold surfaces beyond them)
     shadow_switch_picks(picks, &Opts::shadowcache, "shadowcache", &pray_stats::rays_shadowcache, nullptr, {3, 8}, 64, t);
@@ -1312,6 +1312,30 @@ TEST_CASE("accel shadow cache: shadowcache=0 and 1 give the reference's image, t
     Switched b = run_switched(bright, {"width=160", "height=160", "shadows=1", "grid=12", "lightbuffer=0"}, "shadowcache");
     CHECK(b.on.stats.rays_shadow > 10000);  // (setup)
     CHECK(b.on.stats.rays_shadowcache == 0);
+
+    // A cluster of 1000 small balls in two voxels, each with a grid of its own: a ball's shadow
+    // on another is cached in the voxel of the nested grid that holds it
+    const std::string cluster =
+        "M = phong({0.6}, {0.3}, {0.1}, 10)\n"
+        "All = sphere(M, [3, 3, 3], 0.15)\n"
+        "S = 7\n"
+        "N = 0\n"
+        "while N < 1000\n"
+        "  S = (S*16807) % 2147483647\n"
+        "  X = S/2147483647\n"
+        "  S = (S*16807) % 2147483647\n"
+        "  Y = S/2147483647\n"
+        "  S = (S*16807) % 2147483647\n"
+        "  Z = S/2147483647\n"
+        "  All = All | sphere(M, [-0.5 + X, -0.5 + Y, -0.5 + Z], 0.04)\n"
+        "  N = N + 1\n"
+        "endwhile\n"
+        "perspective <0.6, 0, 0>, <0, 0.5, 0.4>, [0, -3, 1], [0, 0, 0]\n"
+        "rendertiff All, dirlight({1}, <1, 2, -3>)\n";
+    Switched n = run_switched(cluster, {"width=64", "height=64", "shadows=1", "grid=2"}, "shadowcache");
+    INFO("shadowcache=1: ", stats_text(n.on.stats), "; shadow rays stopped by the cache ", n.on.stats.rays_shadowcache);
+    CHECK(n.on.stats.nested_grids > 0);  // (setup)
+    CHECK(n.on.stats.rays_shadowcache > n.on.stats.rays_shadow / 20);
 }
 
 TEST_CASE("accel threads: the counts of a render are the same for 1, 2, 3 and 8 threads") {
