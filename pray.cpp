@@ -3242,6 +3242,13 @@ struct Hull {
     int fixed;    // its node's status is fixed for the ray: 1 outside, 2 inside (plan_fixed)
 };
 
+// The shadow cache's voxel for a light (shadow_probe): a voxel of the grid, or of a grid nested
+// in it, as its box within the voxels above it, and its list; list -1: none.
+struct Blocker {
+    real lo[3], hi[3];
+    int list;
+};
+
 struct Scratch {
     Cross *cross;
     Hull *hull;  // per solid of a list with a plan (at most one per node)
@@ -3256,7 +3263,7 @@ struct Scratch {
     unsigned *nfixed;               // status known for the rest of this ray ...
     unsigned char *nfixval;         // ... and its value
     int root_fixed;                 // the root's status cannot change any more on this ray
-    int *blocker;                   // per light: the shadow cache's voxel, x y z; x -1: none (shadow_probe)
+    Blocker *blocker;               // per light: the shadow cache's voxel (shadow_probe)
     // image sequences (10b): the record of the pixel being traced (NULL: none kept) and its regions
     unsigned *rbits;
     const struct Regions *rg;
@@ -3265,7 +3272,7 @@ struct Scratch {
 // Empty the shadow cache. Each band of the image starts with it empty, so that what the cache
 // does (and so the statistics) does not depend on which thread rendered the band before.
 void shadow_cache_clear(const Scene *s, Scratch *w) {
-    for (int i = 0; i < s->lights.n; i++) w->blocker[3 * i] = -1;
+    for (int i = 0; i < s->lights.n; i++) w->blocker[i].list = -1;
 }
 
 // What threads write all the time stays off the cache lines of other threads' data: every
@@ -3288,7 +3295,7 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->nfrozen = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
     w->nfixed = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
     w->nfixval = (unsigned char *)thread_alloc(c, nn);
-    w->blocker = (int *)thread_alloc(c, sizeof(int) * 3 * (size_t)(s->lights.n + 1));
+    w->blocker = (Blocker *)thread_alloc(c, sizeof(Blocker) * (size_t)(s->lights.n + 1));
     if (w->blocker) shadow_cache_clear(s, w);
     return w->blocker && w->cross && (w->span2 || !s->tori) && w->hull && w->pstat && w->nstat && w->nfirst && w->cnt && w->span &&
            w->nfrozen && w->nfixed && w->nfixval;
@@ -4237,11 +4244,66 @@ struct GridPlan {
 // A voxel with more primitives to check than this gets a grid of its own (option nest: how many
 // levels deep). The nested grid covers the box that holds those primitives within the voxel,
 // with about 4 voxels per primitive to check (as auto_grid), at most 32 a side; the rest of the
-// voxel has the voxel's list without them (Grid::rest).
+// voxel has the voxel's list without them (Grid::rest). A primitive that crosses the whole voxel
+// along some axis (a floor, a wall, a long rod) is no part of a crowd: the box leaves it out,
+// and the rest of the voxel checks it, unless that would crowd the rest.
 const int NEST_CHECKS = 32;
 
 bool grid_lists(ListBuilder &b, Grid &G, GridPlan &gp, const Array<int> &cand, const Array<int> &start, double margin,
                 int steps, int depth);
+
+// Box bx widened by wid, within the voxel [v0, v1]: lo, hi; whether it crosses the voxel along
+// some axis.
+bool nest_clip(const Box &bx, double wid, const double *v0, const double *v1, double *lo, double *hi) {
+    bool crosses = false;
+    for (int l = 0; l < 3; l++) {
+        double a = (double)bx.lo[l] - wid, z = (double)bx.hi[l] + wid;
+        crosses = crosses || (a <= v0[l] && z >= v1[l]);
+        lo[l] = a > v0[l] ? a : v0[l];
+        hi[l] = z < v1[l] ? z : v1[l];
+    }
+    return crosses;
+}
+
+// Whether box bx widened by wid lies within [lo, hi] inside the voxel [v0, v1].
+bool nest_holds(const Box &bx, double wid, const double *v0, const double *v1, const double *lo, const double *hi) {
+    double plo[3], phi[3];
+    nest_clip(bx, wid, v0, v1, plo, phi);
+    for (int l = 0; l < 3; l++)
+        if (!(plo[l] >= lo[l] && phi[l] <= hi[l])) return false;
+    return true;
+}
+
+// The box of a nested grid in the voxel [v0, v1]: of the primitives to check (b.rprims, b.rcls)
+// whose boxes do not cross the voxel, when the others are few enough for the rest of the voxel
+// (at most NEST_CHECKS outside that box), else of them all. Their boxes are widened by wid; the
+// box is within the voxel, and false when it is empty.
+bool nest_box(const ListBuilder &b, const Box *eff, double wid, const double *v0, const double *v1, double *lo,
+              double *hi) {
+    double alo[3], ahi[3], plo[3], phi[3];
+    for (int l = 0; l < 3; l++) alo[l] = lo[l] = HUGE_VAL, ahi[l] = hi[l] = -HUGE_VAL;
+    int local = 0;
+    for (int i = 0; i < b.rprims.n; i++) {
+        if (b.rcls[i] != CL_BD) continue;
+        bool crosses = nest_clip(eff[b.rprims[i]], wid, v0, v1, plo, phi);
+        local += !crosses;
+        for (int l = 0; l < 3; l++) {
+            alo[l] = plo[l] < alo[l] ? plo[l] : alo[l];
+            ahi[l] = phi[l] > ahi[l] ? phi[l] : ahi[l];
+            lo[l] = !crosses && plo[l] < lo[l] ? plo[l] : lo[l];
+            hi[l] = !crosses && phi[l] > hi[l] ? phi[l] : hi[l];
+        }
+    }
+    int out = 0;
+    for (int i = 0; local > 0 && i < b.rprims.n; i++)
+        if (b.rcls[i] == CL_BD && !nest_holds(eff[b.rprims[i]], wid, v0, v1, lo, hi)) out++;
+    bool all = local == 0 || out > NEST_CHECKS;
+    for (int l = 0; l < 3; l++) {
+        if (all) lo[l] = alo[l], hi[l] = ahi[l];
+        if (!(hi[l] > lo[l])) return false;
+    }
+    return true;
+}
 
 // A grid of its own for voxel ix of G, whose candidates are ids[0 .. n) and which has `checks`
 // primitives to check (classed in the voxel: b.rprims, b.rcls): its index in Accel::nested; -1
@@ -4251,21 +4313,13 @@ int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const
     pray_ctx *c = b.c;
     // the box of the primitives to check, widened by the most a nested grid's margin can be
     // (m <= 32 below), within the voxel
-    double wid = (double)G.h * 1e-6 + gp.round * (steps + 36), lo[3], hi[3], ext = 0, vol = 1;
-    for (int l = 0; l < 3; l++) lo[l] = HUGE_VAL, hi[l] = -HUGE_VAL;
-    for (int i = 0; i < b.rprims.n; i++)
-        for (int l = 0; b.rcls[i] == CL_BD && l < 3; l++) {
-            const Box &bx = gp.eff[b.rprims[i]];
-            lo[l] = (double)bx.lo[l] - wid < lo[l] ? (double)bx.lo[l] - wid : lo[l];
-            hi[l] = (double)bx.hi[l] + wid > hi[l] ? (double)bx.hi[l] + wid : hi[l];
-        }
+    double wid = (double)G.h * 1e-6 + gp.round * (steps + 36), v0[3], v1[3], lo[3], hi[3], ext = 0, vol = 1;
     for (int l = 0; l < 3; l++) {
-        double v0 = (double)G.org[l] + ix[l] * (double)G.h, v1 = v0 + (double)G.h;
-        lo[l] = lo[l] > v0 ? lo[l] : v0;
-        hi[l] = hi[l] < v1 ? hi[l] : v1;
-        if (!(hi[l] > lo[l])) return -1;
-        ext = hi[l] - lo[l] > ext ? hi[l] - lo[l] : ext;
+        v0[l] = (double)G.org[l] + ix[l] * (double)G.h;
+        v1[l] = v0[l] + (double)G.h;
     }
+    if (!nest_box(b, gp.eff, wid, v0, v1, lo, hi)) return -1;
+    for (int l = 0; l < 3; l++) ext = hi[l] - lo[l] > ext ? hi[l] - lo[l] : ext;
     for (int l = 0; l < 3; l++) vol *= hi[l] - lo[l] > ext / 16 ? hi[l] - lo[l] : ext / 16;
     // cubic voxels, about 4 per primitive to check, fewer while the budget is short
     Grid S;
@@ -4293,7 +4347,8 @@ int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const
     steps += (m > S.n[2] ? m : S.n[2]) + 4;
     double margin = (double)S.h * 1e-6 + gp.round * steps;
     if (margin > (double)S.h / 4) return -1;  // (b.rprims and b.rcls left as they are)
-    // the rest of the voxel: what is inside it all, without the primitives to check
+    // the rest of the voxel: what is inside it all, and the primitives to check that reach
+    // out of the box
     Array<int> rp, cand, start;
     Array<unsigned char> rc;
     rp.init();
@@ -4302,7 +4357,8 @@ int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const
     start.init();
     bool ok = rp.reserve(c, b.rprims.n + 1) && rc.reserve(c, b.rprims.n + 1);
     for (int i = 0; ok && i < b.rprims.n; i++)
-        if (b.rcls[i] != CL_BD) rp.p[rp.n++] = b.rprims[i], rc.p[rc.n++] = b.rcls[i];
+        if (b.rcls[i] != CL_BD || !nest_holds(gp.eff[b.rprims[i]], wid, v0, v1, lo, hi))
+            rp.p[rp.n++] = b.rprims[i], rc.p[rc.n++] = b.rcls[i];
     S.rest = ok ? lb_list(b, rp.p, rc.p, rp.n) : -1;
     ok = S.rest >= 0;
     gp.budget -= nv;
@@ -5996,26 +6052,46 @@ void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, 
 // (ray_begin): it starts in the middle of the ray, where what was settled before is unknown.
 bool shadow_probe(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, ShadowHit &visit) {
     const Accel *A = s->accel;
-    const int *ix = w->blocker + 3 * light;
-    real lo[3], hi[3], inv[3], ta, tb;
-    for (int l = 0; l < 3; l++) {
-        lo[l] = A->g.org[l] + (real)ix[l] * A->g.h;
-        hi[l] = lo[l] + A->g.h;
-    }
+    const Blocker &bk = w->blocker[light];
+    real inv[3], ta, tb;
     ray_inverse(ray, inv);
-    if (!ray_box(ray, inv, lo, hi, &ta, &tb)) return false;
+    if (!ray_box(ray, inv, bk.lo, bk.hi, &ta, &tb)) return false;
     ta = ta > 0 ? ta : 0;
     tb = tb < tmax ? tb : tmax;
     if (!(ta < tb)) return false;
     ray_begin(s, w);
     ShadowHit probe = visit;
     probe.f = cmake(1, 1, 1);
-    eval_list(s, A, w, ray, A->g.voxel[voxel_index(A->g, ix)], ta, tb, tmax, self, probe);
+    eval_list(s, A, w, ray, bk.list, ta, tb, tmax, self, probe);
     if (!czero(probe.f)) return false;
     if (w->rbits) region_note(w, ray, tb);  // (the whole ray lets through no more than (ta, tb])
     w->k.cache += 1;
     visit.f = probe.f;
     return true;
+}
+
+// The voxel that holds point p in the deepest grid there, for the shadow cache: false when p is
+// outside the grid, or in the rest of a voxel around its nested grid's box (which is no box).
+// A nested grid's box may reach out of its voxel, where its lists do not hold: the box kept is
+// the voxel's within the voxels above it.
+bool blocker_of(const Accel *A, R3 p, Blocker *bk) {
+    const Grid *G = &A->g;
+    for (int l = 0; l < 3; l++) bk->lo[l] = -REAL_INF, bk->hi[l] = REAL_INF;
+    for (;;) {
+        int ix[3];
+        if (!voxel_of(*G, p, ix)) return false;
+        for (int l = 0; l < 3; l++) {
+            real lo = G->org[l] + (real)ix[l] * G->h, hi = lo + G->h;
+            bk->lo[l] = lo > bk->lo[l] ? lo : bk->lo[l];
+            bk->hi[l] = hi < bk->hi[l] ? hi : bk->hi[l];
+        }
+        int L = G->voxel[voxel_index(*G, ix)];
+        if (L >= 0) {
+            bk->list = L;
+            return true;
+        }
+        G = &A->nested[-1 - L];
+    }
 }
 
 // The hits along a shadow ray towards light `light`: the shadow cache's answer when it has one;
@@ -6026,17 +6102,15 @@ void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
         find_hits(s, w, ray, tmax, self, visit);
         return;
     }
-    int *ix = w->blocker + 3 * light;
-    if (A->cache && ix[0] >= 0 && shadow_probe(s, w, ray, tmax, self, light, visit)) return;
+    Blocker *bk = w->blocker + light;
+    if (A->cache && bk->list >= 0 && shadow_probe(s, w, ray, tmax, self, light, visit)) return;
     ZoneSource zone;
     zone.L = A->lbuf ? lightbuf_find(A->lbuf[light], A->outer, ray.o, tmax, &zone.ta, &zone.tb) : -1;
     if (zone.L >= 0) {  // (the outer list alone when the ray misses the grid's box)
         w->k.lbuf += 1;
         drive(s, w, ray, tmax, self, visit, &zone);
     } else find_hits(s, w, ray, tmax, self, visit);
-    // (a voxel with a nested grid has no list to probe)
-    if (A->cache && !(czero(visit.f) && voxel_of(A->g, ray.o + ray.d * visit.t, ix) && A->g.voxel[voxel_index(A->g, ix)] >= 0))
-        ix[0] = -1;
+    if (A->cache && !(czero(visit.f) && blocker_of(A, ray.o + ray.d * visit.t, bk))) bk->list = -1;
 }
 
 // The hits along a primary ray, which starts at the eye: through the cell of the eye's buffer

@@ -623,7 +623,8 @@ inline Scene make_scene(pray_ctx *c, int kind, uint64_t seed) {
     }
     case K_CLUSTER: {
         // 150 to 400 small leaves (spheres, boxes, rods in any direction, holed balls) packed
-        // in a ball, minus a few solids; one to three spheres 10 to 200 cluster widths away
+        // in a ball, minus a few solids; one to three spheres 10 to 200 cluster widths away; often
+        // an unbounded floor and unbounded thin rods
         g.spread = 0.12;
         int n = 150 + r.below(251);
         for (int i = 0; i < n; i++) {
@@ -641,6 +642,11 @@ inline Scene make_scene(pray_ctx *c, int kind, uint64_t seed) {
             pray_object *far = g.sphere(mul(r.dir(), r.range(20, 400)), g.radius(0.2, 2));
             root = pray_csg(c, PRAY_UNION, root, far);
         }
+        // what crosses the crowded voxels whole and is no part of the crowd: a floor under the
+        // cluster or through it, and thin rods along the axes through it
+        if (r.chance(0.6)) root = pray_csg(c, PRAY_UNION, root, g.plane(V(0, 0, r.range(-1.5, 0.5)), V(0, 0, r.chance(0.8) ? 1 : -1)));
+        for (int i = 0, m = r.below(4); i < m; i++)
+            root = pray_csg(c, PRAY_UNION, root, g.cylinder(g.point(-0.8, 0.8), axis_vec(r.below(3), 1), g.radius(0.01, 0.05)));
         break;
     }
     }

@@ -620,8 +620,8 @@ TEST_CASE("accel hits: many small spheres in a union minus a few solids (12 seed
 TEST_CASE("accel hits: lattices of touching spheres (15 seeds)") { run_kind(K_LATTICE, 1, 15, g_total); }
 TEST_CASE("accel hits: blocks sharing faces, on quarter units (20 seeds)") { run_kind(K_BLOCKS, 1, 20, g_total); }
 TEST_CASE("accel hits: an unbounded floor with solids on it (15 seeds)") { run_kind(K_FLOOR, 1, 15, g_total); }
-TEST_CASE("accel hits: dense clusters of small solids with a few far away, where grids nest (5 seeds)") {
-    run_kind(K_CLUSTER, 1, 5, g_total);
+TEST_CASE("accel hits: dense clusters of small solids with a few far away, a floor and rods, where grids nest (8 seeds)") {
+    run_kind(K_CLUSTER, 1, 8, g_total);
 }
 TEST_CASE("accel hits: boxes, rods, cones, tori, stretched and mirrored solids with the others, grazed (60 seeds)") {
     run_kind(K_SHAPES, 1, 60, g_total);
@@ -1052,6 +1052,49 @@ TEST_CASE("accel stats: a grid has voxels, lists and areas; merging moves throug
     pray_free(b);
 }
 
+TEST_CASE("accel stats: a layer of balls over a floor is divided as finely as without the floor") {
+    // 300 small balls in a flat layer in a corner of a voxel, which the floor crosses: the nested
+    // grid covers the layer's box, not the floor's, and has the voxels it has without the floor
+    const std::string program =
+        "M = phong({0.6}, {0.3}, {0.1}, 10)\n"
+        "All = sphere(M, [0.8, 0.8, 0.8], 0.15)\n"
+        "S = 7\n"
+        "N = 0\n"
+        "while N < 300\n"
+        "  S = (S*16807) % 2147483647\n"
+        "  X = S/2147483647\n"
+        "  S = (S*16807) % 2147483647\n"
+        "  Y = S/2147483647\n"
+        "  S = (S*16807) % 2147483647\n"
+        "  Z = S/2147483647\n"
+        "  All = All | sphere(M, [-0.9 + 0.5*X, -0.9 + 0.5*Y, -0.7 + 0.1*Z], 0.02)\n"
+        "  N = N + 1\n"
+        "endwhile\n"
+        "FLOOR\n"
+        "perspective <1, 0, 0>, <0, 0.8, 0.6>, [0, -3, 2.5], [0, 0, 0]\n"
+        "rendertiff All, dirlight({1}, <1, 2, -3>)\n";
+    const std::vector<std::string> options = {"grid=2", "nest=1", "width=64", "height=64"};
+    Run runs[2];
+    for (int floor = 0; floor < 2; floor++) {
+        std::string text = program;
+        text.replace(text.find("FLOOR"), 5, floor ? "All = All | plane(M, [0, 0, -0.75], <0, 0, 1>)" : "");
+        runs[floor] = run_program("layer.ray", text, options);
+        INFO("floor ", floor, ": ", stats_text(runs[floor].stats));
+        REQUIRE(runs[floor].status == PRAY_OK);
+        CHECK(runs[floor].stats.nested_grids > 0);
+    }
+    CHECK(runs[1].stats.nested_grids == runs[0].stats.nested_grids);
+    CHECK(runs[1].stats.nested_voxels == runs[0].stats.nested_voxels);
+    // and the image is the reference's
+    std::vector<std::string> brute = options;
+    brute.push_back("brute=1");
+    std::string text = program;
+    text.replace(text.find("FLOOR"), 5, "All = All | plane(M, [0, 0, -0.75], <0, 0, 1>)");
+    Run ref = run_program("layer.ray", text, brute);
+    REQUIRE(ref.status == PRAY_OK);
+    CHECK(frame_difference(ref.frames, runs[1].frames) == "");
+}
+
 TEST_CASE("accel stats: of a program run; parts that cannot matter are not kept") {
     // A sphere minus a sphere far away: with bounds the subtracted part is dropped.
     const std::string program =
@@ -1225,10 +1268,10 @@ TEST_CASE("accel light buffers: lightbuffer=0 and 1 give the reference's image, 
 }
 
 TEST_CASE("accel shadow cache: shadowcache=0 and 1 give the reference's image, through glass and with lights amid "
-          "the objects; a table and a pane of glass over a field of spheres") {
+          "the objects; a table and a pane of glass over a field of spheres; a cluster in nested grids") {
     const Pick picks[] = {{K_RANDOM, 30}, {K_RANDOM, 41}, {K_RANDOM, 64}, {K_RANDOM, 66}, {K_MANY, 4},  {K_LATTICE, 3},
                           {K_BLOCKS, 7},  {K_FLOOR, 5},   {K_FLOOR, 12},  {K_SCALED, 2},  {K_SCALED, 6},
-                          {K_SHAPES, 11}};
+                          {K_SHAPES, 11}, {K_CLUSTER, 2}, {K_CLUSTER, 5}};
     SwitchTally t;
     // (the lamps amid the objects end their shadow rays in voxels that hold surfaces beyond them)
     shadow_switch_picks(picks, &Opts::shadowcache, "shadowcache", &pray_stats::rays_shadowcache, nullptr, {3, 8}, 64, t);
@@ -1269,6 +1312,30 @@ TEST_CASE("accel shadow cache: shadowcache=0 and 1 give the reference's image, t
     Switched b = run_switched(bright, {"width=160", "height=160", "shadows=1", "grid=12", "lightbuffer=0"}, "shadowcache");
     CHECK(b.on.stats.rays_shadow > 10000);  // (setup)
     CHECK(b.on.stats.rays_shadowcache == 0);
+
+    // A cluster of 1000 small balls in two voxels, each with a grid of its own: a ball's shadow
+    // on another is cached in the voxel of the nested grid that holds it
+    const std::string cluster =
+        "M = phong({0.6}, {0.3}, {0.1}, 10)\n"
+        "All = sphere(M, [3, 3, 3], 0.15)\n"
+        "S = 7\n"
+        "N = 0\n"
+        "while N < 1000\n"
+        "  S = (S*16807) % 2147483647\n"
+        "  X = S/2147483647\n"
+        "  S = (S*16807) % 2147483647\n"
+        "  Y = S/2147483647\n"
+        "  S = (S*16807) % 2147483647\n"
+        "  Z = S/2147483647\n"
+        "  All = All | sphere(M, [-0.5 + X, -0.5 + Y, -0.5 + Z], 0.04)\n"
+        "  N = N + 1\n"
+        "endwhile\n"
+        "perspective <0.6, 0, 0>, <0, 0.5, 0.4>, [0, -3, 1], [0, 0, 0]\n"
+        "rendertiff All, dirlight({1}, <1, 2, -3>)\n";
+    Switched n = run_switched(cluster, {"width=64", "height=64", "shadows=1", "grid=2"}, "shadowcache");
+    INFO("shadowcache=1: ", stats_text(n.on.stats), "; shadow rays stopped by the cache ", n.on.stats.rays_shadowcache);
+    CHECK(n.on.stats.nested_grids > 0);  // (setup)
+    CHECK(n.on.stats.rays_shadowcache > n.on.stats.rays_shadow / 20);
 }
 
 TEST_CASE("accel threads: the counts of a render are the same for 1, 2, 3 and 8 threads") {
