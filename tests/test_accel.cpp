@@ -1052,24 +1052,29 @@ TEST_CASE("accel stats: a grid has voxels, lists and areas; merging moves throug
     pray_free(b);
 }
 
+// A PRAY loop that adds n balls of model M to All, at random X, Y, Z in [0, 1) (a Lehmer
+// generator seeded with 7); `where` is the sphere's point and radius written with them.
+static std::string random_balls(int n, const std::string &where) {
+    return "S = 7\nN = 0\nwhile N < " + std::to_string(n) +
+           "\n"
+           "  S = (S*16807) % 2147483647\n"
+           "  X = S/2147483647\n"
+           "  S = (S*16807) % 2147483647\n"
+           "  Y = S/2147483647\n"
+           "  S = (S*16807) % 2147483647\n"
+           "  Z = S/2147483647\n"
+           "  All = All | sphere(M, " + where + ")\n"
+           "  N = N + 1\n"
+           "endwhile\n";
+}
+
 TEST_CASE("accel stats: a layer of balls over a floor is divided as finely as without the floor") {
     // 300 small balls in a flat layer in a corner of a voxel, which the floor crosses: the nested
     // grid covers the layer's box, not the floor's, and has the voxels it has without the floor
     const std::string program =
         "M = phong({0.6}, {0.3}, {0.1}, 10)\n"
         "All = sphere(M, [0.8, 0.8, 0.8], 0.15)\n"
-        "S = 7\n"
-        "N = 0\n"
-        "while N < 300\n"
-        "  S = (S*16807) % 2147483647\n"
-        "  X = S/2147483647\n"
-        "  S = (S*16807) % 2147483647\n"
-        "  Y = S/2147483647\n"
-        "  S = (S*16807) % 2147483647\n"
-        "  Z = S/2147483647\n"
-        "  All = All | sphere(M, [-0.9 + 0.5*X, -0.9 + 0.5*Y, -0.7 + 0.1*Z], 0.02)\n"
-        "  N = N + 1\n"
-        "endwhile\n"
+        + random_balls(300, "[-0.9 + 0.5*X, -0.9 + 0.5*Y, -0.7 + 0.1*Z], 0.02") +
         "FLOOR\n"
         "perspective <1, 0, 0>, <0, 0.8, 0.6>, [0, -3, 2.5], [0, 0, 0]\n"
         "rendertiff All, dirlight({1}, <1, 2, -3>)\n";
@@ -1318,18 +1323,7 @@ TEST_CASE("accel shadow cache: shadowcache=0 and 1 give the reference's image, t
     const std::string cluster =
         "M = phong({0.6}, {0.3}, {0.1}, 10)\n"
         "All = sphere(M, [3, 3, 3], 0.15)\n"
-        "S = 7\n"
-        "N = 0\n"
-        "while N < 1000\n"
-        "  S = (S*16807) % 2147483647\n"
-        "  X = S/2147483647\n"
-        "  S = (S*16807) % 2147483647\n"
-        "  Y = S/2147483647\n"
-        "  S = (S*16807) % 2147483647\n"
-        "  Z = S/2147483647\n"
-        "  All = All | sphere(M, [-0.5 + X, -0.5 + Y, -0.5 + Z], 0.04)\n"
-        "  N = N + 1\n"
-        "endwhile\n"
+        + random_balls(1000, "[-0.5 + X, -0.5 + Y, -0.5 + Z], 0.04") +
         "perspective <0.6, 0, 0>, <0, 0.5, 0.4>, [0, -3, 1], [0, 0, 0]\n"
         "rendertiff All, dirlight({1}, <1, 2, -3>)\n";
     Switched n = run_switched(cluster, {"width=64", "height=64", "shadows=1", "grid=2"}, "shadowcache");
