@@ -13,11 +13,11 @@
    [SECTION] 9b Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
                 [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas and
                 jumps, [9b.4] light and eye buffers, [9b.5] accel_build; per ray: [9b.6] list
-                evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver (which notes
-                where rays went, for image sequences)
+                evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver
    [SECTION] 9c Reading files (programs, textures, fonts), TIFF reader and textures, the built-in font
    [SECTION] 10 Whitted shading, textured surfaces, the render driver (threads, undersampling)
-   [SECTION] 10b Image sequences (3.7): comparing a frame's scene with the one before, records
+   [SECTION] 10b Image sequences (3.7): the regions a ray crosses, comparing a frame's scene with
+                the one before, records
    [SECTION] 11 Image writers: TIFF, PPM, PNG; writing files safely; public functions
    [SECTION] 12 PRAY lexer
    [SECTION] 13 PRAY parser
@@ -3381,6 +3381,16 @@ struct Hit {
     int root_enter;  // the ray enters the whole solid there
 };
 
+// A crossing of a primitive at t, when t is in (a, b] and before tmax: noted for a sweep
+// (`prim`: the primitive, or its place in a list with a plan, 9b).
+inline void add_cross(Scratch *w, int *nc, real t, int prim, int enter, real a, real b, real tmax) {
+    if (!(t > a && t <= b && t < tmax)) return;
+    Cross &x = w->cross[(*nc)++];
+    x.t = t;
+    x.prim = prim;
+    x.enter = enter;
+}
+
 // The start of a sweep: the status of every primitive and node at the start of the ray (just
 // after it, for a start on a surface) into w, and the crossings in (0, tmax) into w->cross
 // (*ncross of them, unsorted). Returns the root's status. The root must be an element.
@@ -3401,12 +3411,7 @@ bool sweep_start(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
         else if (k == SPAN || k == SPAN2) {
             for (int j = 0; j < (k == SPAN2 ? 4 : 2); j++) {
                 in = in || (!(j & 1) && t[j] <= 0 && 0 < t[j + 1]);
-                if (t[j] > 0 && t[j] < tmax) {
-                    w->cross[nc].t = t[j];
-                    w->cross[nc].prim = i;
-                    w->cross[nc].enter = !(j & 1);
-                    nc++;
-                }
+                add_cross(w, &nc, t[j], i, !(j & 1), 0, REAL_INF, tmax);
             }
         }
         w->pstat[i] = in;
@@ -4194,12 +4199,12 @@ bool voxel_range(const Grid &G, const Box &bx, double margin, int *lo, int *hi) 
     return true;
 }
 
-// The candidates of each voxel of G: of the primitives ids[0 .. n) (0 .. n - 1 when NULL),
-// those whose boxes meet the voxel, as cand[start[v] .. start[v + 1]), in two passes (count,
-// then fill).
-bool grid_bucket(pray_ctx *c, const Grid &G, const Box *eff, const int *ids, int n, double margin, Array<int> &cand,
-                 Array<int> &start) {
-    long nv = (long)G.n[0] * G.n[1] * G.n[2];
+// The items of each cell of a grid of dim[0] x dim[1] x dim[2] cells, x fastest, as
+// cand[start[v] .. start[v + 1]), in two passes (count, then fill): `range(k, &id, lo, hi)`
+// gives item k's number and the cells it meets, lo[l] to hi[l] along each axis (false: none).
+template <class Range>
+bool bucket(pray_ctx *c, const int *dim, int n, const Range &range, Array<int> &cand, Array<int> &start) {
+    long nv = (long)dim[0] * dim[1] * dim[2];
     start.n = cand.n = 0;
     if (!start.reserve(c, (int)nv + 1)) return false;
     start.n = (int)nv + 1;
@@ -4210,12 +4215,12 @@ bool grid_bucket(pray_ctx *c, const Grid &G, const Box *eff, const int *ids, int
                 fail_cancelled(c);
                 return false;
             }
-            int i = ids ? ids[k] : k, lo[3], hi[3];
-            if (!voxel_range(G, eff[i], margin, lo, hi)) continue;
+            int i, lo[3], hi[3];
+            if (!range(k, &i, lo, hi)) continue;
             for (int z = lo[2]; z <= hi[2]; z++)
                 for (int y = lo[1]; y <= hi[1]; y++)
                     for (int x = lo[0]; x <= hi[0]; x++) {
-                        int v = (z * G.n[1] + y) * G.n[0] + x;
+                        int v = (z * dim[1] + y) * dim[0] + x;
                         if (pass == 0) start[v + 1]++;
                         else cand[start[v]++] = i;
                     }
@@ -4231,6 +4236,20 @@ bool grid_bucket(pray_ctx *c, const Grid &G, const Box *eff, const int *ids, int
     }
     return true;
 }
+
+// The voxels of G that the boxes of primitives ids[0 .. n) (0 .. n - 1 when NULL) meet, widened
+// by the margin (voxel_range), for bucket.
+struct VoxelRange {
+    const Grid &G;
+    const Box *eff;
+    const int *ids;
+    double margin;
+    VoxelRange(const Grid &G_, const Box *eff_, const int *ids_, double margin_) : G(G_), eff(eff_), ids(ids_), margin(margin_) {}
+    bool operator()(int k, int *i, int *lo, int *hi) const {
+        *i = ids ? ids[k] : k;
+        return voxel_range(G, eff[*i], margin, lo, hi);
+    }
+};
 
 // What the grids of a scene are built with: where bounds place each primitive, the rounding of a
 // position per step of a walk (the margins grow with the steps of the walks above a grid), and
@@ -4363,7 +4382,7 @@ int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const
     ok = S.rest >= 0;
     gp.budget -= nv;
     S.voxel = ok ? (int *)mem_zalloc(c, sizeof(int) * (size_t)nv) : NULL;
-    ok = S.voxel && grid_bucket(c, S, gp.eff, ids, n, margin, cand, start) &&
+    ok = S.voxel && bucket(c, S.n, n, VoxelRange(S, gp.eff, ids, margin), cand, start) &&
          grid_lists(b, S, gp, cand, start, margin, steps, depth) && b.a->nested.push(c, S);
     rp.release(c);
     rc.release(c);
@@ -4704,6 +4723,19 @@ void point_face(int fi, LightFace *F) {
     F->e[1] = unitv[(ax + 2) % 3];
 }
 
+// The cells of a face that each primitive's footprint covers (per primitive u0, u1, v0, v1), for
+// bucket.
+struct Footprint {
+    const int *foot;
+    explicit Footprint(const int *foot_) : foot(foot_) {}
+    bool operator()(int k, int *i, int *lo, int *hi) const {
+        const int *ft = foot + 4 * k;
+        *i = k;
+        lo[0] = ft[0], hi[0] = ft[1], lo[1] = ft[2], hi[1] = ft[3], lo[2] = hi[2] = 0;
+        return lo[0] <= hi[0] && lo[1] <= hi[1];
+    }
+};
+
 // Build the light buffers: cells and slabs about `cell` wide where the grid's box is, and lists
 // for the space between each voxel and its light. `eff`: where
 // bounds place each primitive; `margin`: how far rounding may move a point (the grid's).
@@ -4832,32 +4864,10 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
                     ft[2 * l + 1] = g1 < 0 ? -1 : g1 >= F.n[l] ? F.n[l] - 1 : (int)g1;
                 }
             }
-            // candidates per cell, in two passes (count, then fill)
-            int ncell = F.n[0] * F.n[1];
-            start.n = 0;
-            ok = start.reserve(c, ncell + 1);
+            // candidates per cell
+            int ncell = F.n[0] * F.n[1], dim[3] = {F.n[0], F.n[1], 1};
+            ok = bucket(c, dim, np, Footprint(foot.p), cand, start);
             if (!ok) break;
-            start.n = ncell + 1;
-            memset(start.p, 0, sizeof(int) * (size_t)(ncell + 1));
-            for (int pass = 0; ok && pass < 2; pass++) {
-                for (int i = 0; i < np; i++) {
-                    const int *ft = foot.p + 4 * i;
-                    for (int y = ft[2]; y <= ft[3]; y++)
-                        for (int x = ft[0]; x <= ft[1]; x++) {
-                            if (pass == 0) start[y * F.n[0] + x + 1]++;
-                            else cand[start[y * F.n[0] + x]++] = i;
-                        }
-                }
-                if (pass == 0) {
-                    for (int k = 0; k < ncell; k++) start[k + 1] += start[k];
-                    cand.n = 0;
-                    ok = cand.reserve(c, start[ncell] + 1);
-                    cand.n = start[ncell];
-                } else {
-                    for (int k = ncell; k > 0; k--) start[k] = start[k - 1];
-                    start[0] = 0;
-                }
-            }
             // a face whose cells meet many primitives on average is left to the grid (and
             // costs no time to build)
             // (the eye's pieces are each only a slab deep)
@@ -5075,7 +5085,7 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         gp.round = 64 * REAL_EPS * (mag + ext);
         gp.budget = (budget - (double)nv * (2 * sizeof(int) + 1)) / 16;
         gp.budget = gp.budget < rays / 2 ? gp.budget : rays / 2;
-        if (!a->g.voxel || !grid_bucket(c, a->g, eff, NULL, np, margin, cand, start) ||
+        if (!a->g.voxel || !bucket(c, a->g.n, np, VoxelRange(a->g, eff, NULL, margin), cand, start) ||
             !grid_lists(b, a->g, gp, cand, start, margin, want + 4, opt_int(c, OPT_NEST)))
             st = c->status;
         for (int i = -1; st == PRAY_OK && i < a->nested.n; i++)
@@ -5308,14 +5318,8 @@ bool eval_flat(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
             hull[k].need++, hull[k].have += st;
         }
         if (sp.kind != SPAN) continue;
-        for (int e = 1; e >= 0; e--) {
-            real t = e ? sp.t0 : sp.t1;
-            if (!(t > a && t <= b && t < tmax)) continue;
-            w->cross[nc].t = t;
-            w->cross[nc].prim = i;  // (the list's position: its plan)
-            w->cross[nc].enter = e;
-            nc++;
-        }
+        add_cross(w, &nc, sp.t0, i, 1, a, b, tmax);  // (the list's position: its plan)
+        add_cross(w, &nc, sp.t1, i, 0, a, b, tmax);
     }
     if (nc == 0) return false;
     for (int g = 0; g < ng; g++) hull[gsolid[g]].need++, hull[gsolid[g]].have += gh[g].have > 0;
@@ -5490,31 +5494,15 @@ bool eval_full(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
             const real *t23 = w->span2 + 2 * p;
             in = (t0 <= a && a < t1) || (t23[0] <= a && a < t23[1]);
             real t[4] = {t0, t1, t23[0], t23[1]};
-            for (int j = 0; j < 4; j++)
-                if (t[j] > a && t[j] <= b && t[j] < tmax) {
-                    w->cross[nc].t = t[j];
-                    w->cross[nc].prim = p;
-                    w->cross[nc].enter = !(j & 1);
-                    nc++;
-                }
+            for (int j = 0; j < 4; j++) add_cross(w, &nc, t[j], p, !(j & 1), a, b, tmax);
             kind = SPAN;
             t0 = t23[0];
             t1 = t23[1];
         }
         w->pstat[p] = in;
         if (kind == SPAN && sp.kind == SPAN) {
-            if (t0 > a && t0 <= b && t0 < tmax) {
-                w->cross[nc].t = t0;
-                w->cross[nc].prim = p;
-                w->cross[nc].enter = 1;
-                nc++;
-            }
-            if (t1 > a && t1 <= b && t1 < tmax) {
-                w->cross[nc].t = t1;
-                w->cross[nc].prim = p;
-                w->cross[nc].enter = 0;
-                nc++;
-            }
+            add_cross(w, &nc, t0, p, 1, a, b, tmax);
+            add_cross(w, &nc, t1, p, 0, a, b, tmax);
         }
         if (A->freeze) settle_prim(s, w, p, in, kind, t0, t1, a);
         if (in) bump(s, w, 2 * p);
@@ -5939,74 +5927,9 @@ bool drive_lists(const Scene *s, Scratch *w, const Ray &ray, real tmax, const So
     return tb < tmax && out(A->outer, tb, tmax);
 }
 
-// The part [*ta, *tb] of the ray inside the grid's box; false when none. (inv: 1 / d)
-bool region_clip(const RegionGrid &g, const double *o, const double *d, const double *inv, double *ta, double *tb) {
-    for (int a = 0; a < 3; a++) {
-        if (d[a] == 0) {
-            if (o[a] < g.lo[a] || o[a] > g.hi[a]) return false;
-            continue;
-        }
-        double t0 = (g.lo[a] - o[a]) * inv[a], t1 = (g.hi[a] - o[a]) * inv[a];
-        if (t0 > t1) {
-            double x = t0;
-            t0 = t1;
-            t1 = x;
-        }
-        if (t0 > *ta) *ta = t0;
-        if (t1 < *tb) *tb = t1;
-    }
-    return *ta <= *tb;
-}
-
-// The cell along an axis of grid coordinate x (in cells from the grid's low side), clamped.
-inline int region_cell(double x, int n) { return !(x >= 0) ? 0 : x >= n ? n - 1 : (int)x; }
-
-// Set the bits of the grid's cells that the part [ta, tb] (inside its box) of the ray crosses,
-// cell by cell (Amanatides and Woo's walk) from the cell at ta to the cell at tb. The steps
-// along each axis are counted out beforehand, so that a step needs no test of the grid's
-// bounds or of tb, and rounding can never take the walk out of the grid. Returns the number of
-// cells set.
-int region_walk(const RegionGrid &g, const double *o, const double *d, const double *inv, double ta, double tb,
-                unsigned *bits) {
-    int n = g.n, id = g.base, steps = 0, left[3], move[3];
-    double next[3], delta[3];
-    for (int a = 0, stride = 1; a < 3; a++, stride *= n) {
-        double O = (o[a] - g.lo[a]) * g.inv[a], D = d[a] * g.inv[a], dt = g.h[a] * inv[a];  // (dt: 1 / D)
-        int c0 = region_cell(O + D * ta, n), c1 = region_cell(O + D * tb, n);
-        id += c0 * stride;
-        if (D > 0) left[a] = c1 - c0, move[a] = stride, next[a] = (c0 + 1 - O) * dt, delta[a] = dt;
-        else left[a] = c0 - c1, move[a] = -stride, next[a] = (c0 - O) * dt, delta[a] = -dt;
-        if (!(left[a] > 0)) left[a] = 0, next[a] = HUGE_VAL;  // (also an axis the ray is parallel to)
-        steps += left[a];
-    }
-    int cells = steps + 1;
-    for (;;) {
-        bits[(id >> 5) * COH_BLOCK] |= 1u << (id & 31);
-        if (!steps--) break;
-        int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
-        id += move[a];
-        next[a] = --left[a] ? next[a] + delta[a] : HUGE_VAL;
-    }
-    return cells;
-}
-
-// Image sequences (10b): set in the record of the pixel being traced the regions that the
-// part (0, end] of the ray crosses: the grid's cells where it is in the grid's box, and bit 0
-// where it is outside. A walk rounded past a corner of cells misses a sliver of a cell there;
-// the boxes of what changed are widened by more than that (coh_mark).
-void region_note(Scratch *w, const Ray &ray, real end) {
-    const RegionGrid &g = w->rg->g;
-    unsigned *bits = w->rbits;
-    double o[3] = {(double)ray.o.x, (double)ray.o.y, (double)ray.o.z};
-    double d[3] = {(double)ray.d.x, (double)ray.d.y, (double)ray.d.z};
-    double inv[3];
-    for (int a = 0; a < 3; a++) inv[a] = d[a] != 0 ? 1 / d[a] : 0;
-    double ta = 0, tb = (double)end;
-    w->k.notes += 1;
-    bool in = region_clip(g, o, d, inv, &ta, &tb);
-    if (!in || ta > 0 || tb < (double)end) bits[0] |= 1u;
-    if (in) w->k.cells += region_walk(g, o, d, inv, ta, tb, bits);
-}
+// Notes in the record of the pixel being traced the regions that the part (0, end] of the ray
+// crosses (section 10b).
+void region_note(Scratch *w, const Ray &ray, real end);
 
 // The one way a ray reaches the accelerated scene (drive_lists); a pixel being traced for an
 // image sequence notes the part of the ray the lists were evaluated on, up to where the visitor
@@ -8078,11 +8001,11 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
 // =============================================================================================
 // A program's frame with the camera, lights, image and options of the frame before takes over
 // every pixel whose rays cannot have met anything that changed. While a pixel is traced, the
-// ray driver notes in the pixel's record the regions of space its rays crossed (region_note,
-// 9b.8): cells of a grid over the scene's finite parts, and bit 0 for all space outside the
-// grid's box. The next frame compares its prepared scene with the frame
-// before's, by value (coh_diff), and marks the cells that the boxes of what changed reach, in
-// both scenes (coh_mark). A pixel whose record meets no marked cell has the same rays and the
+// ray driver (9b.8) notes in the pixel's record the regions of space its rays crossed
+// (region_note, below): cells of a grid over the scene's finite parts, and bit 0 for all space
+// outside the grid's box. The next frame compares its prepared scene with the frame before's,
+// by value (coh_diff), and marks the cells that the boxes of what changed reach, in both
+// scenes (coh_mark). A pixel whose record meets no marked cell has the same rays and the
 // same colour; the others are traced again. With undersampling the unit is the band of rows
 // the render driver samples alone. The records of a frame are at most COH_BYTES; a frame that
 // cannot have them is traced in full (docs/acceleration.md, "Image sequences").
@@ -8112,6 +8035,76 @@ void coh_release(pray_ctx *c) {
     mem_free(c, h->img);
     mem_free(c, h);
     c->coh = NULL;
+}
+
+// ---- noting the regions a ray crosses (the ray driver calls region_note) ----
+// The part [*ta, *tb] of the ray inside the grid's box; false when none. (inv: 1 / d)
+bool region_clip(const RegionGrid &g, const double *o, const double *d, const double *inv, double *ta, double *tb) {
+    for (int a = 0; a < 3; a++) {
+        if (d[a] == 0) {
+            if (o[a] < g.lo[a] || o[a] > g.hi[a]) return false;
+            continue;
+        }
+        double t0 = (g.lo[a] - o[a]) * inv[a], t1 = (g.hi[a] - o[a]) * inv[a];
+        if (t0 > t1) {
+            double x = t0;
+            t0 = t1;
+            t1 = x;
+        }
+        if (t0 > *ta) *ta = t0;
+        if (t1 < *tb) *tb = t1;
+    }
+    return *ta <= *tb;
+}
+
+// The cell along an axis of grid coordinate x (in cells from the grid's low side), clamped.
+inline int region_cell(double x, int n) { return !(x >= 0) ? 0 : x >= n ? n - 1 : (int)x; }
+
+// Set the bits of the grid's cells that the part [ta, tb] (inside its box) of the ray crosses,
+// cell by cell (Amanatides and Woo's walk) from the cell at ta to the cell at tb. The steps
+// along each axis are counted out beforehand, so that a step needs no test of the grid's
+// bounds or of tb, and rounding can never take the walk out of the grid. Returns the number of
+// cells set.
+int region_walk(const RegionGrid &g, const double *o, const double *d, const double *inv, double ta, double tb,
+                unsigned *bits) {
+    int n = g.n, id = g.base, steps = 0, left[3], move[3];
+    double next[3], delta[3];
+    for (int a = 0, stride = 1; a < 3; a++, stride *= n) {
+        double O = (o[a] - g.lo[a]) * g.inv[a], D = d[a] * g.inv[a], dt = g.h[a] * inv[a];  // (dt: 1 / D)
+        int c0 = region_cell(O + D * ta, n), c1 = region_cell(O + D * tb, n);
+        id += c0 * stride;
+        if (D > 0) left[a] = c1 - c0, move[a] = stride, next[a] = (c0 + 1 - O) * dt, delta[a] = dt;
+        else left[a] = c0 - c1, move[a] = -stride, next[a] = (c0 - O) * dt, delta[a] = -dt;
+        if (!(left[a] > 0)) left[a] = 0, next[a] = HUGE_VAL;  // (also an axis the ray is parallel to)
+        steps += left[a];
+    }
+    int cells = steps + 1;
+    for (;;) {
+        bits[(id >> 5) * COH_BLOCK] |= 1u << (id & 31);
+        if (!steps--) break;
+        int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
+        id += move[a];
+        next[a] = --left[a] ? next[a] + delta[a] : HUGE_VAL;
+    }
+    return cells;
+}
+
+// Set in the record of the pixel being traced the regions that the part (0, end] of the ray
+// crosses: the grid's cells where it is in the grid's box, and bit 0
+// where it is outside. A walk rounded past a corner of cells misses a sliver of a cell there;
+// the boxes of what changed are widened by more than that (coh_mark).
+void region_note(Scratch *w, const Ray &ray, real end) {
+    const RegionGrid &g = w->rg->g;
+    unsigned *bits = w->rbits;
+    double o[3] = {(double)ray.o.x, (double)ray.o.y, (double)ray.o.z};
+    double d[3] = {(double)ray.d.x, (double)ray.d.y, (double)ray.d.z};
+    double inv[3];
+    for (int a = 0; a < 3; a++) inv[a] = d[a] != 0 ? 1 / d[a] : 0;
+    double ta = 0, tb = (double)end;
+    w->k.notes += 1;
+    bool in = region_clip(g, o, d, inv, &ta, &tb);
+    if (!in || ta > 0 || tb < (double)end) bits[0] |= 1u;
+    if (in) w->k.cells += region_walk(g, o, d, inv, ta, tb, bits);
 }
 
 // ---- comparing two prepared scenes by value ----

@@ -1238,6 +1238,69 @@ TEST_CASE("reach: every voxel's cube of its list, exactly as large as it can be 
     pray_free(c);
 }
 
+TEST_CASE("blocker_of: the shadow cache's box holds the point, and the list it keeps holds in all of the box") {
+    // A floor and a cluster of small balls in one voxel of a coarse grid, which gets a grid of
+    // its own. The cache evaluates the kept list on any ray's stretch through the kept box, so
+    // at every point of that box the deepest voxel (found here by plain arithmetic) must have
+    // that list; a point where no voxel's list holds (outside the grid, or in the rest of a
+    // voxel around its nested grid's box) keeps nothing.
+    TCtx k;
+    pray_ctx *c = k.c;
+    REQUIRE(pray_option(c, "grid", 2) == PRAY_OK);
+    REQUIRE(pray_option(c, "width", 256) == PRAY_OK);
+    REQUIRE(pray_option(c, "height", 256) == PRAY_OK);
+    pray_model *m = k.mat(1);
+    pray_object *all = pray_plane(c, m, t_vec(0, 0, -0.6), t_vec(0, 0, 1));
+    all = pray_csg(c, PRAY_UNION, all, pray_sphere(c, m, t_vec(3, 3, 3), 0.2));
+    TRng g(11);
+    for (int i = 0; i < 400; i++)
+        all = pray_csg(c, PRAY_UNION, all, pray_sphere(c, m, t_vec(g.uni(0.2, 1), g.uni(0.2, 1), g.uni(0.2, 1)), 0.03));
+    TScene B(c, all);
+    REQUIRE(B.ok);
+    REQUIRE(B.s.accel);
+    const Accel *A = B.s.accel;
+    REQUIRE(A->nested.n > 0);  // (setup)
+    auto list_at = [&](const double *q) {  // the deepest voxel's list at q; -1: none
+        const Grid *G = &A->g;
+        for (;;) {
+            int ix[3];
+            for (int l = 0; l < 3; l++) {
+                double v = (q[l] - (double)G->org[l]) / (double)G->h;
+                if (!(v >= 0 && v < G->n[l])) return -1;
+                ix[l] = (int)floor(v);
+            }
+            int L = G->voxel[((long)ix[2] * G->n[1] + ix[1]) * G->n[0] + ix[0]];
+            if (L >= 0) return L;
+            G = &A->nested[-1 - L];
+        }
+    };
+    int kept = 0, deep = 0, wrong = 0;
+    for (int i = 0; i < 3000; i++) {
+        double p[3];
+        for (int l = 0; l < 3; l++)  // half in the cluster, half anywhere around the scene
+            p[l] = i % 2 ? g.uni(0.15, 1.05) : g.uni((double)A->g.org[l] - 1, (double)A->g.top[l] + 1);
+        Blocker bk;
+        int want = list_at(p);
+        if (!blocker_of(A, r3((real)p[0], (real)p[1], (real)p[2]), &bk)) {
+            wrong += want >= 0;
+            continue;
+        }
+        kept++;
+        deep += bk.hi[0] - bk.lo[0] < A->g.h;
+        bool in = bk.list == want;
+        for (int l = 0; l < 3; l++) in = in && bk.lo[l] <= p[l] && p[l] <= bk.hi[l];
+        for (int j = 0; in && j < 20; j++) {
+            double q[3];
+            for (int l = 0; l < 3; l++) q[l] = (double)bk.lo[l] + (double)(bk.hi[l] - bk.lo[l]) * g.uni(0.001, 0.999);
+            in = list_at(q) == bk.list;
+        }
+        wrong += !in;
+    }
+    CHECK(kept > 1000);  // (setup)
+    CHECK(deep > 500);   // (setup: points in the nested grid)
+    CHECK(wrong == 0);
+}
+
 TEST_CASE("texture pyramid: the range over texels holds every value a lookup between the coordinates takes") {
     pray_ctx *c = pray_new();
     for (uint64_t seed = 1; seed <= 30; seed++) {
