@@ -492,7 +492,7 @@ enum {
     OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_COHERENCE, OPT_CUTOFF, OPT_DEPTH, OPT_EYEBUFFER, OPT_FREEZE,
     OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_LIGHTBUFFER, OPT_MAXFRAMES, OPT_MAXLINE, OPT_MAXMEM, OPT_MAXNEST,
     OPT_MAXOUTPUT, OPT_MAXPIXELS, OPT_MAXPRIMS, OPT_MAXRAYS, OPT_MAXSTEPS, OPT_MAXSTRING, OPT_MERGE, OPT_NEST, OPT_OUTPUT,
-    OPT_SHADOWCACHE, OPT_SHADOWS, OPT_TEXMEM, OPT_THREADS,
+    OPT_PLANS, OPT_SHADOWCACHE, OPT_SHADOWS, OPT_TEXMEM, OPT_THREADS,
     OPT_WIDTH, OPT_COUNT
 };
 
@@ -1648,6 +1648,7 @@ const OptDef OPTS[OPT_COUNT] = {
     {"merge", 1, 0, 1, 1, 0},
     {"nest", 2, 0, 4, 1, 0},
     {"output", 0, 0, 0, 0, 0},
+    {"plans", 1, 0, 1, 1, 0},
     {"shadowcache", 1, 0, 1, 1, 0},
     {"shadows", 1, 0, 1, 1, 0},
     {"texmem", 256, 1, 65536, 1, 64},
@@ -5110,7 +5111,8 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     start.release(c);
     mem_free(c, eff);
     lb_release(b);
-    if (st == PRAY_OK) {
+    if (st == PRAY_OK) {  // the lists' plans (option plans 0: every list is evaluated in full)
+        bool plans = opt_int(c, OPT_PLANS) != 0;
         int nn = s->nodes.n + 1;
         int *kids = (int *)mem_zalloc(c, sizeof(int) * (size_t)nn);
         int *solid = (int *)mem_alloc(c, sizeof(int) * (size_t)nn);
@@ -5121,7 +5123,7 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
                 st = fail_cancelled(c);
                 break;
             }
-            int where = list_plan(c, s, a->data.p + a->off[L], kids, solid, &a->plan);
+            int where = plans ? list_plan(c, s, a->data.p + a->off[L], kids, solid, &a->plan) : -1;
             if (where == -2 || !a->plan_at.push(c, where))
                 st = c->status;
         }

@@ -176,7 +176,7 @@ void pray_cancel(pray_ctx *ctx);
    depth (ray depth, 5), cutoff (1: leave out rays that, all together, could move no sample by
    half a step of the output; 0: the whole ray tree), antialias (samples per pixel side, 1), adaptive (0), grid (-1 =
    automatic), gridmem (MiB for the grid, 64), freeze, merge, bounds, lightbuffer, eyebuffer,
-   shadowcache, shadows (1/0, default 1), brute (1 = the brute-force reference renderer, 0),
+   shadowcache, plans, shadows (1/0, default 1), brute (1 = the brute-force reference renderer, 0),
    coherence (1: a program's frame with the camera, lights and options of the frame before
    re-traces only the pixels whose rays could have met what changed; 0: every pixel), threads (0 = automatic), maxsteps (statements a program may execute, 10000000; 0 = no
    limit), texmem (MiB for textures, 256),
@@ -640,7 +640,7 @@ pray_status pray_texture_register(pray_ctx *ctx, const char *name, pray_texture 
    rays end, from one list per direction; a shadow ray passes over lists of clear surfaces
    only), and primary rays walk the lists of the eye's buffer, a grid of
    pyramids around a perspective camera's eye; a shadow ray first tries the voxel where the
-   last one towards its light was stopped. Options grid, freeze, merge, bounds,
+   last one towards its light was stopped. Options grid, freeze, merge, bounds, plans,
    lightbuffer, eyebuffer and shadowcache switch the parts on and off; every setting gives the
    image of brute=1, byte for byte.
    docs/acceleration.md explains the methods, docs/benchmarks.md measures them.

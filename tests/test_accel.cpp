@@ -44,13 +44,13 @@ const int NGRIDS = sizeof GRIDS / sizeof GRIDS[0];
 // on by default.
 struct Opts {
     int brute, grid, freeze, merge, bounds;
-    int lightbuffer = 1, eyebuffer = 1, shadowcache = 1;
-    // (the three methods only where they are off)
+    int lightbuffer = 1, eyebuffer = 1, shadowcache = 1, plans = 1;
+    // (the four methods only where they are off)
     std::string text() const {
         if (brute) return "brute=1";
         std::string s;
         for (auto &o : fixed())
-            if (o != "brute=0" && o != "lightbuffer=1" && o != "eyebuffer=1" && o != "shadowcache=1")
+            if (o != "brute=0" && o != "lightbuffer=1" && o != "eyebuffer=1" && o != "shadowcache=1" && o != "plans=1")
                 s += (s.empty() ? "" : " ") + o;
         return s;
     }
@@ -65,21 +65,49 @@ struct Opts {
         v.push_back("lightbuffer=" + std::to_string(lightbuffer));
         v.push_back("eyebuffer=" + std::to_string(eyebuffer));
         v.push_back("shadowcache=" + std::to_string(shadowcache));
+        v.push_back("plans=" + std::to_string(plans));
         return v;
     }
 };
 
 Opts reference() { return Opts{1, -1, 1, 1, 1}; }
 
-// grid x freeze x merge x bounds, the other switches on
+// grid x freeze x merge x bounds, the other switches on; and grid x freeze with plans=0 (every
+// list evaluated in full)
 std::vector<Opts> all_combinations() {
     std::vector<Opts> v;
     for (int g = 0; g < NGRIDS; g++)
-        for (int f = 0; f < 2; f++)
+        for (int f = 0; f < 2; f++) {
             for (int m = 0; m < 2; m++)
                 for (int b = 0; b < 2; b++) v.push_back(Opts{0, GRIDS[g], f, m, b});
+            v.push_back(Opts{0, GRIDS[g], f, 1, 1, 1, 1, 1, 0});
+        }
     return v;
 }
+
+// Intersection tests of renders side by side, freeze=0 and freeze=1 of each other setting:
+// freezing must never add any.
+struct FreezeTally {
+    std::map<std::string, std::pair<double, double> > tests;  // by the setting with freeze=0
+    void add(const Opts &o, double t) {
+        Opts k = o;
+        k.freeze = 0;
+        (o.freeze ? tests[k.text()].second : tests[k.text()].first) = t;
+    }
+    // the settings where freeze=1 made more intersection tests than freeze=0, into `problems`
+    long violations(const std::string &label, std::vector<std::string> &problems) const {
+        long n = 0;
+        for (auto &e : tests)
+            if (e.second.second > e.second.first) {
+                n++;
+                if (problems.size() < 40)
+                    problems.push_back(label + ", " + e.first + ": " + std::to_string((long)e.second.second) +
+                                       " intersection tests with freeze=1, " + std::to_string((long)e.second.first) +
+                                       " with freeze=0");
+            }
+        return n;
+    }
+};
 
 // lightbuffer x eyebuffer x shadowcache x freeze x merge, and x bounds or with bounds=1, at one
 // grid; the first is the defaults (all on)
@@ -100,7 +128,8 @@ bool apply(pray_ctx *c, const Opts &o) {
     return pray_option(c, "brute", o.brute) == PRAY_OK && pray_option(c, "grid", o.grid) == PRAY_OK &&
            pray_option(c, "freeze", o.freeze) == PRAY_OK && pray_option(c, "merge", o.merge) == PRAY_OK &&
            pray_option(c, "bounds", o.bounds) == PRAY_OK && pray_option(c, "lightbuffer", o.lightbuffer) == PRAY_OK &&
-           pray_option(c, "eyebuffer", o.eyebuffer) == PRAY_OK && pray_option(c, "shadowcache", o.shadowcache) == PRAY_OK;
+           pray_option(c, "eyebuffer", o.eyebuffer) == PRAY_OK && pray_option(c, "shadowcache", o.shadowcache) == PRAY_OK &&
+           pray_option(c, "plans", o.plans) == PRAY_OK;
 }
 
 // ---- rays ----
@@ -609,7 +638,8 @@ Report g_total;
 } // namespace
 
 // ---------------------------------------------------------------------------------------------
-// Identical hits: reference vs every combination of grid x freeze x merge x bounds.
+// Identical hits: reference vs every combination of grid x freeze x merge x bounds, and grid x
+// freeze with plans=0.
 // ---------------------------------------------------------------------------------------------
 TEST_CASE("accel hits: random CSG trees of spheres, half-spaces, boxes, cylinders (140 seeds)") {
     run_kind(K_RANDOM, 1, 140, g_total);
@@ -733,7 +763,7 @@ std::string frame_difference(const std::vector<testkit::Frame> &want, const std:
 // the eye's buffer are built only on the coarsest grids (1 to 5 voxels along the longest side),
 // where the image has enough samples per voxel of a buffer; the buffers' cases below use larger
 // images and switch them.)
-TEST_CASE("accel images: nine examples at 48 x 48, every grid x freeze x merge x bounds, the same floats as "
+TEST_CASE("accel images: nine examples at 48 x 48, every grid x freeze x merge x bounds, and plans=0, the same floats as "
           "--brute; freezing never adds intersection tests") {
     auto t0 = std::chrono::steady_clock::now();
     long runs = 0, image_mismatches = 0, freeze_violations = 0;
@@ -750,8 +780,7 @@ TEST_CASE("accel images: nine examples at 48 x 48, every grid x freeze x merge x
         CHECK(ref.frames[0].height == 48);
         CHECK(ref.frames.size() == (ex.first == "anim.ray" ? 3u : 1u));
         runs++;
-        // tests[grid][merge][bounds][freeze]
-        double tests[NGRIDS][2][2][2];
+        FreezeTally tests;
         for (const Opts &o : all_combinations()) {
             std::vector<std::string> opts = size;
             for (auto &x : o.fixed()) opts.push_back(x);
@@ -763,19 +792,9 @@ TEST_CASE("accel images: nine examples at 48 x 48, every grid x freeze x merge x
                 image_mismatches++;
                 if (problems.size() < 20) problems.push_back(ex.first + ", " + o.text() + ": " + d);
             }
-            int g = (int)(std::find(GRIDS, GRIDS + NGRIDS, o.grid) - GRIDS);
-            tests[g][o.merge][o.bounds][o.freeze] = r.stats.intersection_tests;
+            tests.add(o, r.stats.intersection_tests);
         }
-        for (int g = 0; g < NGRIDS; g++)
-            for (int m = 0; m < 2; m++)
-                for (int b = 0; b < 2; b++)
-                    if (tests[g][m][b][1] > tests[g][m][b][0]) {
-                        freeze_violations++;
-                        char buf[200];
-                        std::snprintf(buf, sizeof buf, "%s, grid=%d merge=%d bounds=%d: %.0f intersection tests with freeze=1, %.0f with freeze=0",
-                                      ex.first.c_str(), GRIDS[g], m, b, tests[g][m][b][1], tests[g][m][b][0]);
-                        if (problems.size() < 40) problems.push_back(buf);
-                    }
+        freeze_violations += tests.violations(ex.first, problems);
     }
     double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::string all;
@@ -815,20 +834,24 @@ TEST_CASE("accel freezing: each evaluation path freezes: fewer intersection test
                  "    X = -0.75 + 0.5*I\n    Z = -0.75 + 0.5*J\n    Y = -1\n  " + box + "    S = S - Bx\n"
                  "    Y = 1\n  " + box + "    S = S - Bx\n    J = J + 1\n  endwhile\n  I = I + 1\nendwhile\n"},
     };
-    for (const Case &k : cases) {
-        CAPTURE(k.name);
-        std::string prog = head + k.body + tail;
-        std::vector<std::string> size = {"width=64", "height=64"};
-        Run on = run_program(k.name, prog, size);
-        std::vector<std::string> off_opts = size;
-        off_opts.push_back("freeze=0");
-        Run off = run_program(k.name, prog, off_opts);
-        REQUIRE_MESSAGE(on.status == PRAY_OK, on.error);
-        REQUIRE_MESSAGE(off.status == PRAY_OK, off.error);
-        CHECK(frame_difference(off.frames, on.frames) == "");
-        CHECK(on.stats.frozen_skips > 0);
-        CHECK(off.stats.frozen_skips == 0);
-        CHECK(on.stats.intersection_tests < off.stats.intersection_tests);
+    // (with plans=0 every list takes the full evaluation)
+    for (int plans : {1, 0}) {
+        for (const Case &k : cases) {
+            CAPTURE(k.name);
+            CAPTURE(plans);
+            std::string prog = head + k.body + tail;
+            std::vector<std::string> size = {"width=64", "height=64", "plans=" + std::to_string(plans)};
+            Run on = run_program(k.name, prog, size);
+            std::vector<std::string> off_opts = size;
+            off_opts.push_back("freeze=0");
+            Run off = run_program(k.name, prog, off_opts);
+            REQUIRE_MESSAGE(on.status == PRAY_OK, on.error);
+            REQUIRE_MESSAGE(off.status == PRAY_OK, off.error);
+            CHECK(frame_difference(off.frames, on.frames) == "");
+            CHECK(on.stats.frozen_skips > 0);
+            CHECK(off.stats.frozen_skips == 0);
+            CHECK(on.stats.intersection_tests < off.stats.intersection_tests);
+        }
     }
 }
 
@@ -900,7 +923,7 @@ template <size_t N, class Fn> void each_pick(const Pick (&picks)[N], Fn fn) {
 } // namespace
 
 // (40 x 40, the three methods on: the buffers only on the coarsest grids, as above)
-TEST_CASE("accel images: random scenes at 40 x 40, every grid x freeze x merge x bounds, the same floats as "
+TEST_CASE("accel images: random scenes at 40 x 40, every grid x freeze x merge x bounds, and plans=0, the same floats as "
           "--brute; freezing never adds intersection tests") {
     const Pick picks[] = {{K_RANDOM, 3}, {K_RANDOM, 17}, {K_RANDOM, 42}, {K_RANDOM, 77}, {K_RANDOM, 101},
                           {K_MANY, 2},   {K_MANY, 5},    {K_LATTICE, 1}, {K_LATTICE, 4}, {K_BLOCKS, 3},
@@ -914,7 +937,7 @@ TEST_CASE("accel images: random scenes at 40 x 40, every grid x freeze x merge x
         Render ref = render(c, s.root, lights, reference(), 40);
         REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
         renders++;
-        double tests[NGRIDS][2][2][2];
+        FreezeTally tests;
         for (const Opts &o : all_combinations()) {
             Render r = render(c, s.root, lights, o, 40);
             renders++;
@@ -924,19 +947,9 @@ TEST_CASE("accel images: random scenes at 40 x 40, every grid x freeze x merge x
                 image_mismatches++;
                 if (problems.size() < 20) problems.push_back(s.label + ", " + o.text() + ": " + d);
             }
-            int g = (int)(std::find(GRIDS, GRIDS + NGRIDS, o.grid) - GRIDS);
-            tests[g][o.merge][o.bounds][o.freeze] = r.stats.intersection_tests;
+            tests.add(o, r.stats.intersection_tests);
         }
-        for (int g = 0; g < NGRIDS; g++)
-            for (int m = 0; m < 2; m++)
-                for (int b = 0; b < 2; b++)
-                    if (tests[g][m][b][1] > tests[g][m][b][0]) {
-                        freeze_violations++;
-                        char buf[200];
-                        std::snprintf(buf, sizeof buf, "%s, grid=%d merge=%d bounds=%d: %.0f intersection tests with freeze=1, %.0f with freeze=0",
-                                      s.label.c_str(), GRIDS[g], m, b, tests[g][m][b][1], tests[g][m][b][0]);
-                        if (problems.size() < 40) problems.push_back(buf);
-                    }
+        freeze_violations += tests.violations(s.label, problems);
     });
     double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::string all;
