@@ -4931,6 +4931,99 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
 }
 
 // ---- [9b.5] Building: the whole structure ----
+// The measure of a box that sizes a grid (auto_grid): the cube of its longest side times its
+// fill, each side counted at least 1/16 of the longest.
+double grid_measure(const Box &bx) {
+    double ext = 0, m = 1;
+    for (int l = 0; l < 3; l++) ext = (double)(bx.hi[l] - bx.lo[l]) > ext ? (double)(bx.hi[l] - bx.lo[l]) : ext;
+    for (int l = 0; l < 3; l++) m *= (double)(bx.hi[l] - bx.lo[l]) > ext / 16 ? (double)(bx.hi[l] - bx.lo[l]) : ext / 16;
+    return m;
+}
+
+// The k-th smallest of x[0 .. n) (x reordered).
+real select_kth(real *x, int n, int k) {
+    int lo = 0, hi = n - 1;
+    while (lo < hi) {
+        real pv = x[(lo + hi) / 2];
+        int i = lo, j = hi;
+        while (i <= j) {
+            while (x[i] < pv) i++;
+            while (pv < x[j]) j--;
+            if (i <= j) {
+                real t = x[i];
+                x[i++] = x[j];
+                x[j--] = t;
+            }
+        }
+        if (k <= j) hi = j;
+        else if (k >= i) lo = i;
+        else break;
+    }
+    return x[k];
+}
+
+// A few parts far from all the others (moons beside a crowded scene) would stretch the grid's box
+// and its voxels a thousandfold, leaving the crowd to nested grids and every ray that misses it
+// a long walk through empty voxels. Such parts are left out of the box: a ray meets them in the
+// list of the space outside it (one test each), and the crowd has a grid of its own size. Of
+// the LONE_MAX parts farthest from the median of the parts' centres, the fewest that leave a
+// box of least measure (each more halving it) are left out, when that box is at least
+// LONE_SHRINK times smaller than the hull of them all.
+const int LONE_MAX = 8;
+const double LONE_SHRINK = 1000;
+
+// The grid's box: the hull of the parts' boxes, but for the lone ones (the box is empty without
+// parts); false on failure.
+bool grid_region(pray_ctx *c, const Array<Box> &parts, Box *region) {
+    int n = parts.n, far[LONE_MAX], nfar = 0;
+    Box all, rest;
+    for (int l = 0; l < 3; l++) all.lo[l] = rest.lo[l] = REAL_BIG, all.hi[l] = rest.hi[l] = -REAL_BIG;
+    for (int i = 0; i < n; i++) box_hull(&all, parts[i]);
+    *region = all;
+    if (n <= 2 * LONE_MAX) return true;
+    Array<real> x;
+    x.init();
+    if (!x.reserve(c, n)) return false;
+    real mid[3];
+    for (int l = 0; l < 3; l++) {
+        for (int i = 0; i < n; i++) x.p[i] = (parts[i].lo[l] + parts[i].hi[l]) / 2;
+        mid[l] = select_kth(x.p, n, n / 2);
+    }
+    // the parts farthest from the median (by the largest distance along an axis), farthest first
+    for (int i = 0; i < n; i++) {
+        real d = 0;
+        for (int l = 0; l < 3; l++) {
+            real e = parts[i].lo[l] - mid[l] > mid[l] - parts[i].hi[l] ? parts[i].lo[l] - mid[l] : mid[l] - parts[i].hi[l];
+            d = e > d ? e : d;
+        }
+        x.p[i] = d;
+        int k = nfar;  // its place among them
+        while (k > 0 && x.p[far[k - 1]] < d) k--;
+        if (k == LONE_MAX) continue;
+        nfar += nfar < LONE_MAX;
+        for (int j = nfar - 1; j > k; j--) far[j] = far[j - 1];
+        far[k] = i;
+    }
+    // the box without the first k of them, for each k
+    Box hull[LONE_MAX + 1];
+    for (int i = 0; i < n; i++) {
+        bool lone = false;
+        for (int k = 0; k < nfar; k++) lone = lone || far[k] == i;
+        if (!lone) box_hull(&rest, parts[i]);
+    }
+    hull[nfar] = rest;
+    for (int k = nfar - 1; k >= 0; k--) {
+        hull[k] = hull[k + 1];
+        box_hull(&hull[k], parts[far[k]]);
+    }
+    int best = 0;
+    for (int k = 1; k <= nfar; k++)
+        if (grid_measure(hull[k]) * 2 < grid_measure(hull[best])) best = k;
+    if (grid_measure(hull[best]) * LONE_SHRINK <= grid_measure(all)) *region = hull[best];
+    x.release(c);
+    return true;
+}
+
 // Build the acceleration structure: the lists of the grid's voxels and of the space around it,
 // and the buffers of the lights and, for a render (`render`), of the eye.
 pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
@@ -4961,32 +5054,34 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     int np = s->prims.n;
     // The grid's box: with bounds, the finite boxes of the scene's parts (a union of a floor and
     // furniture: the furniture's); otherwise, or when that finds nothing, the finite boxes of the
-    // primitives.
+    // primitives; in both cases but for a few lone ones far from the rest (grid_region).
     Box region;
-    for (int l = 0; l < 3; l++) {
-        region.lo[l] = REAL_BIG;
-        region.hi[l] = -REAL_BIG;
-    }
-    if (a->bounds && s->root >= 0) {
+    for (int l = 0; l < 3; l++) region.lo[l] = REAL_BIG, region.hi[l] = -REAL_BIG;
+    Array<Box> parts;  // their finite boxes
+    parts.init();
+    if (!parts.reserve(c, np + s->nodes.n + 1)) st = c->status;
+    if (st == PRAY_OK && a->bounds && s->root >= 0) {
         Array<int> &stk = b.touched;
         stk.n = 0;
         if (!stk.push(c, s->root)) st = c->status;
         while (st == PRAY_OK && stk.n) {
             int e = stk[--stk.n];
             const Box &bx = elem_box(s, e);
-            if (box_finite(bx)) box_hull(&region, bx);
-            else if (e_is_node(e) && s->nodes[e_index(e)].op == O_UNION) {
+            if (e_is_node(e) && s->nodes[e_index(e)].op == O_UNION) {  // (its box: their hull)
                 const Node &nd = s->nodes[e_index(e)];
                 for (int i = 0; i < nd.n && st == PRAY_OK; i++)
                     if (!stk.push(c, s->kids[nd.k0 + i])) st = c->status;
+            } else if (box_finite(bx)) {
+                if (!box_empty(bx) && !parts.push(c, bx)) st = c->status;
             } else if (e_is_node(e) && s->nodes[e_index(e)].op == O_DIFF) {
                 if (!stk.push(c, s->kids[s->nodes[e_index(e)].k0])) st = c->status;
             }
         }
     }
-    if (box_empty(region))
-        for (int i = 0; i < np; i++)
-            if (box_finite(s->prims[i].box)) box_hull(&region, s->prims[i].box);
+    for (int i = 0; st == PRAY_OK && parts.n == 0 && i < np; i++)
+        if (box_finite(s->prims[i].box) && !parts.push(c, s->prims[i].box)) st = c->status;
+    if (st == PRAY_OK && !grid_region(c, parts, &region)) st = c->status;
+    parts.release(c);
     if (a->bounds && s->root >= 0) box_clip(&region, elem_box(s, s->root));
     int bounded = 0;  // primitives that reach into the grid's box
     for (int i = 0; i < np && !box_empty(region); i++) bounded += box_overlap(s->prims[i].box, region);
