@@ -5748,15 +5748,25 @@ struct GridSource {
     const Grid &G;
     const Ray &ray;
     real inv[3];  // the direction's reciprocals (ray_inverse)
+    // the direction's components (0 along an axis the ray is parallel to) and their signs: worked
+    // out by span() for a ray that meets the grid's box, and handed to the walks of nested grids
+    mutable real dir[3];
+    mutable int step[3];
     GridSource(const Accel *A_, const Ray &ray_) : A(A_), G(A_->g), ray(ray_) { ray_inverse(ray, inv); }
-    GridSource(const Accel *A_, const Grid &G_, const Ray &ray_, const real *inv_) : A(A_), G(G_), ray(ray_) {
-        for (int l = 0; l < 3; l++) inv[l] = inv_[l];
+    // a nested grid's, for the same ray
+    GridSource(const GridSource &up, const Grid &G_) : A(up.A), G(G_), ray(up.ray) {
+        for (int l = 0; l < 3; l++) inv[l] = up.inv[l], dir[l] = up.dir[l], step[l] = up.step[l];
     }
     bool span(real *ta, real *tb) const {
         *ta = 0;
         if (in_box(ray.o, G.org, G.top)) *tb = box_exit(ray, inv, G.org, G.top);
         else if (!ray_box(ray, inv, G.org, G.top, ta, tb)) return false;
-        return *tb > 0;
+        if (!(*tb > 0)) return false;
+        for (int l = 0; l < 3; l++) {
+            dir[l] = inv[l] == 0 ? 0 : comp(ray.d, l);
+            step[l] = dir[l] > 0 ? 1 : dir[l] < 0 ? -1 : 0;
+        }
+        return true;
     }
     template <class Out>
     bool walk(Out &out, real t, real tend) const;
@@ -5778,17 +5788,14 @@ inline bool rest_stretch(Out &out, int L, real a, real b) {
 template <class Out>
 bool GridSource::walk(Out &out, real t, real tend) const {
     R3 p = ray.o + ray.d * t;
-    int ix[3], step[3], left[3];       // left: voxels ahead along each axis inside the grid
-    real next[3], delta[3], slope[3];  // slope: voxels per unit of t along each axis
+    int ix[3], left[3];      // left: voxels ahead along each axis inside the grid
+    real next[3], delta[3];
     for (int l = 0; l < 3; l++) {
-        real dd = inv[l] == 0 ? 0 : comp(ray.d, l);
         real g = (comp(p, l) - G.org[l]) * G.inv_h;  // clamped before the cast
         ix[l] = !(g > 0) ? 0 : g >= (real)G.n[l] ? G.n[l] - 1 : (int)g;
-        step[l] = dd > 0 ? 1 : dd < 0 ? -1 : 0;
-        left[l] = dd > 0 ? G.n[l] - 1 - ix[l] : dd < 0 ? ix[l] : 0;
-        next[l] = dd == 0 ? REAL_INF : (G.org[l] + (real)(ix[l] + (dd > 0)) * G.h - comp(ray.o, l)) * inv[l];
+        left[l] = step[l] > 0 ? G.n[l] - 1 - ix[l] : step[l] < 0 ? ix[l] : 0;
+        next[l] = step[l] == 0 ? REAL_INF : (G.org[l] + (real)(ix[l] + (step[l] > 0)) * G.h - comp(ray.o, l)) * inv[l];
         delta[l] = G.h * (inv[l] < 0 ? -inv[l] : inv[l]);
-        slope[l] = (dd < 0 ? -dd : dd) * G.inv_h;
     }
     int run = -1;  // the list of the area being crossed
     real run_a = t;
@@ -5819,7 +5826,7 @@ bool GridSource::walk(Out &out, real t, real tend) const {
             ta = ta > t ? ta : t;
             tb = tb < exit ? tb : exit;
             if (!(ta < tb)) ta = tb = exit;
-            GridSource sub(A, N, ray, inv);
+            GridSource sub(*this, N);
             if ((ta > t && rest_stretch(out, N.rest, t, ta)) || (ta < tb && sub.walk(out, ta, tb)) ||
                 (tb < exit && rest_stretch(out, N.rest, tb, exit))) {
                 stopped = true;
@@ -5866,8 +5873,8 @@ bool GridSource::walk(Out &out, real t, real tend) const {
         // across the boundary of axis ax; along the others, across the boundaries before it
         for (int l = 0; l < 3; l++) {
             int k = m[l] + 1;
-            if (l != ax) {
-                real f = (near - next[l]) * slope[l];
+            if (l != ax) {  // (slope: voxels per unit of t)
+                real slope = (dir[l] < 0 ? -dir[l] : dir[l]) * G.inv_h, f = (near - next[l]) * slope;
                 k = step[l] == 0 || !(f >= 0) ? 0 : f < (real)m[l] ? (int)f + 1 : m[l];
             }
             if (k == 0) continue;
