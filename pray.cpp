@@ -4981,6 +4981,17 @@ bool grid_region(pray_ctx *c, const Array<Box> &parts, Box *region) {
     for (int i = 0; i < n; i++) box_hull(&all, parts[i]);
     *region = all;
     if (n <= 2 * LONE_MAX) return true;
+    // A box LONE_SHRINK times smaller is at most 0.64 of the hull along the hull's longest axis
+    // (the measure counts the other sides at least 1/16 of the longest): so a slab of 0.18 of it
+    // at one end or the other meets only lone parts. Most scenes fail this at once.
+    int ax = 0, ends[2] = {0, 0};
+    for (int l = 1; l < 3; l++) ax = all.hi[l] - all.lo[l] > all.hi[ax] - all.lo[ax] ? l : ax;
+    real cut = (all.hi[ax] - all.lo[ax]) * (real)0.18;
+    for (int i = 0; i < n && (ends[0] <= LONE_MAX || ends[1] <= LONE_MAX); i++) {
+        ends[0] += parts[i].lo[ax] < all.lo[ax] + cut;
+        ends[1] += parts[i].hi[ax] > all.hi[ax] - cut;
+    }
+    if (ends[0] > LONE_MAX && ends[1] > LONE_MAX) return true;
     Array<real> x;
     x.init();
     if (!x.reserve(c, n)) return false;
@@ -5007,8 +5018,8 @@ bool grid_region(pray_ctx *c, const Array<Box> &parts, Box *region) {
     // the box without the first k of them, for each k
     Box hull[LONE_MAX + 1];
     for (int i = 0; i < n; i++) {
-        bool lone = false;
-        for (int k = 0; k < nfar; k++) lone = lone || far[k] == i;
+        bool lone = false;  // (the distance first: only a tie with the last of them is looked up)
+        for (int k = 0; nfar > 0 && x.p[i] >= x.p[far[nfar - 1]] && k < nfar; k++) lone = lone || far[k] == i;
         if (!lone) box_hull(&rest, parts[i]);
     }
     hull[nfar] = rest;
