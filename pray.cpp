@@ -4942,6 +4942,110 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
 }
 
 // ---- [9b.5] Building: the whole structure ----
+// The measure of a box that sizes a grid (auto_grid): the cube of its longest side times its
+// fill, each side counted at least 1/16 of the longest.
+double grid_measure(const Box &bx) {
+    double ext = 0, m = 1;
+    for (int l = 0; l < 3; l++) ext = (double)(bx.hi[l] - bx.lo[l]) > ext ? (double)(bx.hi[l] - bx.lo[l]) : ext;
+    for (int l = 0; l < 3; l++) m *= (double)(bx.hi[l] - bx.lo[l]) > ext / 16 ? (double)(bx.hi[l] - bx.lo[l]) : ext / 16;
+    return m;
+}
+
+// The k-th smallest of x[0 .. n) (x reordered).
+real select_kth(real *x, int n, int k) {
+    int lo = 0, hi = n - 1;
+    while (lo < hi) {
+        real pv = x[(lo + hi) / 2];
+        int i = lo, j = hi;
+        while (i <= j) {
+            while (x[i] < pv) i++;
+            while (pv < x[j]) j--;
+            if (i <= j) {
+                real t = x[i];
+                x[i++] = x[j];
+                x[j--] = t;
+            }
+        }
+        if (k <= j) hi = j;
+        else if (k >= i) lo = i;
+        else break;
+    }
+    return x[k];
+}
+
+// A few parts far from all the others (moons beside a crowded scene) would stretch the grid's box
+// and its voxels a thousandfold, leaving the crowd to nested grids and every ray that misses it
+// a long walk through empty voxels. Such parts are left out of the box: a ray meets them in the
+// list of the space outside it (one test each), and the crowd has a grid of its own size. Of
+// the LONE_MAX parts farthest from the median of the parts' centres, the fewest that leave a
+// box of least measure (each more halving it) are left out, when that box is at least
+// LONE_SHRINK times smaller than the hull of them all.
+const int LONE_MAX = 8;
+const double LONE_SHRINK = 1000;
+
+// The grid's box: the hull of the parts' boxes, but for the lone ones (the box is empty without
+// parts); false on failure.
+bool grid_region(pray_ctx *c, const Array<Box> &parts, Box *region) {
+    int n = parts.n, far[LONE_MAX], nfar = 0;
+    Box all, rest;
+    for (int l = 0; l < 3; l++) all.lo[l] = rest.lo[l] = REAL_BIG, all.hi[l] = rest.hi[l] = -REAL_BIG;
+    for (int i = 0; i < n; i++) box_hull(&all, parts[i]);
+    *region = all;
+    if (n <= 2 * LONE_MAX) return true;
+    // A box LONE_SHRINK times smaller is at most 0.64 of the hull along the hull's longest axis
+    // (the measure counts the other sides at least 1/16 of the longest): so a slab of 0.18 of it
+    // at one end or the other meets only lone parts. Most scenes fail this at once.
+    int ax = 0, ends[2] = {0, 0};
+    for (int l = 1; l < 3; l++) ax = all.hi[l] - all.lo[l] > all.hi[ax] - all.lo[ax] ? l : ax;
+    real cut = (all.hi[ax] - all.lo[ax]) * (real)0.18;
+    for (int i = 0; i < n && (ends[0] <= LONE_MAX || ends[1] <= LONE_MAX); i++) {
+        ends[0] += parts[i].lo[ax] < all.lo[ax] + cut;
+        ends[1] += parts[i].hi[ax] > all.hi[ax] - cut;
+    }
+    if (ends[0] > LONE_MAX && ends[1] > LONE_MAX) return true;
+    Array<real> x;
+    x.init();
+    if (!x.reserve(c, n)) return false;
+    real mid[3];
+    for (int l = 0; l < 3; l++) {
+        for (int i = 0; i < n; i++) x.p[i] = (parts[i].lo[l] + parts[i].hi[l]) / 2;
+        mid[l] = select_kth(x.p, n, n / 2);
+    }
+    // the parts farthest from the median (by the largest distance along an axis), farthest first
+    for (int i = 0; i < n; i++) {
+        real d = 0;
+        for (int l = 0; l < 3; l++) {
+            real e = parts[i].lo[l] - mid[l] > mid[l] - parts[i].hi[l] ? parts[i].lo[l] - mid[l] : mid[l] - parts[i].hi[l];
+            d = e > d ? e : d;
+        }
+        x.p[i] = d;
+        int k = nfar;  // its place among them
+        while (k > 0 && x.p[far[k - 1]] < d) k--;
+        if (k == LONE_MAX) continue;
+        nfar += nfar < LONE_MAX;
+        for (int j = nfar - 1; j > k; j--) far[j] = far[j - 1];
+        far[k] = i;
+    }
+    // the box without the first k of them, for each k
+    Box hull[LONE_MAX + 1];
+    for (int i = 0; i < n; i++) {
+        bool lone = false;  // (the distance first: only a tie with the last of them is looked up)
+        for (int k = 0; nfar > 0 && x.p[i] >= x.p[far[nfar - 1]] && k < nfar; k++) lone = lone || far[k] == i;
+        if (!lone) box_hull(&rest, parts[i]);
+    }
+    hull[nfar] = rest;
+    for (int k = nfar - 1; k >= 0; k--) {
+        hull[k] = hull[k + 1];
+        box_hull(&hull[k], parts[far[k]]);
+    }
+    int best = 0;
+    for (int k = 1; k <= nfar; k++)
+        if (grid_measure(hull[k]) * 2 < grid_measure(hull[best])) best = k;
+    if (grid_measure(hull[best]) * LONE_SHRINK <= grid_measure(all)) *region = hull[best];
+    x.release(c);
+    return true;
+}
+
 // Build the acceleration structure: the lists of the grid's voxels and of the space around it,
 // and the buffers of the lights and, for a render (`render`), of the eye.
 pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
@@ -4972,32 +5076,34 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     int np = s->prims.n;
     // The grid's box: with bounds, the finite boxes of the scene's parts (a union of a floor and
     // furniture: the furniture's); otherwise, or when that finds nothing, the finite boxes of the
-    // primitives.
+    // primitives; in both cases but for a few lone ones far from the rest (grid_region).
     Box region;
-    for (int l = 0; l < 3; l++) {
-        region.lo[l] = REAL_BIG;
-        region.hi[l] = -REAL_BIG;
-    }
-    if (a->bounds && s->root >= 0) {
+    for (int l = 0; l < 3; l++) region.lo[l] = REAL_BIG, region.hi[l] = -REAL_BIG;
+    Array<Box> parts;  // their finite boxes
+    parts.init();
+    if (!parts.reserve(c, np + s->nodes.n + 1)) st = c->status;
+    if (st == PRAY_OK && a->bounds && s->root >= 0) {
         Array<int> &stk = b.touched;
         stk.n = 0;
         if (!stk.push(c, s->root)) st = c->status;
         while (st == PRAY_OK && stk.n) {
             int e = stk[--stk.n];
             const Box &bx = elem_box(s, e);
-            if (box_finite(bx)) box_hull(&region, bx);
-            else if (e_is_node(e) && s->nodes[e_index(e)].op == O_UNION) {
+            if (e_is_node(e) && s->nodes[e_index(e)].op == O_UNION) {  // (its box: their hull)
                 const Node &nd = s->nodes[e_index(e)];
                 for (int i = 0; i < nd.n && st == PRAY_OK; i++)
                     if (!stk.push(c, s->kids[nd.k0 + i])) st = c->status;
+            } else if (box_finite(bx)) {
+                if (!box_empty(bx) && !parts.push(c, bx)) st = c->status;
             } else if (e_is_node(e) && s->nodes[e_index(e)].op == O_DIFF) {
                 if (!stk.push(c, s->kids[s->nodes[e_index(e)].k0])) st = c->status;
             }
         }
     }
-    if (box_empty(region))
-        for (int i = 0; i < np; i++)
-            if (box_finite(s->prims[i].box)) box_hull(&region, s->prims[i].box);
+    for (int i = 0; st == PRAY_OK && parts.n == 0 && i < np; i++)
+        if (box_finite(s->prims[i].box) && !parts.push(c, s->prims[i].box)) st = c->status;
+    if (st == PRAY_OK && !grid_region(c, parts, &region)) st = c->status;
+    parts.release(c);
     if (a->bounds && s->root >= 0) box_clip(&region, elem_box(s, s->root));
     int bounded = 0;  // primitives that reach into the grid's box
     for (int i = 0; i < np && !box_empty(region); i++) bounded += box_overlap(s->prims[i].box, region);
@@ -5643,15 +5749,25 @@ struct GridSource {
     const Grid &G;
     const Ray &ray;
     real inv[3];  // the direction's reciprocals (ray_inverse)
+    // the direction's components (0 along an axis the ray is parallel to) and their signs: worked
+    // out by span() for a ray that meets the grid's box, and handed to the walks of nested grids
+    mutable real dir[3];
+    mutable int step[3];
     GridSource(const Accel *A_, const Ray &ray_) : A(A_), G(A_->g), ray(ray_) { ray_inverse(ray, inv); }
-    GridSource(const Accel *A_, const Grid &G_, const Ray &ray_, const real *inv_) : A(A_), G(G_), ray(ray_) {
-        for (int l = 0; l < 3; l++) inv[l] = inv_[l];
+    // a nested grid's, for the same ray
+    GridSource(const GridSource &up, const Grid &G_) : A(up.A), G(G_), ray(up.ray) {
+        for (int l = 0; l < 3; l++) inv[l] = up.inv[l], dir[l] = up.dir[l], step[l] = up.step[l];
     }
     bool span(real *ta, real *tb) const {
         *ta = 0;
         if (in_box(ray.o, G.org, G.top)) *tb = box_exit(ray, inv, G.org, G.top);
         else if (!ray_box(ray, inv, G.org, G.top, ta, tb)) return false;
-        return *tb > 0;
+        if (!(*tb > 0)) return false;
+        for (int l = 0; l < 3; l++) {
+            dir[l] = inv[l] == 0 ? 0 : comp(ray.d, l);
+            step[l] = dir[l] > 0 ? 1 : dir[l] < 0 ? -1 : 0;
+        }
+        return true;
     }
     template <class Out>
     bool walk(Out &out, real t, real tend) const;
@@ -5673,17 +5789,14 @@ inline bool rest_stretch(Out &out, int L, real a, real b) {
 template <class Out>
 bool GridSource::walk(Out &out, real t, real tend) const {
     R3 p = ray.o + ray.d * t;
-    int ix[3], step[3], left[3];       // left: voxels ahead along each axis inside the grid
-    real next[3], delta[3], slope[3];  // slope: voxels per unit of t along each axis
+    int ix[3], left[3];      // left: voxels ahead along each axis inside the grid
+    real next[3], delta[3];
     for (int l = 0; l < 3; l++) {
-        real dd = inv[l] == 0 ? 0 : comp(ray.d, l);
         real g = (comp(p, l) - G.org[l]) * G.inv_h;  // clamped before the cast
         ix[l] = !(g > 0) ? 0 : g >= (real)G.n[l] ? G.n[l] - 1 : (int)g;
-        step[l] = dd > 0 ? 1 : dd < 0 ? -1 : 0;
-        left[l] = dd > 0 ? G.n[l] - 1 - ix[l] : dd < 0 ? ix[l] : 0;
-        next[l] = dd == 0 ? REAL_INF : (G.org[l] + (real)(ix[l] + (dd > 0)) * G.h - comp(ray.o, l)) * inv[l];
+        left[l] = step[l] > 0 ? G.n[l] - 1 - ix[l] : step[l] < 0 ? ix[l] : 0;
+        next[l] = step[l] == 0 ? REAL_INF : (G.org[l] + (real)(ix[l] + (step[l] > 0)) * G.h - comp(ray.o, l)) * inv[l];
         delta[l] = G.h * (inv[l] < 0 ? -inv[l] : inv[l]);
-        slope[l] = (dd < 0 ? -dd : dd) * G.inv_h;
     }
     int run = -1;  // the list of the area being crossed
     real run_a = t;
@@ -5714,7 +5827,7 @@ bool GridSource::walk(Out &out, real t, real tend) const {
             ta = ta > t ? ta : t;
             tb = tb < exit ? tb : exit;
             if (!(ta < tb)) ta = tb = exit;
-            GridSource sub(A, N, ray, inv);
+            GridSource sub(*this, N);
             if ((ta > t && rest_stretch(out, N.rest, t, ta)) || (ta < tb && sub.walk(out, ta, tb)) ||
                 (tb < exit && rest_stretch(out, N.rest, tb, exit))) {
                 stopped = true;
@@ -5761,8 +5874,8 @@ bool GridSource::walk(Out &out, real t, real tend) const {
         // across the boundary of axis ax; along the others, across the boundaries before it
         for (int l = 0; l < 3; l++) {
             int k = m[l] + 1;
-            if (l != ax) {
-                real f = (near - next[l]) * slope[l];
+            if (l != ax) {  // (slope: voxels per unit of t)
+                real slope = (dir[l] < 0 ? -dir[l] : dir[l]) * G.inv_h, f = (near - next[l]) * slope;
                 k = step[l] == 0 || !(f >= 0) ? 0 : f < (real)m[l] ? (int)f + 1 : m[l];
             }
             if (k == 0) continue;

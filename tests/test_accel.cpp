@@ -1113,6 +1113,44 @@ TEST_CASE("accel stats: a layer of balls over a floor is divided as finely as wi
     CHECK(frame_difference(ref.frames, runs[1].frames) == "");
 }
 
+TEST_CASE("accel stats: a few parts far from a cluster are left out of the grid's box") {
+    // 400 balls in a unit cube and three moons (one of them a difference) a thousand units away,
+    // in view: the grid covers the balls as without the moons, which the outer list holds
+    const std::string program =
+        "M = phong({0.6}, {0.3}, {0.1}, 10)\n"
+        "All = nothing\n"
+        + random_balls(400, "[X, Y, Z], 0.04") +
+        "MOONS\n"
+        "perspective <1.2, 0, 0>, <0, 0, 1.2>, [0.5, -3, 0.5], [0.5, 0, 0.5]\n"
+        "rendertiff All, dirlight({1}, <1, -2, 3>)\n";
+    const std::string moons = "All = All | (sphere(M, [-200, 1000, 0], 60) - sphere(M, [-200, 960, 0], 40)) "
+                              "| sphere(M, [150, 1100, 100], 50) | sphere(M, [0, 900, -150], 30)";
+    const std::vector<std::string> options = {"width=64", "height=64"};
+    Run runs[2];
+    for (int with = 0; with < 2; with++) {
+        std::string text = program;
+        text.replace(text.find("MOONS"), 5, with ? moons : "");
+        runs[with] = run_program("moons.ray", text, options);
+        INFO("moons ", with, ": ", stats_text(runs[with].stats));
+        REQUIRE(runs[with].status == PRAY_OK);
+    }
+    for (int l = 0; l < 3; l++) CHECK(runs[1].stats.grid[l] == runs[0].stats.grid[l]);
+    CHECK(runs[1].stats.nested_grids == runs[0].stats.nested_grids);
+    // and the image is the reference's, with and without bounds
+    for (int bounds = 0; bounds < 2; bounds++) {
+        std::vector<std::string> opts = options;
+        opts.push_back(bounds ? "bounds=1" : "bounds=0");
+        std::string text = program;
+        text.replace(text.find("MOONS"), 5, moons);
+        Run run = run_program("moons.ray", text, opts);
+        opts.push_back("brute=1");
+        Run ref = run_program("moons.ray", text, opts);
+        REQUIRE(run.status == PRAY_OK);
+        REQUIRE(ref.status == PRAY_OK);
+        CHECK(frame_difference(ref.frames, run.frames) == "");
+    }
+}
+
 TEST_CASE("accel stats: of a program run; parts that cannot matter are not kept") {
     // A sphere minus a sphere far away: with bounds the subtracted part is dropped.
     const std::string program =
