@@ -8205,9 +8205,9 @@ int region_walk(const RegionGrid &g, const double *o, const double *d, const dou
 }
 
 // Set in the record of the pixel being traced the regions that the part (0, end] of the ray
-// crosses: the grid's cells where it is in the grid's box, and bit 0
-// where it is outside. A walk rounded past a corner of cells misses a sliver of a cell there;
-// the boxes of what changed are widened by more than that (coh_mark).
+// crosses: the grid's cells where it is in the grid's box, and bit 0 where it is outside. A
+// walk rounded past a corner of cells misses a sliver of a cell there; the boxes of what
+// changed are widened by more than that (coh_mark).
 void region_note(Scratch *w, const Ray &ray, real end) {
     const RegionGrid &g = w->rg->g;
     unsigned *bits = w->rbits;
