@@ -491,7 +491,7 @@ struct TexName {
 enum {
     OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_COHERENCE, OPT_CUTOFF, OPT_DEPTH, OPT_EYEBUFFER, OPT_FREEZE,
     OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_LIGHTBUFFER, OPT_MAXFRAMES, OPT_MAXLINE, OPT_MAXMEM, OPT_MAXNEST,
-    OPT_MAXOUTPUT, OPT_MAXPIXELS, OPT_MAXPRIMS, OPT_MAXRAYS, OPT_MAXSTEPS, OPT_MAXSTRING, OPT_MERGE, OPT_NEST, OPT_OUTPUT,
+    OPT_MAXOUTPUT, OPT_MAXPIXELS, OPT_MAXPRIMS, OPT_MAXRAYS, OPT_MAXSTEPS, OPT_MAXSTRING, OPT_MAXTIME, OPT_MERGE, OPT_NEST, OPT_OUTPUT,
     OPT_PLANS, OPT_SHADOWCACHE, OPT_SHADOWS, OPT_TEXMEM, OPT_THREADS,
     OPT_WIDTH, OPT_COUNT
 };
@@ -553,8 +553,9 @@ struct pray_ctx {
     double written;          // bytes of image files written by this run (option maxoutput)
     pray_object *drop;       // given up by a program's rendertiff: released once flattened (scene_build)
     int eye_inside;          // the camera's eye is inside the solid last rendered (render_scene)
-    volatile sig_atomic_t cancel;  // pray_cancel: the running call stops at its next check
+    volatile sig_atomic_t cancel;  // CANCEL_*: the running call stops at its next check
     int calls;               // cancellable public calls running (a run renders and writes)
+    double started;          // when the outermost of them started (option maxtime)
     Coherence *coh;          // image sequences (option coherence): the frame before, or NULL
 };
 
@@ -587,17 +588,58 @@ pray_status fail_nomem(pray_ctx *c) {
     return fail(c, PRAY_ERR_NOMEM, "out of memory");
 }
 
+// Why the running call stops: pray_cancel (from any thread or a signal handler), or the time
+// of option maxtime spent. The flag is an atomic where the compiler has them, so that a host's
+// thread sanitizer sees no race, and lock-free, so that a signal handler may set it.
+enum { CANCEL_NONE, CANCEL_HOST, CANCEL_TIME };
+inline int cancel_flag(const pray_ctx *c) {
+#if defined(__GNUC__) || defined(__clang__)
+    return __atomic_load_n(&c->cancel, __ATOMIC_RELAXED);
+#else
+    return c->cancel;
+#endif
+}
+inline void cancel_set(pray_ctx *c, int why) {
+#if defined(__GNUC__) || defined(__clang__)
+    __atomic_store_n(&c->cancel, (sig_atomic_t)why, __ATOMIC_RELAXED);
+#else
+    c->cancel = (sig_atomic_t)why;
+#endif
+}
+
 // A public call that pray_cancel can stop. The outermost one forgets a cancel made before it
-// started; the work checks `cancelled` in its loops (statements, voxels, rows of the image).
+// started and starts the clock of option maxtime; the work checks `cancelled` in its loops
+// (statements, voxels, rows of the image) and `over_time` where it is long (statements, rows).
 struct Call {
     pray_ctx *c;
     explicit Call(pray_ctx *x) : c(x) {
-        if (c->calls++ == 0) c->cancel = 0;
+        if (c->calls++ == 0) {
+            cancel_set(c, CANCEL_NONE);
+            c->started = clock_seconds();
+        }
     }
     ~Call() { c->calls--; }
 };
-inline bool cancelled(const pray_ctx *c) { return c->cancel != 0; }
-pray_status fail_cancelled(pray_ctx *c) { return fail(c, PRAY_ERR_CANCELLED, "cancelled"); }
+inline bool cancelled(const pray_ctx *c) { return cancel_flag(c) != CANCEL_NONE; }
+// The run has taken longer than option maxtime allows: every check of `cancelled` stops it.
+bool over_time(pray_ctx *c) {
+    double lim = c->cur.opt.v[OPT_MAXTIME];
+    if (lim > 0 && c->calls > 0 && clock_seconds() - c->started > lim) cancel_set(c, CANCEL_TIME);
+    return cancelled(c);
+}
+const char *cancel_text(const pray_ctx *c, char *buf, size_t size) {
+    if (cancel_flag(c) != CANCEL_TIME) return "cancelled";
+    double lim = c->cur.opt.v[OPT_MAXTIME];
+    snprintf(buf, size, "the run was stopped after %.0f second%s (option maxtime)", lim, lim == 1 ? "" : "s");
+    return buf;
+}
+pray_status cancel_status(const pray_ctx *c) {
+    return cancel_flag(c) == CANCEL_TIME ? PRAY_ERR_LIMIT : PRAY_ERR_CANCELLED;
+}
+pray_status fail_cancelled(pray_ctx *c) {
+    char buf[80];
+    return fail(c, cancel_status(c), "%s", cancel_text(c, buf, sizeof buf));
+}
 
 // The context's cap: the host's, lowered by option maxmem (MiB) when that is set.
 void apply_memory_cap(pray_ctx *c) {
@@ -1645,6 +1687,7 @@ const OptDef OPTS[OPT_COUNT] = {
     {"maxrays", 65536, 1, 1e9, 1, 256},
     {"maxsteps", 1e7, 0, 1e15, 1, 1e6},
     {"maxstring", 65536, 1, 16777216, 1, 4096},
+    {"maxtime", 0, 0, 1e9, 1, 600},
     {"merge", 1, 0, 1, 1, 0},
     {"nest", 2, 0, 4, 1, 0},
     {"output", 0, 0, 0, 0, 0},
@@ -4212,7 +4255,7 @@ bool bucket(pray_ctx *c, const int *dim, int n, const Range &range, Array<int> &
     memset(start.p, 0, sizeof(int) * (size_t)(nv + 1));
     for (int pass = 0; pass < 2; pass++) {
         for (int k = 0; k < n; k++) {
-            if (cancelled(c)) {
+            if (over_time(c)) {
                 fail_cancelled(c);
                 return false;
             }
@@ -4401,7 +4444,7 @@ bool grid_lists(ListBuilder &b, Grid &G, GridPlan &gp, const Array<int> &cand, c
                 int steps, int depth) {
     for (int z = 0; z < G.n[2]; z++)
         for (int y = 0; y < G.n[1]; y++) {
-            if (cancelled(b.c)) {
+            if (over_time(b.c)) {
                 fail_cancelled(b.c);
                 return false;
             }
@@ -4874,7 +4917,7 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
             // (the eye's pieces are each only a slab deep)
             bool crowded = !B.pieces && start[ncell] > (double)ncell * LB_MAX_CAND / 2;
             for (int cel = 0; ok && cel < ncell; cel++) {
-                if (cancelled(c)) {
+                if (over_time(c)) {
                     fail_cancelled(c);
                     ok = false;
                     break;
@@ -5225,7 +5268,7 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         if (!kids || !solid) st = c->status;
         for (int j = 0; st == PRAY_OK && j < nn; j++) solid[j] = -1;
         for (int L = 0; st == PRAY_OK && L < a->off.n; L++) {
-            if (cancelled(c)) {
+            if (over_time(c)) {
                 st = fail_cancelled(c);
                 break;
             }
@@ -7478,7 +7521,7 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     // snapped before compaction, over every primitive flattened, so that the reference and the
     // simplified scene give the same surviving primitives the same numbers
     if (s->root == -3 || snap_coincident(c, s) || merge_chains(c, s) || scene_compact(c, s)) return c->status;
-    if (cancelled(c)) return fail_cancelled(c);
+    if (over_time(c)) return fail_cancelled(c);
     for (int i = 0; lights && i < lights->n; i++) {
         const LightSrc &src = lights->src[i];
         Light L;
@@ -7877,7 +7920,7 @@ void adaptive_band(Worker &k, int y0, int y1) {
                 }
                 put_pixel(job, i, j, cscale(sum, 1.0 / ((double)A * A)));
             }
-        if (X1 == SW - 1 || i1 == rx1 || cancelled(job->c)) break;  // (pray_cancel: checked per tile)
+        if (X1 == SW - 1 || i1 == rx1 || over_time(job->c)) break;  // (pray_cancel, maxtime: checked per tile)
         for (int y = 0; y < n; y++)  // the last column is the next tile's first
             for (int x = 0; x < n; x++) {
                 Sample &v = k.cache[y * n + x];
@@ -7918,16 +7961,16 @@ void render_band(Worker &k, int band) {
         return;
     }
     Ray rays[RAY_BATCH];
-    for (int j = y0; j < y1 && !cancelled(job->c); j++) {
+    for (int j = y0; j < y1 && !over_time(job->c); j++) {
         set_row_background(k, j);
         size_t u = (size_t)j * s->width;  // (image sequences: the whole image is rendered)
         if (s->antialias > 1) {  // pixel() makes each row of samples ahead
-            for (int i = x0; i < x1; i++)
+            for (int i = x0; i < x1 && !over_time(job->c); i++)
                 if (unit_kept(k, u + i)) put_kept(job, i, i + 1, j), k.kept++;
                 else put_pixel(job, i, j, pixel(k, i, j)), k.traced++, unit_done(k);
             continue;
         }
-        for (int i0 = x0; i0 < x1; i0 += RAY_BATCH) {
+        for (int i0 = x0; i0 < x1 && !over_time(job->c); i0 += RAY_BATCH) {
             int n = x1 - i0 < RAY_BATCH ? x1 - i0 : RAY_BATCH;
             for (int q = 0; q < n; q++) rays[q] = sample_ray(s, i0 + q, j, 0, 0);
             for (int q = 0; q < n; q++)
@@ -7948,7 +7991,7 @@ void worker_main(void *arg) {
         render_band(k, job->band0 + band);
         job->mu.lock();
         if (k.tr.over) job->cancelled = job->over = 1;
-        if (cancelled(job->c)) job->cancelled = 1;
+        if (over_time(job->c)) job->cancelled = 1;
         int y0, y1;
         band_rows_in(job, job->band0 + band, &y0, &y1);
         job->rows_done += y1 - y0;
@@ -9182,7 +9225,7 @@ void pray_set_render(pray_ctx *c, pray_render_fn fn, void *ud) {
 }
 
 void pray_cancel(pray_ctx *c) {
-    if (c) c->cancel = 1;
+    if (c) cancel_set(c, CANCEL_HOST);
 }
 
 pray_status pray_option(pray_ctx *c, const char *name, double value) {
@@ -10798,8 +10841,11 @@ struct Parser {
     Lexer *L;    // the tokens of the current line: t[0 .. L->toks.n)
     Tok *t;
     int pos;
+    // One bound, option maxnest, on the whole depth of the run: the levels around the file
+    // being read (the blocks and includes that led to it), its blocks, and the expression read.
     int depth;   // nesting of parentheses, literals, calls, unary operators, powers
-    int blocks;  // nesting of if and while
+    int blocks;  // nesting of if and while, counted from `base`
+    int base;    // the levels around this file: 0 for the program
     double maxnest;  // option maxnest as the run started
     Arena *arena;    // the syntax tree of the statement being read
     Arena *names;    // the names of variables, for the whole run
@@ -11092,13 +11138,22 @@ Expr *parse_primary(Parser &P) {
     return NULL;
 }
 
+// The message of a run nested deeper than maxnest: `what` went past the bound, with `around`
+// levels of other kinds (blocks, includes) outside it.
+const char *nest_message(char *msg, size_t size, const char *what, double lim, int around) {
+    int n = snprintf(msg, size, "%s nested deeper than %.0f level%s", what, lim, lim == 1 ? "" : "s");
+    if (around > 0 && n > 0 && (size_t)n < size)
+        n += snprintf(msg + n, size - (size_t)n, ", counting the %d level%s around %s", around, around == 1 ? "" : "s",
+                      strcmp(what, "expression") == 0 ? "it" : "them");
+    if (n > 0 && (size_t)n < size) snprintf(msg + n, size - (size_t)n, " (option maxnest)");
+    return msg;
+}
+
 // One level deeper, at token `at` (default: the current token).
 bool enter(Parser &P, const Tok *at) {
-    if (++P.depth > P.maxnest) {
-        char msg[80];
-        double lim = P.maxnest;
-        snprintf(msg, sizeof msg, "expression nested deeper than %.0f level%s (option maxnest)", lim, lim == 1 ? "" : "s");
-        syn(P, at ? *at : cur(P), "%s", msg);
+    if (++P.depth + P.blocks > P.maxnest) {
+        char msg[160];
+        syn(P, at ? *at : cur(P), "%s", nest_message(msg, sizeof msg, "expression", P.maxnest, P.blocks));
         return false;
     }
     return true;
@@ -11383,8 +11438,8 @@ Stmt *parse_statement(Parser &P) {
         if (is_if && is_word(cur(P), "then")) P.pos++;
         if (end_of_line(P)) return NULL;
         if (++P.blocks > P.maxnest) {
-            double lim = P.maxnest;
-            syn(P, word, "blocks nested deeper than %.0f level%s (option maxnest)", lim, lim == 1 ? "" : "s");
+            char msg[160];
+            syn(P, word, "%s", nest_message(msg, sizeof msg, "blocks", P.maxnest, P.base));
             return NULL;
         }
         Array<Stmt *> body;
@@ -11521,6 +11576,7 @@ struct Interp {
     Parser *parser;    // the program's: names of variables and their hash, maxnest, maxstring
     Array<IncFile> files;  // the files being read: [0] the program, then each included one
     int include_last;  // the last statement of the top level with an include in it, -1: none
+    int depth;         // the blocks and includes around the statement running (option maxnest)
     int chained;       // the error's message has the places of the includes that led to it
     Array<Var> vars;
     Array<Value> vals;  // by variable slot
@@ -11533,6 +11589,7 @@ struct Interp {
     const void *top;  // the statement of the top level running now, and its number
     int top_index;
     double steps;
+    unsigned ticks;  // statements, for a look at the clock every 1024 (option maxtime)
     int quit;
     int frames;
     Array<NameCount> names;  // output names used so far, and their frames
@@ -12456,7 +12513,10 @@ void release_dead(Interp &I, int k) {
 }
 
 pray_status step(Interp &I, const Stmt *s) {
-    if (cancelled(I.c)) return perr(I.c, I.name, s->line, s->col, PRAY_ERR_CANCELLED, "cancelled");
+    if ((++I.ticks & 1023) == 0 ? over_time(I.c) : cancelled(I.c)) {
+        char buf[80];
+        return perr(I.c, I.name, s->line, s->col, cancel_status(I.c), "%s", cancel_text(I.c, buf, sizeof buf));
+    }
     I.steps += 1;
     double lim = I.c->cur.opt.v[OPT_MAXSTEPS];
     if (lim > 0 && I.steps > lim)
@@ -12491,6 +12551,19 @@ PRAY_NOINLINE pray_status include_loop(Interp &I, const char *path, int loop) {
 }
 #endif
 
+// Reading a file costs the run a statement (option maxsteps) for each of its lines, however few
+// statements they hold: an include of a long file in a loop is bounded as its statements are.
+pray_status include_steps(Interp &I, const char *text, size_t n) {
+    double lines = n > 0 && text[n - 1] != '\n' ? 1 : 0;
+    for (const char *p = text; (p = (const char *)memchr(p, '\n', n - (size_t)(p - text))) != NULL; p++) lines++;
+    I.steps += lines;
+    double lim = I.c->cur.opt.v[OPT_MAXSTEPS];
+    if (lim > 0 && I.steps > lim)
+        return fail(I.c, PRAY_ERR_LIMIT, "the program was stopped after %.0f statements (option maxsteps; each line "
+                    "an include reads counts as one)", lim);
+    return PRAY_OK;
+}
+
 // include "F": the statements of file F, read beside the file that names it, run here as the
 // program's own are (checked whole first, then read and run a statement at a time).
 PRAY_NOINLINE pray_status exec_include(Interp &I, const Stmt *s) {
@@ -12500,10 +12573,11 @@ PRAY_NOINLINE pray_status exec_include(Interp &I, const Stmt *s) {
     (void)c;
     return rerr(I, f, PRAY_ERR_RUNTIME, "include: this build has no file access");
 #else
-    double most = I.parser->maxnest;
-    if (I.files.n > most)
-        return perr(c, I.name, s->line, s->col, PRAY_ERR_LIMIT, "includes nested deeper than %.0f level%s (option maxnest)",
-                    most, most == 1 ? "" : "s");
+    if (I.depth + 1 > I.parser->maxnest) {
+        char msg[160];
+        return perr(c, I.name, s->line, s->col, PRAY_ERR_LIMIT, "%s",
+                    nest_message(msg, sizeof msg, "includes", I.parser->maxnest, I.depth - (I.files.n - 1)));
+    }
     const char *why = c->untrusted ? untrusted_path_problem(f->s) : NULL;
     if (why)
         return rerr(I, f, PRAY_ERR_RUNTIME, "untrusted program: '%s' is %s; files are read from the program's "
@@ -12536,6 +12610,7 @@ PRAY_NOINLINE pray_status exec_include(Interp &I, const Stmt *s) {
         st = include_loop(I, path, loop);
     else if (!read_program(c, in, &t)) st = c->status;
     else if (ferror(in)) st = fail(c, PRAY_ERR_IO, "cannot read '%s'", *ShownPath(path));
+    else st = include_steps(I, t.str(), (size_t)t.a.n);
     if (in) fclose(in);
     IncFile nf;
     nf.name = path;
@@ -12568,6 +12643,7 @@ PRAY_NOINLINE pray_status exec_include(Interp &I, const Stmt *s) {
         r->Q.L = &r->L;
         r->Q.arena = &r->tree;
         r->Q.included = 1;
+        r->Q.base = ++I.depth;
         const char *outer = I.name;
         I.name = path;
         double parse_time = 0;
@@ -12578,6 +12654,7 @@ PRAY_NOINLINE pray_status exec_include(Interp &I, const Stmt *s) {
         }
         c->stats.time_parse += parse_time;
         I.name = outer;
+        I.depth--;
         r->L.toks.release(c);
         r->tree.release(c);
         r->words.release(c);
@@ -12617,7 +12694,10 @@ pray_status exec(Interp &I, const Stmt *s) {
     case ST_IF: {
         double x;
         if (eval_num(I, s->args[0], &x)) return c->status;
-        return x != 0 ? exec_block(I, s->body, s->nbody) : exec_block(I, s->els, s->nels);
+        I.depth++;
+        pray_status st = x != 0 ? exec_block(I, s->body, s->nbody) : exec_block(I, s->els, s->nels);
+        I.depth--;
+        return st;
     }
     case ST_WHILE:
         for (bool first = true;; first = false) {
@@ -12625,7 +12705,10 @@ pray_status exec(Interp &I, const Stmt *s) {
             double x;
             if (eval_num(I, s->args[0], &x)) return c->status;
             if (x == 0) return PRAY_OK;
-            if (exec_block(I, s->body, s->nbody) || I.quit) return c->status;
+            I.depth++;
+            pray_status st = exec_block(I, s->body, s->nbody);
+            I.depth--;
+            if (st || I.quit) return c->status;
         }
     default: break;
     }
@@ -12789,7 +12872,8 @@ PRAY_NOINLINE pray_status read_statements(Parser &P, const char *text, size_t le
     pray_ctx *c = P.c;
     int k = 0;  // statements of the top level read so far
     double t0 = clock_seconds();
-    P.depth = P.blocks = 0;
+    P.depth = 0;
+    P.blocks = P.base;
     pray_status st = lex_start(*P.L, text, len, !run);
     P.t = P.L->toks.p;
     P.pos = 0;

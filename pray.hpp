@@ -136,7 +136,8 @@ void pray_set_memory_limit(pray_ctx *ctx, size_t bytes);
 /* Untrusted mode, for programs from elsewhere; it cannot be turned off. Every limit option gets a
    ceiling (lowered to it now; a higher value, or 0 where 0 means "no limit", is refused later):
    depth 16, gridmem 64, maxframes 1000, maxline 4096, maxmem 1024, maxnest 64, maxoutput 1024,
-   maxpixels 16777216, maxprims 1048576, maxsteps 1000000, maxstring 4096, texmem 64. Texture and
+   maxpixels 16777216, maxprims 1048576, maxsteps 1000000, maxstring 4096, maxtime 600, texmem 64.
+   Texture and
    font files, and the files of `include`, named by a program are read only from the program's
    directory (relative names without "..", opened one directory at a time without following any
    symbolic link; on Windows and DOS links inside the directory are followed); an `output` set by
@@ -185,12 +186,13 @@ void pray_cancel(pray_ctx *ctx);
 
    Limits (each refuses with a message naming the option; see "Limits" in the manual below):
    maxsteps, depth, gridmem, texmem as above; maxline (characters on one line of a program,
-   65536), maxnest (nesting of blocks and of expressions, 256, at most 1024), maxstring (bytes
+   65536), maxnest (nesting of blocks, includes and expressions together, 256, at most 1024), maxstring (bytes
    of a string, literal or built, 65536), maxprims (primitives one object stands for, 16777216),
    maxpixels (samples of one image: width x height x antialias^2, 1073741824), maxrays (rays one
    sample may take, primary, reflected and refracted, 65536), maxmem (MiB a context may hold,
    0 = no cap), maxframes (frames of a run, 0 = no limit), maxoutput (MiB of image files a run
-   writes, 0 = no limit). maxline and maxnest apply when a program is read, so only the host or
+   writes, 0 = no limit), maxtime (seconds a run may take, 0 = no limit). maxline and maxnest
+   apply when a program is read, so only the host or
    the command line can change them for that program.
 
    What the host sets here (options, camera, background) is where every program run starts;
@@ -665,8 +667,10 @@ pray_status pray_texture_register(pray_ctx *ctx, const char *name, pray_texture 
    8. Limits
    Every limit of a run is an option with a default (the command line sets it with -D):
        option     limits                                        default      untrusted
-       maxsteps   statements a program executes (0 = none)      10000000     1000000
-       maxnest    nesting of blocks and of expressions           256          64
+       maxsteps   statements a program executes, and each line   10000000     1000000
+                  an include reads (0 = none)
+       maxnest    nesting of blocks, includes and expressions    256          64
+                  together, across files
        maxline    characters on one line of a program            65536        4096
        maxstring  bytes of one string (literal or built by +)    65536        4096
        maxprims   primitives one object stands for               16777216     1048576
@@ -678,6 +682,7 @@ pray_status pray_texture_register(pray_ctx *ctx, const char *name, pray_texture 
        maxmem     MiB the context may hold (0 = no cap)          0            1024
        maxframes  frames a run renders (0 = no limit)            0            1000
        maxoutput  MiB of image files a run writes (0 = none)     0            1024
+       maxtime    seconds a run takes (0 = no limit)             0            600
    maxline and maxnest are read when a program is read. Fixed limits besides: images up to
    65536 pixels a side and 2^28 pixels, CSG trees up to 2000 levels, models up to 256 levels
    and, with textures, 4096 parts (each use of a shared part counted).

@@ -3,8 +3,10 @@
 #include <doctest/doctest.h>
 
 #include "testkit.hpp"
+#include "tempfiles.hpp"
 
 #include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -97,6 +99,187 @@ TEST_CASE("limit maxnest: parentheses, calls and blocks at the depth allowed and
     pray_free(c);
     std::string sq = "X = " + repeat("sqrt(", 1024) + "1" + repeat(")", 1024) + "\nprint X\n";
     CHECK(testkit::run(sq, {"maxnest=1024"}).printed == "1\n");
+}
+
+#if defined(__unix__) || defined(__APPLE__)
+TEST_CASE("limit maxnest: one bound on blocks, includes and expressions together, across files") {
+    testkit::TempDir d;
+    // k blocks around an include of a file with m blocks around an expression e deep: the
+    // innermost parenthesis is at level k + 1 + m + e
+    auto write = [&](int k, int m, int e) {
+        testkit::spit(d / "main.ray", repeat("while I < 1\n", k) + "I = 1\ninclude \"inner.ray\"\n" + repeat("endwhile\n", k));
+        testkit::spit(d / "inner.ray", repeat("if 1\n", m) + "print " + repeat("(", e) + "7" + repeat(")", e) + "\n" +
+                                           repeat("endif\n", m));
+    };
+    auto run_at = [&](double maxnest, std::string *out) {
+        pray_ctx *c = pray_new();
+        pray_set_print(c, testkit::print_sink, out);
+        pray_option(c, "maxnest", maxnest);
+        std::string prog = "I = 0\ninclude \"main.ray\"\n";
+        testkit::spit(d / "top.ray", prog);
+        pray_status st = pray_run_file(c, (d / "top.ray").c_str());
+        std::string err = st ? pray_error(c) : "";
+        pray_free(c);
+        return err;
+    };
+    struct Case { int k, m, e; } cases[] = {{3, 4, 5}, {0, 9, 0}, {9, 0, 0}, {100, 100, 55}};
+    for (const Case &t : cases) {
+        write(t.k, t.m, t.e);
+        int total = 1 + t.k + 1 + t.m + t.e;  // (top.ray's include of main.ray is one level)
+        CAPTURE(total);
+        std::string out;
+        CHECK(run_at(total, &out) == "");
+        CHECK(out == "7\n");
+        out.clear();
+        std::string err = run_at(total - 1, &out);
+        CHECK(out == "");
+        CHECK_MESSAGE(err.find("nested deeper than " + std::to_string(total - 1) + " levels") != std::string::npos, err);
+        CHECK_MESSAGE(err.find("(option maxnest)") != std::string::npos, err);
+    }
+    // the message names the levels around the part that went past the bound
+    write(3, 4, 5);
+    std::string out;
+    CHECK(run_at(13, &out) == d / "inner.ray" + ":5:11: error: expression nested deeper than 13 levels, counting the "
+                                                "9 levels around it (option maxnest) (included from " + d / "main.ray" +
+                                                ":5, included from " + d / "top.ray" + ":2)");
+    CHECK(run_at(8, &out) == d / "inner.ray" + ":4:1: error: blocks nested deeper than 8 levels, counting the 5 levels "
+                                               "around them (option maxnest) (included from " + d / "main.ray" +
+                                               ":5, included from " + d / "top.ray" + ":2)");
+    CHECK(run_at(4, &out) == d / "main.ray" + ":5:1: error: includes nested deeper than 4 levels, counting the 3 levels "
+                                              "around them (option maxnest) (included from " + d / "top.ray" + ":2)");
+}
+
+TEST_CASE("limit maxnest: the deepest program the option allows runs on the stack of the smallest target (4 MB)") {
+    // DJGPP's recipe gives pray 4 MB of stack (ports/djgpp); a 64-bit build needs more than the
+    // 32-bit one. At the highest maxnest, each kind of nesting alone and mixed, with the deepest
+    // CSG tree a program may build rendered at the innermost level, and the program of the
+    // report that crashed (255 files, each 255 blocks deep around the next) past the bound.
+    testkit::TempDir d;
+    const std::string tree = "M = phong({0.8, 0.1, 0.1}, {0.3}, 3)\nO = sphere(M, [0, 0, 0], 0.5)\nK = 0\n"
+                             "while K < 1990\n  O = sphere(M, [0.001*K, 0, 0], 0.5) - O\n  K = K + 1\nendwhile\n"
+                             "L = dirlight({1}, <1, 1, 1>)\n";
+    const std::string render = "rendertiff O + " + repeat("(", 900) + "nothing" + repeat(")", 900) + ", L\n";
+    auto chain = [&](const std::string &stem, int files, int blocks, const std::string &inner) {
+        for (int i = 0; i < files; i++) {
+            std::string body = i + 1 < files ? "include \"" + stem + std::to_string(i + 1) + ".ray\"\n" : inner;
+            testkit::spit(d / (stem + std::to_string(i) + ".ray"), repeat("if 1\n", blocks) + body + repeat("endif\n", blocks));
+        }
+    };
+    auto pray_small_stack = [&](const std::string &prog, const std::string &opts) {
+        std::string prog_path = std::filesystem::absolute(testkit::pray_program()).string();
+        std::string cmd = "cd '" + d.path + "' && ulimit -s 4096 && '" + prog_path + "' --quiet -s 8x8 " +
+                          opts + " -o out.ppm " + prog + " 2>&1";
+        std::string out;
+        FILE *p = popen(cmd.c_str(), "r");
+        REQUIRE(p);
+        char buf[4096];
+        size_t n;
+        while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+        int rc = pclose(p);
+        std::remove((d / "out.ppm").c_str());
+        return std::to_string(WIFEXITED(rc) ? WEXITSTATUS(rc) : -1) + " " + out;
+    };
+    testkit::spit(d / "paren.ray", tree + "rendertiff O + " + repeat("(", 1024) + "nothing" + repeat(")", 1024) + ", L\n");
+    CHECK(pray_small_stack("paren.ray", "-D maxnest=1024") == "0 ");
+    testkit::spit(d / "blocks.ray", tree + repeat("while K > 0\n", 1024) + "K = 0\nrendertiff O, L\n" +
+                                        repeat("endwhile\n", 1024));
+    CHECK(pray_small_stack("blocks.ray", "-D maxnest=1024") == "0 ");
+    chain("inc", 1025, 0, "rendertiff O, L\n");
+    testkit::spit(d / "incs.ray", tree + "include \"inc1.ray\"\n");  // inc1 .. inc1024: 1024 levels
+    CHECK(pray_small_stack("incs.ray", "-D maxnest=1024") == "0 ");
+    chain("mix", 12, 40, render);  // 12 includes, 480 blocks around the render's 900 parentheses: too deep
+    testkit::spit(d / "mix.ray", tree + "include \"mix0.ray\"\n");
+    std::string r = pray_small_stack("mix.ray", "-D maxnest=1024");
+    CHECK_MESSAGE(r.find("1 mix11.ray:41:") == 0, r);
+    CHECK_MESSAGE(r.find("nested deeper than 1024 levels") != std::string::npos, r);
+    chain("mixok", 3, 40, render);  // 3 includes and 120 blocks around 900 parentheses: 1023
+    testkit::spit(d / "mixok.ray", tree + "include \"mixok0.ray\"\n");
+    CHECK(pray_small_stack("mixok.ray", "-D maxnest=1024") == "0 ");
+    chain("crash", 255, 255, "print 1\n");
+    r = pray_small_stack("crash0.ray", "");
+    CHECK_MESSAGE(r.find("1 crash1.ray:1:1: error: blocks nested deeper than 256 levels") == 0, r);
+}
+#endif
+
+TEST_CASE("limit maxsteps: every line an include reads counts as a statement") {
+    testkit::TempDir d;
+    // 1 + 3 statements, then 5 includes of a file of 10 lines with 2 statements each:
+    // 4 + 5 * (1 + 10 + 2) = 69
+    testkit::spit(d / "lib.ray", "// a library\n\n\n\n\n\n\n\nX = X + 1\nY = 2");
+    testkit::spit(d / "main.ray", "X = 0\nI = 0\nwhile I < 5\ninclude \"lib.ray\"\nI = I + 1\nendwhile\nprint X\n");
+    auto run_at = [&](double maxsteps, std::string *out) {
+        pray_ctx *c = pray_new();
+        pray_set_print(c, testkit::print_sink, out);
+        pray_option(c, "maxsteps", maxsteps);
+        pray_status st = pray_run_file(c, (d / "main.ray").c_str());
+        std::string err = st ? pray_error(c) : "";
+        pray_free(c);
+        return err;
+    };
+    std::string out;
+    // 1 + 1 + 6 tests of the loop + 5 * (include, 10 lines, 2 statements, I = I + 1) + print
+    CHECK(run_at(1 + 1 + 6 + 5 * 14 + 1, &out) == "");
+    CHECK(out == "5\n");
+    // one less: the last print; 13 less: the fifth include's lines
+    CHECK(run_at(1 + 1 + 6 + 5 * 14, &out).find("main.ray:7:1: error: the program was stopped after 78 statements (option maxsteps)") !=
+          std::string::npos);
+    CHECK(run_at(1 + 1 + 5 + 4 * 14 + 1 + 9, &out) ==
+          d / "main.ray" + ":4:9: error: the program was stopped after 73 statements (option maxsteps; each line an include "
+                           "reads counts as one)");
+    // a file of comments read again and again stops as its statements would
+    testkit::spit(d / "big.ray", repeat("// " + repeat("x", 60) + "\n", 20000));
+    testkit::spit(d / "main.ray", "I = 0\nwhile 1\ninclude \"big.ray\"\nendwhile\n");
+    pray_ctx *c = pray_new();
+    pray_set_untrusted(c);
+    CHECK(pray_run_file(c, (d / "main.ray").c_str()) == PRAY_ERR_LIMIT);
+    CHECK(std::string(pray_error(c)).find("main.ray:3:9: error: the program was stopped after 1000000 statements") != std::string::npos);
+    pray_free(c);
+}
+
+TEST_CASE("limit maxtime: a run that takes longer stops with an error naming the option") {
+    auto seconds_since = [](std::chrono::steady_clock::time_point t0) {
+        return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    };
+    // statements: an endless loop under no step limit
+    pray_ctx *c = pray_new();
+    pray_option(c, "maxsteps", 0);
+    pray_option(c, "maxtime", 1);
+    const char *loop = "I = 0\nwhile 1\n  I = I + 1\nendwhile\n";
+    auto t0 = std::chrono::steady_clock::now();
+    CHECK(pray_run_string(c, "t.ray", loop, strlen(loop)) == PRAY_ERR_LIMIT);
+    double took = seconds_since(t0);
+    CHECK(took >= 1);
+    CHECK(took < 30);  // (a busy machine; the point is that it ends)
+    std::string err = pray_error(c);
+    CHECK_MESSAGE((err == "t.ray:3:3: error: the run was stopped after 1 second (option maxtime)" ||
+                   err == "t.ray:2:1: error: the run was stopped after 1 second (option maxtime)"), err);
+    // a render: many nested transparent shells on a large image, with one thread and with two
+    for (int threads : {1, 2}) {
+        CAPTURE(threads);
+        pray_option(c, "threads", threads);
+        pray_option(c, "width", 2048);
+        pray_option(c, "height", 2048);
+        pray_option(c, "depth", 64);
+        const char *shells = "M = transparent({0.99}, 1)\nO = nothing\nK = 1\nwhile K < 400\n"
+                             "  O = O | (sphere(M, [0, 0, 0], 0.001 * K) - sphere(M, [0, 0, 0], 0.001 * K - 0.0004))\n"
+                             "  K = K + 1\nendwhile\nrendertiff O, dirlight({1}, <1, 1, 1>)\n";
+        std::vector<testkit::Frame> frames;
+        pray_set_frame(c, testkit::frame_sink, &frames);
+        t0 = std::chrono::steady_clock::now();
+        CHECK(pray_run_string(c, "s.ray", shells, strlen(shells)) == PRAY_ERR_LIMIT);
+        took = seconds_since(t0);
+        CHECK(took < 30);
+        CHECK(std::string(pray_error(c)) == "s.ray:8:1: error: the run was stopped after 1 second (option maxtime)");
+        CHECK(frames.empty());
+    }
+    // the same run with time enough succeeds; maxtime 0 is no limit
+    pray_option(c, "width", 16);
+    pray_option(c, "height", 16);
+    const char *quick = "rendertiff sphere(phong({1}, {0}, 1), [0, 0, 0], 0.5), dirlight({1}, <1, 1, 1>)\n";
+    CHECK(pray_run_string(c, "q.ray", quick, strlen(quick)) == PRAY_OK);
+    pray_option(c, "maxtime", 0);
+    CHECK(pray_run_string(c, "q.ray", quick, strlen(quick)) == PRAY_OK);
+    pray_free(c);
 }
 
 TEST_CASE("limit maxline: a line of exactly maxline characters, and one more") {
@@ -357,7 +540,7 @@ TEST_CASE("untrusted mode: every limit gets its ceiling; higher values and 'no l
                     {"maxline", 4096},     {"maxmem", 1024},          {"maxnest", 64},
                     {"maxoutput", 1024},   {"maxpixels", 16777216},   {"maxprims", 1048576},
                     {"maxrays", 256},      {"maxsteps", 1000000},     {"maxstring", 4096},
-                    {"texmem", 64}};
+                    {"maxtime", 600},      {"texmem", 64}};
     pray_ctx *c = pray_new();
     pray_option(c, "maxsteps", 0);
     pray_option(c, "depth", 3);
@@ -375,6 +558,7 @@ TEST_CASE("untrusted mode: every limit gets its ceiling; higher values and 'no l
     CHECK(pray_option(c, "maxsteps", 0) == PRAY_ERR_ARG);
     CHECK(std::string(pray_error(c)) == "error: option 'maxsteps': 0 (no limit) is above 1000000, the ceiling in untrusted mode");
     CHECK(pray_option(c, "maxmem", 0) == PRAY_ERR_ARG);
+    CHECK(pray_option(c, "maxtime", 0) == PRAY_ERR_ARG);
     // a program meets the same ceilings
     const char *prog = "option \"maxsteps\", 2000000\n";
     CHECK(pray_run_string(c, "u.ray", prog, strlen(prog)) != PRAY_OK);
