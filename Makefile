@@ -17,6 +17,7 @@
 #   make check-mpi  pray-mpi, --part/--join, --frames and the recipes of docs/distributed.md
 #                   against one ./pray, byte for byte (tests/distributed.sh)
 #   make sanitize   the tests and the bad inputs under AddressSanitizer and UBSan
+#   make tsan       ThreadSanitizer: a render cancelled from another thread, two contexts at once
 #   make fuzz       build the libFuzzer harness and fuzz for FUZZ_SECONDS (needs clang)
 #   make fuzz-tiff  the same for the TIFF reader (textures and font atlases)
 #   make fuzz-long  the program harness on long inputs, from generated chains of 20000 operators
@@ -169,6 +170,16 @@ sanitize: deps $(PRAY) textures
 	./build/sanitize/pray_tests
 	@echo "== bad inputs under the sanitizers"
 	PRAY=build/sanitize/pray tests/bad/run.sh
+
+# ThreadSanitizer (GCC's, which sees a plain flag written by one thread and read by another): a
+# render on two threads cancelled from a third, and two contexts rendering at once; a race makes
+# the program exit non-zero.
+.PHONY: tsan
+build/tsan/cancel: tests/tsan/cancel.cpp pray.cpp pray.hpp
+	@mkdir -p build/tsan
+	g++ -std=c++11 -g -O1 -fsanitize=thread -I. tests/tsan/cancel.cpp pray.cpp -o $@ -lpthread
+tsan: build/tsan/cancel
+	TSAN_OPTIONS=halt_on_error=1 ./build/tsan/cancel
 
 # libFuzzer (clang; on Debian the runtime is in libclang-rt-14-dev): the harness runs fuzz inputs
 # as PRAY programs. New inputs go to build/fuzz/corpus, crashes to build/fuzz/artifacts/; the seeds

@@ -64,6 +64,14 @@
 #error "pray.cpp and pray.hpp are from different versions"
 #endif
 
+// pray relies on IEEE arithmetic: rays run to infinity, and a program's 10^400 or 0/0 is an error
+// found by testing for infinities and NaN, which -ffast-math, -ffinite-math-only, -Ofast or /fp:fast
+// allow the compiler to remove. Compile pray.cpp without them (with GCC and Clang, -fno-fast-math
+// after the other flags undoes them; pray's CMake target adds it).
+#if defined(__FAST_MATH__) || (defined(__FINITE_MATH_ONLY__) && __FINITE_MATH_ONLY__) || defined(_M_FP_FAST)
+#error "pray.cpp needs IEEE infinities and NaN: compile it without -ffast-math, -ffinite-math-only, -Ofast or /fp:fast (add -fno-fast-math)"
+#endif
+
 #ifndef PRAY_REAL
 #define PRAY_REAL double
 #endif
@@ -10033,7 +10041,18 @@ pray_status pray_render(pray_ctx *c, pray_object *root, pray_light *lights, pray
         c->in_render_fn = 1;
         pray_status st = c->render_fn(c->render_ud, c, root, lights, c->frames, out);
         c->in_render_fn = 0;
-        if (st == PRAY_OK) return PRAY_OK;
+        if (st == PRAY_OK && !out->pixels && out->width == 0 && out->height == 0) return PRAY_OK;  // skipped
+        if (st == PRAY_OK) {
+            // the frame must be an image of this context, as pray_render or pray_image_new make
+            // them: its pixels are freed with it (a host's buffer, or another context's, is not)
+            size_t need = out->width > 0 && out->height > 0 ? sizeof(float) * 3 * (size_t)out->width * (size_t)out->height : 0;
+            if (out->pixels && need && owner_of(out->pixels) == c && ((const Block *)out->pixels - 1)->size >= need)
+                return PRAY_OK;
+            out->width = out->height = 0;
+            out->pixels = NULL;
+            return fail(c, PRAY_ERR_ARG, "the render function gave an image that is not one of this context's "
+                        "(pray_render, pray_image_new)");
+        }
         pray_image_free(c, out);
         if (c->status == PRAY_OK || !c->msg[0]) fail(c, st, "the render function failed");
         return c->status = st;
@@ -10135,14 +10154,18 @@ int pray_intersect(pray_ctx *c, pray_scene *q, pray_vec origin, pray_vec dir, do
     }
     if (owner_of(q) != c) return fail(c, PRAY_ERR_ARG, "pray_intersect: the scene belongs to another context"), -1;
     if (max_hits > 0 && !hits) return fail(c, PRAY_ERR_ARG, "pray_intersect: no room for the hits"), -1;
-    if (!vfinite(origin) || !vfinite(dir) || vlen(dir) == 0 || tmax != tmax) {
-        fail(c, PRAY_ERR_ARG, "pray_intersect: the ray must have a finite origin and direction");
+    // the direction divided by its largest component: a tiny or a huge one is a direction too
+    double m = fabs(dir.x) > fabs(dir.y) ? fabs(dir.x) : fabs(dir.y);
+    m = fabs(dir.z) > m ? fabs(dir.z) : m;
+    if (!vfinite(origin) || !vfinite(dir) || m == 0 || tmax != tmax) {
+        fail(c, PRAY_ERR_ARG, "pray_intersect: the ray must have a finite origin and a finite, non-zero direction");
         return -1;
     }
+    pray_vec d = {dir.x / m, dir.y / m, dir.z / m};
     CollectHits ch;
     ch.s = &q->s;
     ch.ray.o = r3of(origin);
-    ch.ray.d = unit(r3of(dir));
+    ch.ray.d = unit(r3of(d));
     ch.out = hits;
     ch.max = max_hits;
     ch.n = 0;
@@ -10298,13 +10321,14 @@ pray_status pray_image_new(pray_ctx *c, int width, int height, pray_image *out) 
     return PRAY_OK;
 }
 
-pray_status pray_set_error(pray_ctx *c, pray_status status, const char *message) {
+pray_status pray_set_error(pray_ctx *c, int code, const char *message) {
     if (!c) return PRAY_ERR_ARG;
-    if (status == PRAY_OK) {
+    if (code == PRAY_OK) {
         pray_clear_error(c);
         return PRAY_OK;
     }
-    if ((int)status < 0 || (int)status > (int)PRAY_ERR_CANCELLED) status = PRAY_ERR_ARG;
+    // (an int: in C++ a value outside the enumeration cannot be a pray_status)
+    pray_status status = code >= PRAY_ERR_NOMEM && code <= PRAY_ERR_CANCELLED ? (pray_status)code : PRAY_ERR_ARG;
     return fail(c, status, "%s", message ? message : pray_status_text(status));
 }
 
@@ -13031,8 +13055,13 @@ void reset_run(pray_ctx *c) {
 }
 } // namespace
 
+// A context runs one program at a time: a frame callback or render function that starts another
+// on it would reset the one that called it.
+pray_status refuse_nested_run(pray_ctx *c) { return fail(c, PRAY_ERR_ARG, "the context is running a program"); }
+
 pray_status pray_run_string(pray_ctx *c, const char *name, const char *text, size_t len) {
     if (!c) return PRAY_ERR_ARG;
+    if (c->running) return refuse_nested_run(c);
     Call call(c);
     reset_run(c);
     if (!text) return fail(c, PRAY_ERR_ARG, "no program text");
@@ -13084,6 +13113,7 @@ bool read_program(pray_ctx *c, FILE *f, Text *t) {
 // A path of "-" reads standard input, named stdin.ray in messages.
 pray_status pray_run_file(pray_ctx *c, const char *path) {
     if (!c) return PRAY_ERR_ARG;
+    if (c->running) return refuse_nested_run(c);
     Call call(c);
     if (!path) return fail(c, PRAY_ERR_ARG, "no program file");
 #if PRAY_HAS_STDIO

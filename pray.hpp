@@ -83,6 +83,20 @@ typedef struct pray_model pray_model;   /* a lighting model (material) */
 typedef struct pray_light pray_light;   /* a set of light sources */
 typedef struct pray_texture pray_texture; /* a decoded TIFF image, for textures and fonts */
 
+/* Callbacks and the context they are called from. While a callback runs, its context is in the
+   middle of a call, and what the callback may do with that context is:
+   - allocator: nothing (it is called with the context's own bookkeeping half done);
+   - print, warning and byte sinks (pray_write_fn): pray_cancel, pray_error, pray_option_get;
+   - progress: pray_cancel only (it runs on the render's threads);
+   - frame callback and render function: everything a host does between calls (build objects,
+     set options, render with pray_render and pray_render_into, write images, pray_set_error),
+     except pray_run_string and pray_run_file, which refuse with PRAY_ERR_ARG ("the context is
+     running a program"): a program runs on a context one at a time;
+   - never pray_free.
+   The image a frame callback gets lives until the callback returns; the handles a render
+   function gets (root, lights) belong to the running program and live until its run ends.
+   Other contexts may be used freely from any callback. */
+
 /* Memory: like Lua's lua_Alloc. nsize == 0 frees ptr and returns NULL; otherwise returns a block
    of nsize bytes holding the first min(osize, nsize) bytes of ptr (ptr may be NULL), or NULL. */
 typedef void *(*pray_alloc_fn)(void *ud, void *ptr, size_t osize, size_t nsize);
@@ -453,9 +467,9 @@ pray_status pray_write_image_note(pray_ctx *ctx, const pray_image *img, const ch
 pray_status pray_image_new(pray_ctx *ctx, int width, int height, pray_image *out);
 /* Record an error as pray's own calls do: status `status`, message "error: " + message (NULL:
    the status's text); returns status. For callbacks (render, frame) that fail with a message of
-   their own. PRAY_OK clears the error (pray_clear_error); a status that is not one of the codes
-   above becomes PRAY_ERR_ARG. */
-pray_status pray_set_error(pray_ctx *ctx, pray_status status, const char *message);
+   their own. PRAY_OK clears the error (pray_clear_error); any other int that is not one of the
+   codes above becomes PRAY_ERR_ARG (the status is an int so that every value is defined). */
+pray_status pray_set_error(pray_ctx *ctx, int status, const char *message);
 
 /* ---------------------------------------------------------------------------------------------
    Parts of a render, for spreading one over processes or machines (docs/distributed.md).

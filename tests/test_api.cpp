@@ -658,3 +658,108 @@ TEST_CASE("api: a prepared scene needs nothing it was made from") {
     CHECK(pray_last_status(c) == PRAY_OK);
     pray_free(c);
 }
+
+TEST_CASE("api: a ray's direction may be tiny or huge; only the zero vector is refused") {
+    pray_ctx *c = pray_new();
+    pray_object *o = ball(c);
+    pray_scene *sc = pray_prepare(c, o);
+    REQUIRE(sc);
+    pray_vec from = {0.1, 0.2, 5};
+    pray_hit want[2], got[2];
+    pray_vec down = {0, 0, -1};
+    REQUIRE(pray_intersect(c, sc, from, down, HUGE_VAL, want, 2) == 2);
+    const double scales[] = {4.9e-324, 1e-310, 1e-200, 1e200, 1.7e308};
+    for (double k : scales) {
+        CAPTURE(k);
+        pray_vec d = {0, 0, -k};
+        REQUIRE(pray_intersect(c, sc, from, d, HUGE_VAL, got, 2) == 2);
+        for (int i = 0; i < 2; i++) {
+            CHECK(got[i].t == want[i].t);
+            CHECK(got[i].entering == want[i].entering);
+        }
+    }
+    // all three components huge: their squares would overflow
+    pray_vec diag = {-1.5e308, -1.5e308, -1.5e308}, unit_diag = {-1, -1, -1};
+    pray_vec far = {2, 2, 2};
+    REQUIRE(pray_intersect(c, sc, far, unit_diag, HUGE_VAL, want, 2) == 2);
+    REQUIRE(pray_intersect(c, sc, far, diag, HUGE_VAL, got, 2) == 2);
+    CHECK(got[0].t == want[0].t);
+    pray_vec zero = {0, 0, 0}, nan_dir = {0, 0, NAN};
+    CHECK(pray_intersect(c, sc, from, zero, HUGE_VAL, got, 2) == -1);
+    CHECK(std::string(pray_error(c)) ==
+          "error: pray_intersect: the ray must have a finite origin and a finite, non-zero direction");
+    CHECK(pray_intersect(c, sc, from, nan_dir, HUGE_VAL, got, 2) == -1);
+    pray_scene_free(c, sc);
+    pray_release(c, o);
+    pray_free(c);
+}
+
+namespace {
+// What a frame callback or a render function tried on the context that called it.
+struct Nested {
+    pray_ctx *other = nullptr;  // a second context, for an image that is not the caller's
+    int calls = 0;
+    std::vector<pray_status> refused;
+    std::vector<std::string> messages;
+    bool give_foreign = false;
+};
+const char *const TWO_FRAMES = "O = sphere(phong({1}, {0}, 1), [0, 0, 0], 0.5)\nrendertiff O\nrendertiff O\n";
+
+void try_nested_run(Nested *n, pray_ctx *c) {
+    n->calls++;
+    const char *prog = "print 1\n";
+    n->refused.push_back(pray_run_string(c, "inner.ray", prog, strlen(prog)));
+    n->messages.push_back(pray_error(c));
+    n->refused.push_back(pray_run_file(c, "examples/redsph.ray"));
+}
+pray_status frame_runs(void *ud, const pray_image *, const char *) {
+    Nested *n = (Nested *)ud;
+    try_nested_run(n, n->other);
+    return PRAY_OK;
+}
+pray_status render_runs(void *ud, pray_ctx *c, pray_object *root, pray_light *lights, int, pray_image *out) {
+    Nested *n = (Nested *)ud;
+    try_nested_run(n, c);
+    if (n->give_foreign) return pray_image_new(n->other, 4, 4, out);
+    return pray_render(c, root, lights, out);
+}
+} // namespace
+
+TEST_CASE("api: callbacks cannot start a run on the context running a program, nor give another's image") {
+    Nested n;
+    n.other = pray_new();  // (the frame callback gets no context: it is told the one it runs on)
+    pray_ctx *c = n.other;
+    pray_option(c, "width", 4);
+    pray_option(c, "height", 4);
+    // a frame callback: both frames arrive, each nested run is refused
+    pray_set_frame(c, frame_runs, &n);
+    CHECK(pray_run_string(c, "outer.ray", TWO_FRAMES, strlen(TWO_FRAMES)) == PRAY_OK);
+    CHECK(n.calls == 2);
+    CHECK(n.refused == std::vector<pray_status>(4, PRAY_ERR_ARG));
+    CHECK(n.messages[0] == "error: the context is running a program");
+    // a render function: both frames go through it (the nested run did not reset the outer one)
+    pray_ctx *d = pray_new();
+    pray_option(d, "width", 4);
+    pray_option(d, "height", 4);
+    Nested m;
+    m.other = c;
+    std::vector<testkit::Frame> frames;
+    pray_set_frame(d, testkit::frame_sink, &frames);
+    pray_set_render(d, render_runs, &m);
+    CHECK(pray_run_string(d, "outer.ray", TWO_FRAMES, strlen(TWO_FRAMES)) == PRAY_OK);
+    CHECK(m.calls == 2);
+    CHECK(m.refused == std::vector<pray_status>(4, PRAY_ERR_ARG));
+    CHECK(frames.size() == 2);
+    // an image of another context is refused: the program stops there and no frame is taken
+    m = Nested();
+    m.other = c;
+    m.give_foreign = true;
+    frames.clear();
+    CHECK(pray_run_string(d, "outer.ray", TWO_FRAMES, strlen(TWO_FRAMES)) == PRAY_ERR_RUNTIME);
+    CHECK(std::string(pray_error(d)) == "outer.ray:2:1: error: the render function gave an image that is not one "
+                                        "of this context's (pray_render, pray_image_new)");
+    CHECK(frames.empty());
+    CHECK(m.calls == 1);
+    pray_free(d);
+    pray_free(c);
+}

@@ -241,8 +241,13 @@ TEST_CASE("parts: pray_image_new, pray_set_error and notes in image files") {
     CHECK(pray_set_error(c, PRAY_ERR_IO, "the disk is full") == PRAY_ERR_IO);
     CHECK(std::string(pray_error(c)) == "error: the disk is full");
     CHECK(pray_last_status(c) == PRAY_ERR_IO);
-    CHECK(pray_set_error(c, (pray_status)99, nullptr) == PRAY_ERR_ARG);
+    CHECK(pray_set_error(c, 99, nullptr) == PRAY_ERR_ARG);
     CHECK(std::string(pray_error(c)) == "error: bad argument");
+    CHECK(pray_set_error(c, 12345, "unknown") == PRAY_ERR_ARG);
+    CHECK(pray_set_error(c, -1, "negative") == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: negative");
+    CHECK(pray_set_error(c, PRAY_ERR_CANCELLED, NULL) == PRAY_ERR_CANCELLED);
+    CHECK(std::string(pray_error(c)) == "error: cancelled");
     CHECK(pray_set_error(c, PRAY_OK, "ignored") == PRAY_OK);
     CHECK(std::string(pray_error(c)) == "");
     CHECK(pray_set_error(nullptr, PRAY_ERR_IO, "x") == PRAY_ERR_ARG);
