@@ -15,6 +15,13 @@
 // program `DIR/fuzz.ray`, so that `tiff(M, M, "t.tif")` and `text(..., "f.tif", 1)` read them
 // (beside the program); other names reach the file system through the same opener.
 //
+// Included files: an input may hold files besides the program, each after a line
+// `//file NAME` (a comment to PRAY, so the whole input is a program too). The part before the
+// first such line is the program; each part after one is written as DIR/NAME for the run and
+// removed after it (at most 8 files; NAME of letters, digits, '_', '-' and '.', not starting
+// with '.', at most 32 characters; other lines are left in the part before). So fuzzing reaches
+// chains of `include`, files that include each other, and errors and limits across files.
+//
 // Besides the sanitizers, the harness checks what the API promises about failures: a failing
 // run returns a known status and leaves a message; a message of a program error starts with
 // "DIR/fuzz.ray:LINE:COL: error: ". A broken promise aborts, so libFuzzer reports it as a crash.
@@ -111,6 +118,41 @@ bool has_place(const char *m) {
     return strncmp(m, " error: ", 8) == 0 && m[8] != 0;
 }
 
+// The files of an input (see the top): program[0] is the program's text, files[i] NAME.
+struct Split {
+    std::string program;
+    std::string names[8], texts[8];
+    int n;
+};
+bool file_name_ok(const std::string &name) {
+    if (name.empty() || name.size() > 32 || name[0] == '.') return false;
+    for (size_t i = 0; i < name.size(); i++) {
+        char ch = name[i];
+        if (!((ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') || (ch >= '0' && ch <= '9') || ch == '_' ||
+              ch == '-' || ch == '.'))
+            return false;
+    }
+    return name != "t.tif" && name != "f.tif" && name != "fuzz.ray";
+}
+void split_input(const char *data, size_t size, Split *out) {
+    out->n = 0;
+    std::string *part = &out->program;
+    size_t i = 0;
+    while (i < size) {
+        size_t e = i;
+        while (e < size && data[e] != '\n') e++;
+        std::string line(data + i, e - i);
+        if (line.compare(0, 7, "//file ") == 0 && out->n < 8 && file_name_ok(line.substr(7))) {
+            out->names[out->n] = line.substr(7);
+            part = &out->texts[out->n++];
+        } else {
+            part->append(line);
+            if (e < size) part->push_back('\n');
+        }
+        i = e + 1;
+    }
+}
+
 } // namespace
 
 extern "C" int LLVMFuzzerInitialize(int *, char ***) {
@@ -137,7 +179,16 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     for (size_t i = 0; i < sizeof caps / sizeof caps[0]; i++)
         if (pray_option_fix(c, caps[i][0], caps[i][1]) != PRAY_OK) broken("a cap was refused", pray_last_status(c), pray_error(c));
 
-    pray_status st = pray_run_string(c, program.c_str(), (const char *)data, size);
+    Split parts;
+    split_input((const char *)data, size, &parts);
+    for (int i = 0; i < parts.n; i++) {
+        FILE *f = fopen((dir + "/" + parts.names[i]).c_str(), "wb");
+        if (!f) abort();
+        fwrite(parts.texts[i].data(), 1, parts.texts[i].size(), f);
+        fclose(f);
+    }
+    pray_status st = pray_run_string(c, program.c_str(), parts.program.data(), parts.program.size());
+    for (int i = 0; i < parts.n; i++) unlink((dir + "/" + parts.names[i]).c_str());
     const char *msg = pray_error(c);
     if (!msg) broken("pray_error returned NULL", st, msg);
     if (st != PRAY_OK) {
