@@ -7,7 +7,7 @@
 # 1), the ratios POV-Ray / pray and Tachyon / pray with their geometric means, and pray's
 # intersection tests per ray (all the intersection tests of its render, from --stats, divided by
 # all the rays it traced: primary, shadow, reflected and refracted).
-# Usage: bench/suite/run.sh [--size N] [--quick] [--compare REF] [--only PATTERN] [--instructions] [--scaling]
+# Usage: bench/suite/run.sh [--size N] [--quick] [--compare REF] [--only PATTERN] [--instructions] [--chart PNG] [--scaling]
 #   --size N        image size N x N (default 512)
 #   --quick         size 64, no POV-Ray nor Tachyon; checks that every scene renders byte for byte the same
 #                   with pray's default options and with --brute (exits 1 on any difference);
@@ -17,13 +17,15 @@
 #   --instructions  count pray's instructions (millions, under valgrind's callgrind) instead of
 #                   timing it, and leave POV-Ray and Tachyon out: exact figures for deciding small
 #                   differences with --compare on a machine whose timings are noisy
+#   --chart PNG     also draw the tests per ray against the primitives, scene by scene, into PNG
+#                   (bench/suite/perray.py; docs/images/bench-perray.png)
 #   --scaling       instead of the suite: time and peak memory against 10^3 to 10^6 balls, pray and
 #                   POV-Ray (bench/suite/scaling.py), drawn into docs/images/bench-scaling-pov.png
 # Installs povray and tachyon-bin-nox with apt-get when missing (not for --quick nor
-# --instructions); builds ./pray if needed.
+# --instructions), and python3-matplotlib for --chart and --scaling; builds ./pray if needed.
 set -e
 usage() { sed -n 's/^# Usage: //p' "$0" >&2; exit 2; }
-SIZE= QUICK= REF= ONLY='*' INSTR= SCALING=
+SIZE= QUICK= REF= ONLY='*' INSTR= SCALING= CHART=
 while [ $# -gt 0 ]; do
   case $1 in
     --size) [ $# -ge 2 ] || usage; SIZE=$2; shift 2 ;;
@@ -31,6 +33,7 @@ while [ $# -gt 0 ]; do
     --compare) [ $# -ge 2 ] || usage; REF=$2; shift 2 ;;
     --only) [ $# -ge 2 ] || usage; ONLY=$2; shift 2 ;;
     --instructions) INSTR=1; shift ;;
+    --chart) [ $# -ge 2 ] || usage; CHART=$2; shift 2 ;;
     --scaling) SCALING=1; shift ;;
     *) usage ;;
   esac
@@ -39,6 +42,7 @@ if [ -n "$REF" ]; then
   case $REF in /*) ;; *) REF=$(pwd)/$REF ;; esac
   [ -x "$REF" ] || { echo "run.sh: $REF is not an executable" >&2; exit 2; }
 fi
+case $CHART in ''|/*) ;; *) CHART=$(pwd)/$CHART ;; esac
 [ -n "$SIZE" ] || { [ -n "$QUICK" ] && SIZE=64 || SIZE=512; }
 case $SIZE in ''|*[!0-9]*|0*) usage ;; esac
 RUNS=${RUNS:-1}
@@ -56,7 +60,9 @@ if [ -z "$QUICK" ] && [ -z "$INSTR" ] && [ -z "$SCALING" ]; then
 elif [ -n "$SCALING" ] && ! command -v povray >/dev/null 2>&1; then missing=povray; fi
 if [ -n "$SCALING" ]; then
   [ -x /usr/bin/time ] || missing="$missing time"
-  $PY -c 'import matplotlib' 2>/dev/null || missing="$missing python3-matplotlib"
+fi
+if [ -n "$SCALING$CHART" ] && ! $PY -c 'import matplotlib' 2>/dev/null; then
+  missing="$missing python3-matplotlib"
 fi
 if [ -n "$missing" ]; then
   echo "installing:$missing" >&2
@@ -174,6 +180,7 @@ while read -r s prims; do
     same $s new ref || { c="$c  DIFFERENT from REF"; bad=1; }
   fi
   echo "$line$c"
+  echo "$line" >> "$OUT/table"
 done < "$OUT/scenes"
 
 geomean() {  # geomean FILE LABEL: the geometric mean of the ratios $1/$2 of the file's lines
@@ -184,4 +191,7 @@ echo
 geomean "$OUT/ratios" POV/pray || true
 geomean "$OUT/tratios" Tachyon/pray || true
 geomean "$OUT/refratios" pray/REF || true
+if [ -n "$CHART" ] && [ -f "$OUT/table" ]; then
+  $PY bench/suite/perray.py "$OUT/table" "$CHART" && echo "chart of tests per ray: $CHART"
+fi
 if [ $bad != 0 ]; then echo "FAILED: some images differ" >&2; exit 1; fi
