@@ -6,7 +6,7 @@
 Each scene is written twice into OUTDIR: NAME.ray, a PRAY program, and NAME.pov, its POV-Ray 3.7
 twin with the same camera, geometry and lights (the shading is only close: see docs/povray.md).
 The .pov files include bench/pov/pray.inc, which the caller copies next to them. OUTDIR/scenes
-lists the names in the suite's order.
+lists the names in the suite's order, each with its number of primitives.
 
 Both files of a scene are written statement by statement from one description, so they cannot
 drift apart. Many objects are made by loops in both languages, with the same pseudo-random
@@ -17,8 +17,7 @@ own random numbers or hashing: the output is the same on every run.
 The procedural families (flake-*, rings-*, tree-*: the sphere flake, rings and tree of the
 classic procedural benchmark scenes, built here from their published descriptions) are written
 object by object, computed in Python, with the same numbers in every file. The flakes and the
-rings also get NAME.nff, a twin in the NFF format for Tachyon (see Triple). OUTDIR/scenes lists
-the names in the suite's order, each with its number of primitives.
+rings also get a third file, NAME.nff, a twin in the NFF format for Tachyon (see Triple).
 """
 import math
 import os
