@@ -6,14 +6,20 @@
 Each scene is written twice into OUTDIR: NAME.ray, a PRAY program, and NAME.pov, its POV-Ray 3.7
 twin with the same camera, geometry and lights (the shading is only close: see docs/povray.md).
 The .pov files include bench/pov/pray.inc, which the caller copies next to them. OUTDIR/scenes
-lists the names in the suite's order.
+lists the names in the suite's order, each with its number of primitives.
 
 Both files of a scene are written statement by statement from one description, so they cannot
 drift apart. Many objects are made by loops in both languages, with the same pseudo-random
 numbers: the Park-Miller generator S = S * 16807 mod (2^31 - 1), whose products are exact in
 double precision, so PRAY and POV-Ray compute the same coordinates. Nothing depends on Python's
 own random numbers or hashing: the output is the same on every run.
+
+The procedural families (flake-*, rings-*, tree-*: the sphere flake, rings and tree of the
+classic procedural benchmark scenes, built here from their published descriptions) are written
+object by object, computed in Python, with the same numbers in every file. The flakes and the
+rings also get a third file, NAME.nff, a twin in the NFF format for Tachyon (see Triple).
 """
+import math
 import os
 import sys
 
@@ -116,9 +122,12 @@ class Twin:
         self.put("%s = %s %s %s" % (var, var, op, obj[0]), obj[1])
         self.prims += prims
 
+    def files(self):
+        return (("ray", self.ray), ("pov", self.pov))
+
     def write(self, out):
         self.put("rendertiff All, Lights", None)
-        for ext, lines in (("ray", self.ray), ("pov", self.pov)):
+        for ext, lines in self.files():
             with open(os.path.join(out, "%s.%s" % (self.name, ext)), "w") as f:
                 f.write("\n".join(lines) + "\n")
 
@@ -425,6 +434,223 @@ def lights_scene(name, lamps):
     return t
 
 
+# The procedural families: the sphere flake, the rings and the tree of the classic procedural
+# benchmark scenes (Eric Haines' "Standard Procedural Databases"), built from their published
+# descriptions. Their objects are computed here and written out one by one, in PRAY, in POV-Ray
+# and (where NFF can say the same) in NFF for Tachyon.
+
+def num(x):
+    return "%.7g" % x
+
+
+def unit(v):
+    n = math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+    return (v[0] / n, v[1] / n, v[2] / n)
+
+
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def comb(*terms):
+    """The sum of the terms (scale, vector)."""
+    return tuple(sum(k * v[i] for k, v in terms) for i in range(3))
+
+
+class Triple(Twin):
+    """A scene of the procedural families: the PRAY program and the POV-Ray twin, and with
+    nff=True an NFF twin for Tachyon. NFF has no loops: every object is written out, and the
+    PRAY and POV-Ray files do the same, with the same numbers (7 significant digits).
+
+    Tachyon reads NFF with two differences from pray's camera, both measured: its field of view
+    is fixed (the view is half as wide as the distance to the point looked at, whatever NFF's
+    angle says), and its picture is the mirror image of the one a right-handed camera takes. So
+    every camera here has that width (view()), and the NFF file has every x coordinate negated
+    (geometry, lights and camera), which mirrors the picture back. Tachyon then samples each
+    pixel half a pixel from the centre that pray and POV-Ray sample: the same picture, moved by
+    half a pixel."""
+
+    def __init__(self, name, what, nff):
+        Twin.__init__(self, name, what)
+        self.nff = [] if nff else None
+        self.fills, self.fill = {}, None
+
+    def files(self):
+        return Twin.files(self) + ((("nff", self.nff),) if self.nff is not None else ())
+
+    def nput(self, *lines):
+        if self.nff is not None:
+            self.nff.extend(lines)
+
+    def view(self, eye, look):
+        d = math.sqrt(sum((a - b) ** 2 for a, b in zip(eye, look)))
+        self.camera(eye, look, 0.5 * d)
+        self.nput("v", "from %s %s %s" % (num(-eye[0]), num(eye[1]), num(eye[2])),
+                  "at %s %s %s" % (num(-look[0]), num(look[1]), num(look[2])), "up 0 0 1",
+                  "angle %s" % num(2 * math.degrees(math.atan(0.5))), "hither 0.001",
+                  "resolution 512 512")
+
+    def background(self, c):
+        Twin.background(self, c)
+        self.nput("b %s" % " ".join(num(x) for x in c))
+
+    def lamp(self, i, p):
+        Twin.lamp(self, i, p)
+        self.nput("l %s %s %s %s %s %s" % (num(-p[0]), num(p[1]), num(p[2]), num(i), num(i), num(i)))
+
+    def material(self, name, c, s, a, e, mirror=0, clear=None, ior=1):
+        Twin.material(self, name, c, s, a, e, mirror, clear, ior)
+        # NFF's fill: colour, diffuse and specular weights (the specular weight is also the
+        # mirror's), shininess, transmittance, index of refraction
+        self.fills[name] = "f %s 1 %s %s 0 1" % (" ".join(num(x) for x in c), num(mirror), num(e))
+
+    def use(self, m):
+        if self.fill != m:
+            self.nput(self.fills[m])
+            self.fill = m
+
+    def ball(self, m, c, r):
+        self.add(sphere(m, [num(x) for x in c], num(r)), 1)
+        self.use(m)
+        self.nput("s %s %s %s %s" % (num(-c[0]), num(c[1]), num(c[2]), num(r)))
+
+    def bar(self, m, a, b, r):
+        """A rod: PRAY's rod, POV-Ray's cylinder (both closed) and NFF's cylinder (open: every
+        bar here ends inside a ball wider than it, so the ends are never seen)."""
+        pa, pb = vec([num(x) for x in a]), vec([num(x) for x in b])
+        self.add(("rod(%s, [%s], [%s], %s)" % (m, pa, pb, num(r)),
+                  "cylinder { <%s>, <%s>, %s material { %s } }" % (pa, pb, num(r), m)), 1)
+        self.use(m)
+        self.nput("c", "%s %s %s %s" % (num(-a[0]), num(a[1]), num(a[2]), num(r)),
+                  "%s %s %s %s" % (num(-b[0]), num(b[1]), num(b[2]), num(r)))
+
+    def cone(self, m, a, ra, b, rb):
+        """A cone, closed in PRAY and POV-Ray; no NFF (Tachyon draws NFF's cone as a cylinder)."""
+        assert self.nff is None
+        pa, pb = vec([num(x) for x in a]), vec([num(x) for x in b])
+        self.add(("cone(%s, [%s], %s, [%s], %s)" % (m, pa, num(ra), pb, num(rb)),
+                  "cone { <%s>, %s, <%s>, %s material { %s } }" % (pa, num(ra), pb, num(rb), m)), 1)
+
+    def ground(self, m, half, z):
+        """A square floor of side 2*half, its top at height z: a slab one unit thick in PRAY and
+        POV-Ray (its sides and bottom are out of every view and every shadow here), its top
+        as an NFF polygon."""
+        lo, hi = (-half, -half, z - 1), (half, half, z)
+        self.add(box(m, [num(x) for x in lo], [num(x) for x in hi], maker=True), 1)
+        self.use(m)
+        self.nput("p 4", *["%s %s %s" % (num(-x), num(y), num(z))
+                           for x, y in ((-half, -half), (half, -half), (half, half), (-half, half))])
+
+
+def flake(level):
+    """The sphere flake: a ball with 9 balls of a third of its radius on it (6 around its
+    equator, 3 above), each of them with 9 more in the same way, to the given level; on a floor
+    24 units wide, under three lamps. Its balls are mirrors."""
+    n = (9 ** (level + 1) - 1) // 8
+    t = Triple("flake-%d" % level, "a sphere flake of %d levels, %d mirror balls, on a floor 24 "
+               "units wide, three lamps" % (level, n), nff=True)
+    t.view((2.1, -1.3, 1.7), (0, 0, 0))
+    t.background((0.55, 0.65, 0.8))
+    t.material("Chrome", (0.55, 0.5, 0.45), 0.5, (0.05, 0.05, 0.05), 40, mirror=0.5)
+    t.material("Sand", (0.75, 0.7, 0.55), 0.1, (0.08, 0.08, 0.06), 5)
+    for p in ((4, -3, 5), (-3, -4, 3), (1, 4, 6)):
+        t.lamp(0.45, p)
+    t.ground("Sand", 12, -0.5)
+    dirs = [(0.0, math.radians(60 * i)) for i in range(6)] + \
+           [(math.radians(50), math.radians(30 + 120 * i)) for i in range(3)]
+
+    def grow(c, r, axis, u, k):
+        t.ball("Chrome", c, r)
+        if k == level:
+            return
+        w = cross(axis, u)
+        for elev, az in dirs:
+            d = comb((math.cos(elev) * math.cos(az), u), (math.cos(elev) * math.sin(az), w),
+                     (math.sin(elev), axis))
+            cos_ad = sum(axis[i] * d[i] for i in range(3))
+            # the child's own axis points away from its parent; its azimuths start from the
+            # direction of the parent's axis, seen from the child
+            grow(comb((1, c), (4 * r / 3, d)), r / 3, d, unit(comb((1, axis), (-cos_ad, d))), k + 1)
+    grow((0, 0, 0), 0.5, (0, 0, 1), (1, 0, 0), 0)
+    assert t.prims == n + 1
+    return t
+
+
+def rings(layers):
+    """The rings: a pyramid of rings standing upright, (layers - k)^2 of them in layer k, each
+    made of 30 rods joined by 30 balls, facing along x and y by turns; on a floor, three lamps."""
+    count = sum(k * k for k in range(1, layers + 1))
+    t = Triple("rings-%d" % layers, "a pyramid of %d layers of rings, %d rings of 30 rods joined "
+               "by 30 balls, on a floor, three lamps" % (layers, count), nff=True)
+    w = 1.5 * (layers - 1) + 2.2
+    look = (0, 0, round(0.4 * w, 3))
+    e = unit((0.55, -1, 0.6))
+    t.view(tuple(round(look[i] + 1.8 * w * e[i], 3) for i in range(3)), look)
+    t.background((0.2, 0.25, 0.35))
+    palette(t)
+    for p in ((1.2, -1.6, 2), (-1.5, -0.8, 1.5), (0.5, 1.5, 2.5)):
+        t.lamp(0.45, tuple(round(w * x, 3) for x in p))
+    t.ground("Grey", 2 * w, 0)
+    rad, rod_r, ball_r, segs = 1.0, 0.07, 0.1, 30
+    colours = ["Red", "Gold", "Green", "Blue"]
+    for k in range(layers):
+        m = layers - k
+        for i in range(m):
+            for j in range(m):
+                c = (1.5 * i + 0.75 * k - 0.75 * (layers - 1), 1.5 * j + 0.75 * k - 0.75 * (layers - 1),
+                     rad + ball_r + 1.5 * k)
+                e1 = (1, 0, 0) if (i + j + k) % 2 == 0 else (0, 1, 0)
+                mat = colours[(i + 2 * j + 3 * k) % 4]
+                pts = [comb((1, c), (rad * math.cos(2 * math.pi * s / segs), e1),
+                            (rad * math.sin(2 * math.pi * s / segs), (0, 0, 1))) for s in range(segs)]
+                for s in range(segs):
+                    t.ball(mat, pts[s], ball_r)
+                    t.bar(mat, pts[s], pts[(s + 1) % segs], rod_r)
+    assert t.prims == 60 * count + 1
+    return t
+
+
+def tree(levels):
+    """The tree: a trunk (a cone with a ball on its top) that forks into two branches, each of
+    them forking in the same way, to the given number of levels; each branch shorter and thinner,
+    the plane of each fork turned a quarter of a turn from the one before. On a floor, two lamps."""
+    n = 2 ** levels - 1
+    t = Triple("tree-%d" % levels, "a tree of %d levels: %d branches, each a cone with a ball on "
+               "its end, on a floor, two lamps" % (levels, n), nff=False)
+    parts = []
+    alpha = math.radians(32)
+
+    def branch(base, d, e, length, r0, k):
+        r1 = 0.65 * r0
+        top = comb((1, base), (length, d))
+        parts.append((base, r0, top, r1))
+        if k == levels:
+            return
+        wv = cross(d, e)
+        for sgn in (1, -1):
+            branch(top, unit(comb((math.cos(alpha), d), (sgn * math.sin(alpha), e))), wv,
+                   0.78 * length, r1, k + 1)
+    branch((0, 0, -0.1), (0, 0, 1), (1, 0, 0), 2.1, 0.18, 1)
+    lo = [min(min(p[0][i], p[2][i]) for p in parts) for i in range(3)]
+    hi = [max(max(p[0][i], p[2][i]) for p in parts) for i in range(3)]
+    size = max(h - l for h, l in zip(hi, lo))
+    look = tuple(round((l + h) / 2, 3) for l, h in zip(lo, hi))
+    e = unit((0.6, -1, 0.3))
+    t.view(tuple(round(look[i] + 1.5 * size * e[i], 3) for i in range(3)), look)
+    t.background((0.55, 0.65, 0.8))
+    t.material("Bark", (0.5, 0.35, 0.2), 0.2, (0.06, 0.04, 0.03), 10)
+    t.material("Leaf", (0.3, 0.65, 0.25), 0.4, (0.04, 0.08, 0.03), 30)
+    t.material("Grass", (0.45, 0.55, 0.3), 0.1, (0.06, 0.07, 0.04), 5)
+    t.lamp(0.6, tuple(round(x * size, 3) for x in (1, -1.2, 2)))
+    t.lamp(0.4, tuple(round(x * size, 3) for x in (-1.5, -0.5, 1.5)))
+    t.ground("Grass", round(2 * size, 3), 0)
+    for base, r0, top, r1 in parts:
+        t.cone("Bark", base, r0, top, r1)
+        t.ball("Leaf", top, r1)
+    assert t.prims == 2 * n + 1
+    return t
+
+
 def scenes():
     yield uniform(1000, 0.5)
     yield uniform(10000, 0.25)
@@ -442,6 +668,12 @@ def scenes():
     yield glass()
     yield lights_scene("lights-2k", True)
     yield lights_scene("sun-2k", False)
+    for level in (3, 4, 5):
+        yield flake(level)
+    for layers in (4, 7, 12):
+        yield rings(layers)
+    for levels in (9, 12, 15):
+        yield tree(levels)
 
 
 def main():
