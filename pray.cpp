@@ -477,6 +477,13 @@ struct Block {
 };
 
 struct Coherence;  // image sequences (10b): what a program's last frame left for its next
+// A file a running program read (include, texture, font): its identity where files have one,
+// and its name as opened (compared where they have none). No image may replace it (9c: is_input).
+struct ReadFile {
+    ReadFile *next;
+    FileId id;
+    char *name;
+};
 
 // A texture the host registered under a name (pray_texture_register).
 struct TexName {
@@ -548,6 +555,7 @@ struct pray_ctx {
     size_t run_dir_len;      // (0: the current directory), for texture files
     FileId prog_id;          // the program file being run, which no image may replace
     const char *prog_name;   // its name (compared where files have no identity)
+    ReadFile *inputs;        // the files the last run read: includes, textures, fonts (note_input)
     char *volatile temp_name;  // the temporary file being written now (pray_temp_file)
     unsigned temp_serial;    // makes temporary names unique
     double written;          // bytes of image files written by this run (option maxoutput)
@@ -6626,14 +6634,61 @@ int open_confined(const char *dir, char *name, bool *link, const char **at) {
 }
 #endif
 
-// The one way pray opens a file to read: programs, textures and fonts. The file is opened once
-// (without waiting on a FIFO) and must be a regular file; `id` gets its identity where the system
-// has one. `dir` (dlen bytes, ending in a separator) is the program's directory: FIND_BESIDE
+// Is `path` the file opened as `name` with identity `id`? By identity where files have one, else
+// by name.
+bool same_file(const char *path, const FileId &id, const char *name) {
+    FileId pid;
+    if (id.valid) return name_id(path, &pid) && same_id(pid, id);
+    const char *a = path, *b = name;
+    while (a[0] == '.' && (a[1] == '/' || a[1] == '\\')) a += 2;
+    while (b[0] == '.' && (b[1] == '/' || b[1] == '\\')) b += 2;
+#if defined(_WIN32) || defined(__DJGPP__)
+    for (; *a && *b; a++, b++) {
+        int x = *a == '\\' ? '/' : tolower((unsigned char)*a), y = *b == '\\' ? '/' : tolower((unsigned char)*b);
+        if (x != y) return false;
+    }
+    return *a == *b;
+#else
+    return strcmp(a, b) == 0;
+#endif
+}
+
+// Record a file the running program opened, once. False when out of memory.
+bool note_input(pray_ctx *c, const char *name, const FileId &id) {
+    for (ReadFile *r = c->inputs; r; r = r->next)
+        if (id.valid ? same_id(id, r->id) : strcmp(name, r->name) == 0) return true;
+    ReadFile *r = (ReadFile *)mem_alloc(c, sizeof(ReadFile));
+    char *nm = r ? mem_strdup(c, name, strlen(name)) : NULL;
+    if (!nm) {
+        mem_free(c, r);
+        return false;
+    }
+    r->next = c->inputs;
+    r->id = id;
+    r->name = nm;
+    c->inputs = r;
+    return true;
+}
+
+// Would writing `path` replace a file the running program read?
+bool is_input(pray_ctx *c, const char *path) {
+    for (ReadFile *r = c->inputs; r; r = r->next)
+        if (same_file(path, r->id, r->name)) return true;
+    return false;
+}
+
+// The one way pray opens a file to read: programs, textures, fonts, included files and the parts
+// of --join. The file is opened once (without waiting on a FIFO) and must be a regular file; `id`
+// (may be NULL) gets its identity where the system has one. While a program runs, the file is
+// recorded as one it read (note_input). `dir` (dlen bytes, ending in a separator) is the program's directory: FIND_BESIDE
 // looks for a relative name as written, then beside the program; FIND_CONFINED beside the program
 // only, without following links where the system allows (PRAY_FILES_AT; elsewhere links are
 // followed). `*path` gets the name opened (context memory, also on failure: free with mem_free).
 // NULL on failure, message set.
 FILE *open_read(pray_ctx *c, const char *dir, size_t dlen, const char *name, int how, char **path, FileId *id) {
+    FileId own;
+    if (!id) id = &own;
+    id->valid = 0;
     size_t n = strlen(name);
     char *p = (char *)mem_alloc(c, 2 * (dlen + n + 2));  // the path, and room for a walk
     *path = p;
@@ -6695,6 +6750,10 @@ FILE *open_read(pray_ctx *c, const char *dir, size_t dlen, const char *name, int
              at ? *Shown(at) : "", at ? "'" : "");
     else if (!f) fail(c, PRAY_ERR_IO, "cannot open '%s': %s", *ShownPath(first), strerror(err));
     if (first != p) memmove(p, first, strlen(first) + 1);
+    if (f && c->running && !note_input(c, p, *id)) {
+        fclose(f);
+        return NULL;
+    }
     return f;
 }
 
@@ -6777,12 +6836,22 @@ pray_texture *texture_file(pray_ctx *c, const char *dir, size_t dlen, const char
 #endif
 }
 
+// What a run leaves for the next one to start afresh: its decoded textures, and the record of the
+// files it read.
 void texture_cache_clear(pray_ctx *c) {
     while (c->textures) {
         pray_texture *t = c->textures;
         c->textures = t->next;
         release_handle(c, t);
     }
+#if PRAY_HAS_STDIO
+    while (c->inputs) {
+        ReadFile *r = c->inputs;
+        c->inputs = r->next;
+        mem_free(c, r->name);
+        mem_free(c, r);
+    }
+#endif
 }
 
 // Where the host's registration of exactly `name` is kept (pray_texture_register), else where
@@ -8951,23 +9020,7 @@ void file_put(void *ud, const void *p, size_t n) {
 }
 
 // Is `path` the program being run? By identity where files have one, else by name.
-bool is_program(pray_ctx *c, const char *path) {
-    if (!c->prog_name) return false;
-    FileId id;
-    if (c->prog_id.valid) return name_id(path, &id) && same_id(id, c->prog_id);
-    const char *a = path, *b = c->prog_name;
-    while (a[0] == '.' && (a[1] == '/' || a[1] == '\\')) a += 2;
-    while (b[0] == '.' && (b[1] == '/' || b[1] == '\\')) b += 2;
-#if defined(_WIN32) || defined(__DJGPP__)
-    for (; *a && *b; a++, b++) {
-        int x = *a == '\\' ? '/' : tolower((unsigned char)*a), y = *b == '\\' ? '/' : tolower((unsigned char)*b);
-        if (x != y) return false;
-    }
-    return *a == *b;
-#else
-    return strcmp(a, b) == 0;
-#endif
-}
+bool is_program(pray_ctx *c, const char *path) { return c->prog_name && same_file(path, c->prog_id, c->prog_name); }
 
 // Create a temporary file beside `path`, exclusively, never through a link, under a name no
 // other writer uses: ".NAME.XXXXXX" + PRAY_TEMP_SUFFIX (NAME: the file's name, cut to 32 bytes,
@@ -10188,6 +10241,9 @@ pray_status write_image_file(pray_ctx *c, const pray_image *img, const char *pat
 #if PRAY_HAS_STDIO
     if (is_program(c, path))
         return fail(c, PRAY_ERR_IO, "cannot write '%s': it is the program being run (choose another output name)",
+                    *ShownPath(path));
+    if (c->running && is_input(c, path))
+        return fail(c, PRAY_ERR_IO, "cannot write '%s': the program reads it (choose another output name)",
                     *ShownPath(path));
     // written under a temporary name, then renamed: the file is whole or not there
     char *tmp = NULL;
@@ -13301,52 +13357,43 @@ void render_id(char out[17], const char *program, int argc, char **argv) {
 // ---- pray --join OUT PART... ----
 struct Part {
     const char *name;
+    FileId id;            // which no output may replace
     unsigned char *file;  // the whole file
     const unsigned char *samples;
     int width, rows, bits, big_endian;
     int row0, row1, height, frame;
-    char id[17];
+    char id_text[17];
 };
 
 unsigned rd16(const unsigned char *p) { return (unsigned)p[0] | (unsigned)p[1] << 8; }
 unsigned long rd32(const unsigned char *p) { return (unsigned long)rd16(p) | (unsigned long)rd16(p + 2) << 16; }
 
-// Read a part written by pray --rows: a TIFF or PPM file as pray writes them, with its note.
-// Returns 0, or the exit status after printing the error.
-int read_part(Part *pt) {
-    FILE *f = fopen(pt->name, "rb");
+// The most a part's header takes, its note included: the samples start within this many bytes.
+const size_t PART_HEAD = 2048;
+
+// Read a part written by pray --rows: a TIFF or PPM file as pray writes them, with its note. It
+// is opened as programs are (open_read: a regular file, no waiting on a FIFO); its header is read
+// first, and then no more than the samples it claims. Returns 0, or the exit status after
+// printing the error.
+int read_part(pray_ctx *c, Part *pt) {
+    char *opened = NULL;
+    FILE *f = open_read(c, "", 0, pt->name, FIND_AS_NAMED, &opened, &pt->id);
+    mem_free(c, opened);
     if (!f) {
-        fprintf(stderr, "pray: error: cannot read '%s': %s\n", pt->name, strerror(errno));
-        return 3;
+        fprintf(stderr, "pray: %s\n", pray_error(c));
+        return exit_code(pray_last_status(c));
     }
-    size_t size = 0, cap = 0;
-    unsigned char *buf = NULL;
-    for (;;) {
-        if (size == cap) {
-            cap = cap ? cap * 2 : 65536;
-            unsigned char *nb = (unsigned char *)realloc(buf, cap);
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                fprintf(stderr, "pray: error: out of memory reading '%s'\n", pt->name);
-                return 1;
-            }
-            buf = nb;
-        }
-        size_t n = fread(buf + size, 1, cap - size, f);
-        if (n == 0) break;
-        size += n;
-    }
-    int bad = ferror(f);
-    fclose(f);
-    pt->file = buf;
-    if (bad) {
-        fprintf(stderr, "pray: error: cannot read '%s'\n", pt->name);
+    unsigned char buf[PART_HEAD];
+    size_t size = fread(buf, 1, sizeof buf, f);
+    if (ferror(f)) {
+        fclose(f);
+        fprintf(stderr, "pray: error: cannot read '%s': %s\n", pt->name, strerror(errno ? errno : EIO));
         return 3;
     }
     char note[PRAY_NOTE_MAX + 1] = "";
     size_t data = 0;
     int maxval = 0;
+    double whole = 0;
     if (size >= 8 && memcmp(buf, "II*\0", 4) == 0) {  // TIFF: the tags pray writes
         unsigned long ifd = rd32(buf + 4), tiff_data = 0, bytes = 0, desc = 0, desc_n = 0, bps_at = 0;
         unsigned comp = 0, photo = 0, spp = 0;
@@ -13399,16 +13446,46 @@ int read_part(Part *pt) {
         text[k] = 0;
         int used = 0;
         if (head != 2 || sscanf(text, "%d %d\n%d\n%n", &pt->width, &pt->rows, &maxval, &used) != 3 ||
-            used != (int)k || (maxval != 255 && maxval != 65535) || pt->width < 1 || pt->rows < 1)
+            used != (int)k || (maxval != 255 && maxval != 65535) || pt->width < 1 || pt->rows < 1 ||
+            pt->width > 65536 || pt->rows > 65536)
             goto not_pray;
         pt->bits = maxval == 255 ? 8 : 16;
         pt->big_endian = 1;
         data = i + k;
     } else
         goto not_pray;
-    if (data > size || (size - data) / 3 / (size_t)(pt->bits / 8) / (size_t)pt->width < (size_t)pt->rows)
-        goto not_pray;
-    pt->samples = buf + data;
+    // the whole file: the header and the samples it claims, no more and no less
+    whole = (double)data + (double)pt->width * pt->rows * 3 * (pt->bits / 8);
+    if (data > size || whole > (double)(size_t)-1 / 2) goto not_pray;
+    {
+        long end = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+        if (end >= 0 && (double)end != whole) {
+            fclose(f);
+            if ((double)end < whole)
+                fprintf(stderr, "pray: error: '%s' is cut short: its header says %.0f bytes, the file has %ld\n",
+                        pt->name, whole, end);
+            else
+                fprintf(stderr, "pray: error: '%s' has %ld bytes, more than the %.0f its header says\n", pt->name,
+                        end, whole);
+            return 1;
+        }
+        size_t n = (size_t)whole;
+        pt->file = (unsigned char *)malloc(n + 1);
+        if (!pt->file) {
+            fclose(f);
+            fprintf(stderr, "pray: error: out of memory reading '%s'\n", pt->name);
+            return 1;
+        }
+        size_t got = fseek(f, 0, SEEK_SET) == 0 ? fread(pt->file, 1, n + 1, f) : 0;
+        int bad = ferror(f);
+        fclose(f);
+        if (bad || got != n) {
+            fprintf(stderr, "pray: error: cannot read '%s': %s\n", pt->name,
+                    bad ? strerror(errno ? errno : EIO) : "its size changed while it was read");
+            return 3;
+        }
+        pt->samples = pt->file + data;
+    }
     {
         int used = 0;
         if (!note[0]) {
@@ -13418,8 +13495,8 @@ int read_part(Part *pt) {
         }
         for (char *ch = note; *ch; ch++)
             if (*ch < 32 || *ch > 126) *ch = '?';  // shown in the message below
-        if (sscanf(note, PART_NOTE "%n", &pt->row0, &pt->row1, &pt->height, &pt->frame, pt->id, &used) != 5 ||
-            used != (int)strlen(note) || strlen(pt->id) != 16 || pt->row0 < 0 || pt->row1 <= pt->row0 ||
+        if (sscanf(note, PART_NOTE "%n", &pt->row0, &pt->row1, &pt->height, &pt->frame, pt->id_text, &used) != 5 ||
+            used != (int)strlen(note) || strlen(pt->id_text) != 16 || pt->row0 < 0 || pt->row1 <= pt->row0 ||
             pt->row1 > pt->height || pt->frame < 0) {
             fprintf(stderr, "pray: error: '%s' is not a row part: its note is '%s'\n", pt->name, note);
             return 1;
@@ -13432,6 +13509,7 @@ int read_part(Part *pt) {
     }
     return 0;
 not_pray:
+    fclose(f);
     fprintf(stderr, "pray: error: '%s' is not a TIFF or PPM file as pray writes them\n", pt->name);
     return 1;
 }
@@ -13448,18 +13526,24 @@ int join_parts(pray_ctx *c, const char *out, char **names, int n) {
     }
     for (int i = 0; i < n && rc == 0; i++) {
         p[i].name = names[i];
-        rc = read_part(&p[i]);
+        rc = read_part(c, &p[i]);
     }
+    for (int i = 0; i < n && rc == 0; i++)  // the output may not replace a part
+        if (same_file(out, p[i].id, p[i].name)) {
+            fprintf(stderr, "pray: error: cannot write '%s': it is the part '%s' (choose another output name)\n", out,
+                    p[i].name);
+            rc = 3;
+        }
     for (int i = 1; i < n && rc == 0; i++) {
         const Part &a = p[0], &b = p[i];
         if (b.width != a.width || b.bits != a.bits || b.height != a.height || b.frame != a.frame ||
-            strcmp(b.id, a.id) != 0) {
+            strcmp(b.id_text, a.id_text) != 0) {
             fprintf(stderr, "pray: error: '%s' and '%s' are parts of different images: ", a.name, b.name);
             if (b.width != a.width) fprintf(stderr, "%d and %d pixels wide\n", a.width, b.width);
             else if (b.bits != a.bits) fprintf(stderr, "%d and %d bits\n", a.bits, b.bits);
             else if (b.height != a.height) fprintf(stderr, "of %d and %d rows\n", a.height, b.height);
             else if (b.frame != a.frame) fprintf(stderr, "frames %d and %d\n", a.frame, b.frame);
-            else fprintf(stderr, "renders %s and %s (another program or other options)\n", a.id, b.id);
+            else fprintf(stderr, "renders %s and %s (another program or other options)\n", a.id_text, b.id_text);
             rc = 1;
         }
     }

@@ -805,6 +805,55 @@ TEST_CASE("command line: pray refuses to write over its own program") {
     CHECK(run_cmd(testkit::pray_shell() + " -s 8x8 -o " + sq(d / "q.ppm") + " " + sq(d / "p.ppm"), &out) == 0);
 }
 
+TEST_CASE("command line: no output replaces a file the program read (an include, a texture)") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    TempDir d;
+    const std::string cd = "cd " + sq(d.path) + " && " + fs::absolute(testkit::pray_program()).string() + " -s 8x8 ";
+    std::string out;
+    spit(d / "bg.ray", "rendertiff nothing\n");
+    REQUIRE(run_cmd(cd + "-o tex.tif bg.ray", &out) == 0);
+    const std::string tex = slurp(d / "tex.tif");
+    spit(d / "lib.ppm", "S = sphere(color({1}), [0, 0, 0], 1)\n");
+    spit(d / "mid.ray", "include \"lib.ppm\"\n");
+    spit(d / "p.ray", "include \"lib.ppm\"\nrendertiff S, none\n");
+    spit(d / "q.ray", "include \"mid.ray\"\nrendertiff S, none\n");
+    spit(d / "t.ray", "T = tiff(color({0}), color({1}), \"tex.tif\")\n"
+                      "rendertiff planemap(T, [0, 0, 0], <0, 0, 1>, <1, 0, 0>, <0, 1, 0>), none\n");
+    fs::create_hard_link(d / "lib.ppm", d / "hard.ppm");
+    const std::string refused = "': the program reads it (choose another output name)\n";
+    struct Case {
+        const char *args;
+        std::string message;
+    } cases[] = {
+        {"-o lib.ppm p.ray", "p.ray:2:1: error: cannot write 'lib.ppm" + refused},
+        {"-o ./lib.ppm p.ray", "p.ray:2:1: error: cannot write './lib.ppm" + refused},
+        {"-o hard.ppm p.ray", "p.ray:2:1: error: cannot write 'hard.ppm" + refused},  // the same file
+        {"--untrusted -o lib.ppm p.ray", "p.ray:2:1: error: cannot write 'lib.ppm" + refused},
+        {"-o lib.ppm q.ray", "q.ray:2:1: error: cannot write 'lib.ppm" + refused},  // included by an include
+        {"-o tex.tif t.ray", "t.ray:2:1: error: cannot write 'tex.tif" + refused},  // a texture
+    };
+    for (const Case &k : cases) {
+        CAPTURE(k.args);
+        CHECK(run_cmd(cd + k.args, &out) == 3);
+        CHECK(out == k.message);
+    }
+    CHECK(slurp(d / "lib.ppm") == "S = sphere(color({1}), [0, 0, 0], 1)\n");
+    CHECK(slurp(d / "tex.tif") == tex);
+    CHECK(d.listing() == "bg.ray hard.ppm lib.ppm mid.ray p.ray q.ray t.ray tex.tif");
+    // another output is fine, and what one run read binds no later run of the same context
+    CHECK(run_cmd(cd + "-o other.ppm p.ray", &out) == 0);
+    pray_ctx *c = pray_new();
+    REQUIRE(c);
+    REQUIRE(pray_option_fix(c, "width", "4") == PRAY_OK);
+    REQUIRE(pray_option_fix(c, "height", "4") == PRAY_OK);
+    REQUIRE(pray_option_fix(c, "output", (d / "lib.ppm").c_str()) == PRAY_OK);
+    CHECK(pray_run_file(c, (d / "p.ray").c_str()) == PRAY_ERR_IO);
+    CHECK(std::string(pray_error(c)).find(refused.substr(3, 20)) != std::string::npos);
+    CHECK(pray_run_file(c, (d / "bg.ray").c_str()) == PRAY_OK);
+    CHECK(whole_ppm(slurp(d / "lib.ppm")) == 4);
+    pray_free(c);
+}
+
 TEST_CASE("command line: a FIFO, a directory or a device as program or texture is an error, never a hang") {
     REQUIRE_MESSAGE(have_pray(), NO_PRAY);
     TempDir d;
