@@ -13616,8 +13616,8 @@ int join_parts(pray_ctx *c, const char *out, char **names, int n) {
     return rc;
 }
 
-// SIGINT and SIGTERM while an image is written: remove its temporary file, then die of the
-// signal as the default would. Only async-signal-safe calls.
+// A signal that ends pray while an image is written (SIGINT, SIGTERM, SIGHUP, SIGQUIT): remove
+// its temporary file, then die of the signal as the default would. Only async-signal-safe calls.
 pray_ctx *volatile the_ctx;
 extern "C" void on_signal(int sig) {
     const char *t = the_ctx ? pray_temp_file(the_ctx) : NULL;
@@ -13630,9 +13630,29 @@ extern "C" void on_signal(int sig) {
     raise(sig);
 }
 
+// Catch those signals during a run of `c` (c NULL: give them back their default). Systems without
+// some of them (DOS, Windows) catch the others.
+void catch_signals(pray_ctx *c) {
+    void (*h)(int) = c ? on_signal : SIG_DFL;
+    if (c) the_ctx = c;
+    signal(SIGINT, h);
+    signal(SIGTERM, h);
+#ifdef SIGHUP
+    signal(SIGHUP, h);
+#endif
+#ifdef SIGQUIT
+    signal(SIGQUIT, h);
+#endif
+    if (!c) the_ctx = NULL;
+}
+
 } // namespace
 
 int main(int argc, char **argv) {
+#ifdef SIGXFSZ
+    // a file over the size limit (ulimit -f): a write error (EFBIG) like any other, not death
+    signal(SIGXFSZ, SIG_IGN);
+#endif
     pray_ctx *c = pray_new();
     if (!c) {
         fprintf(stderr, "pray: error: out of memory\n");
@@ -13648,13 +13668,9 @@ int main(int argc, char **argv) {
         else {
             for (int i = 3; i < argc && rc == 0; i++)
                 if (argv[i][0] == '-' && argv[i][1]) rc = usage_error("--join takes file names only, not '%s'", argv[i]);
-            the_ctx = c;
-            signal(SIGINT, on_signal);
-            signal(SIGTERM, on_signal);
+            catch_signals(c);
             if (rc == 0) rc = join_parts(c, argv[2], argv + 3, argc - 3);
-            signal(SIGINT, SIG_DFL);
-            signal(SIGTERM, SIG_DFL);
-            the_ctx = NULL;
+            catch_signals(NULL);
         }
         pray_free(c);
         return rc;
@@ -13772,13 +13788,9 @@ int main(int argc, char **argv) {
     memset(&flog, 0, sizeof flog);
     flog.c = c;
     if (stats && !sp.row1 && !sp.n) pray_set_frame(c, log_frame, &flog);
-    the_ctx = c;
-    signal(SIGINT, on_signal);
-    signal(SIGTERM, on_signal);
+    catch_signals(c);
     pray_status st = pray_run_file(c, program);
-    signal(SIGINT, SIG_DFL);
-    signal(SIGTERM, SIG_DFL);
-    the_ctx = NULL;
+    catch_signals(NULL);
     if (st != PRAY_OK) {
         const char *m = pray_error(c);
         if (strncmp(m, "error: ", 7) == 0) fprintf(stderr, "pray: %s\n", m);

@@ -9,6 +9,7 @@
 #include "tempfiles.hpp"
 
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -723,24 +724,27 @@ TEST_CASE("command line: renders to one output at once leave one whole image (8 
     }
 }
 
-TEST_CASE("command line: SIGINT or SIGTERM while writing removes the temporary file (60 runs)") {
+TEST_CASE("command line: SIGINT, SIGTERM, SIGHUP or SIGQUIT while writing removes the temporary file (80 runs)") {
     REQUIRE_MESSAGE(have_pray(), NO_PRAY);
     TempDir d;
     spit(d / "p.ray", "rendertiff nothing\n");
     std::string prog = fs::absolute(testkit::pray_program()).string(), out = d / "out.ppm", ray = d / "p.ray";
+    // a closed terminal or a dropped ssh (SIGHUP) and Ctrl-\ (SIGQUIT) end pray as SIGINT and SIGTERM do
+    const int sigs[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+    const char *const names[] = {"SIGINT", "SIGTERM", "SIGHUP", "SIGQUIT"};
     // the test's own handlers (doctest's) must not run in a child before it becomes ./pray:
     // the signals wait, blocked, until the child has their default disposition
-    sigset_t both, before;
-    sigemptyset(&both);
-    sigaddset(&both, SIGINT);
-    sigaddset(&both, SIGTERM);
-    sigprocmask(SIG_BLOCK, &both, &before);
+    sigset_t all, before;
+    sigemptyset(&all);
+    for (int s : sigs) sigaddset(&all, s);
+    sigprocmask(SIG_BLOCK, &all, &before);
     auto start = [&]() {
         pid_t pid = fork();
         if (pid == 0) {
-            signal(SIGINT, SIG_DFL);
-            signal(SIGTERM, SIG_DFL);
-            sigprocmask(SIG_UNBLOCK, &both, NULL);
+            for (int s : sigs) signal(s, SIG_DFL);
+            struct rlimit none = {0, 0};  // SIGQUIT dumps no core
+            setrlimit(RLIMIT_CORE, &none);
+            sigprocmask(SIG_UNBLOCK, &all, NULL);
             execl(prog.c_str(), "pray", "--quiet", "-s", "1200x1200", "-D", "bits=16", "-o", out.c_str(), ray.c_str(),
                   (char *)NULL);
             _exit(127);
@@ -757,17 +761,18 @@ TEST_CASE("command line: SIGINT or SIGTERM while writing removes the temporary f
     long total = (long)std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0).count();
     fs::remove(out);
     srand(12345);
-    int killed = 0, finished = 0;
-    for (int i = 0; i < 60; i++) {
+    int killed[4] = {0, 0, 0, 0}, finished = 0;
+    for (int i = 0; i < 80; i++) {
         CAPTURE(i);
+        CAPTURE(names[i % 4]);
         pid = start();
         REQUIRE(pid > 0);
         usleep((useconds_t)(rand() % (total + 1)));
-        kill(pid, i % 2 ? SIGINT : SIGTERM);
+        kill(pid, sigs[i % 4]);
         waitpid(pid, &status, 0);
         if (WIFSIGNALED(status)) {
-            killed++;
-            CHECK((WTERMSIG(status) == SIGINT || WTERMSIG(status) == SIGTERM));  // died of the signal
+            killed[i % 4]++;
+            CHECK(WTERMSIG(status) == sigs[i % 4]);  // died of the signal
         } else
             finished++;
         CHECK(temporaries(d) == "");
@@ -777,8 +782,33 @@ TEST_CASE("command line: SIGINT or SIGTERM while writing removes the temporary f
         }
     }
     sigprocmask(SIG_SETMASK, &before, NULL);
-    MESSAGE("killed ", killed, ", finished ", finished, " of 60 runs of ", total / 1000, " ms");
-    CHECK(killed > 10);
+    MESSAGE("killed by SIGINT ", killed[0], ", SIGTERM ", killed[1], ", SIGHUP ", killed[2], ", SIGQUIT ", killed[3],
+            "; finished ", finished, " of 80 runs of ", total / 1000, " ms");
+    for (int k = 0; k < 4; k++) {
+        CAPTURE(names[k]);
+        CHECK(killed[k] > 3);
+    }
+}
+
+TEST_CASE("command line: a file over the size limit (ulimit -f, SIGXFSZ) is a write error, nothing left") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    TempDir d;
+    spit(d / "p.ray", "rendertiff nothing\n");
+    const std::string prog = fs::absolute(testkit::pray_program()).string();
+    std::string out;
+    // 200 blocks of 512 bytes: the 600 x 600 image of 1 MiB does not fit, the part of 8 rows does
+    const std::string limit = "cd " + sq(d.path) + " && ulimit -f 200 && ";
+    CHECK(run_cmd(limit + prog + " --quiet -s 600x600 -o out.ppm p.ray", &out) == 3);
+    CHECK(out == "p.ray:1:1: error: cannot write 'out.ppm': File too large\n");
+    CHECK(d.listing() == "p.ray");
+    // a part small enough, one too large, and --join of two parts too large together
+    CHECK(run_cmd(limit + prog + " --quiet -s 600x600 --rows 0:8 -o a.ppm p.ray", &out) == 0);
+    CHECK(run_cmd(limit + prog + " --quiet -s 600x600 --rows 8:600 -o b.ppm p.ray", &out) == 3);
+    CHECK(out == "p.ray:1:1: error: cannot write 'b.ppm': File too large\n");
+    CHECK(run_cmd("cd " + sq(d.path) + " && " + prog + " --quiet -s 600x600 --rows 8:600 -o b.ppm p.ray", &out) == 0);
+    CHECK(run_cmd(limit + prog + " --join out.ppm a.ppm b.ppm", &out) == 3);
+    CHECK(out == "pray: error: cannot write 'out.ppm': File too large\n");
+    CHECK(d.listing() == "a.ppm b.ppm p.ray");
 }
 
 TEST_CASE("command line: pray refuses to write over its own program") {
