@@ -1230,7 +1230,7 @@ pray_object *csg_make(pray_ctx *c, int op, pray_object *a, pray_object *b) {
     // a tree may use one part many times over; what it stands for must stay renderable
     double lim = c->cur.opt.v[OPT_MAXPRIMS];
     if ((double)a->nprims + (double)b->nprims > lim) {
-        fail(c, PRAY_ERR_LIMIT, "object of more than %.0f primitives (option maxprims)", lim);
+        fail(c, PRAY_ERR_LIMIT, "object of more than %.0f primitive%s (option maxprims)", lim, lim == 1 ? "" : "s");
         return NULL;
     }
     pray_object *o = obj_new(c, op, NULL);
@@ -8138,7 +8138,8 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         run_parallel(nt, worker_main, args, starts);
         job.mu.destroy();
         if (job.over)
-            st = fail(c, PRAY_ERR_LIMIT, "a sample of the image needs more than %ld rays (option maxrays)", s->maxrays);
+            st = fail(c, PRAY_ERR_LIMIT, "a sample of the image needs more than %ld ray%s (option maxrays)", s->maxrays,
+                      s->maxrays == 1 ? "" : "s");
         else if (job.cancelled)
             st = cancelled(c) ? fail_cancelled(c) : fail(c, PRAY_ERR_CANCELLED, "cancelled by the progress callback");
     }
@@ -9985,8 +9986,8 @@ pray_status image_limits(pray_ctx *c) {
     if ((double)W * H * aa * aa > lim) {
         char how[40] = "";
         if (aa > 1) snprintf(how, sizeof how, " with antialias %.0f", aa);
-        return fail(c, PRAY_ERR_LIMIT, "image of %d x %d pixels%s is over the limit of %.0f samples (option maxpixels)",
-                    W, H, how, lim);
+        return fail(c, PRAY_ERR_LIMIT, "image of %d x %d pixels%s is over the limit of %.0f sample%s (option maxpixels)",
+                    W, H, how, lim, lim == 1 ? "" : "s");
     }
     return PRAY_OK;
 }
@@ -10615,8 +10616,8 @@ pray_status lex_string(Lexer &L) {
         st = lex_text_char(L, &n);
         if (st) break;
         if ((double)t.a.n + n > L.maxstring) {
-            st = perr(L.c, L.name, line, col, PRAY_ERR_LIMIT, "string longer than %.0f bytes (option maxstring)",
-                      L.maxstring);
+            st = perr(L.c, L.name, line, col, PRAY_ERR_LIMIT, "string longer than %.0f byte%s (option maxstring)",
+                      L.maxstring, L.maxstring == 1 ? "" : "s");
             break;
         }
         if (!t.add(L.c, (const char *)L.p, (size_t)n)) {
@@ -10656,8 +10657,8 @@ pray_status check_line_lengths(Lexer &L) {
             line++;
             col = 0;
         } else if ((*q & 0xC0) != 0x80 && ++col > lim) {
-            return perr(L.c, L.name, line, (int)col, PRAY_ERR_LIMIT, "line longer than %.0f characters (option maxline)",
-                        lim);
+            return perr(L.c, L.name, line, (int)col, PRAY_ERR_LIMIT, "line longer than %.0f character%s (option maxline)",
+                        lim, lim == 1 ? "" : "s");
         }
     }
     return PRAY_OK;
@@ -12083,7 +12084,7 @@ pray_status concat(Interp &I, const Expr *e, const Value &a, const Value &b, Val
     double lim = I.c->cur.opt.v[OPT_MAXSTRING];
     if (ok && t.a.n > lim) {
         t.a.release(I.c);
-        return rerr(I, e, PRAY_ERR_LIMIT, "string longer than %.0f bytes (option maxstring)", lim);
+        return rerr(I, e, PRAY_ERR_LIMIT, "string longer than %.0f byte%s (option maxstring)", lim, lim == 1 ? "" : "s");
     }
     Str *s = ok ? str_new(I.c, t.str(), (size_t)t.a.n) : NULL;
     t.a.release(I.c);
@@ -12424,7 +12425,7 @@ PRAY_NOINLINE pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
     double most = c->cur.opt.v[OPT_MAXFRAMES];
     if (most > 0 && I.frames >= most) {
         release_handle(c, all);
-        fail(c, PRAY_ERR_LIMIT, "more than %.0f frames (option maxframes)", most);
+        fail(c, PRAY_ERR_LIMIT, "more than %.0f frame%s (option maxframes)", most, most == 1 ? "" : "s");
         return api_err(I, s->line, s->col);
     }
     // the output option, else the program's name with .tif; the frame's name adds _NNNN
@@ -12517,7 +12518,7 @@ pray_status step(Interp &I, const Stmt *s) {
     double lim = I.c->cur.opt.v[OPT_MAXSTEPS];
     if (lim > 0 && I.steps > lim)
         return perr(I.c, I.name, s->line, s->col, PRAY_ERR_LIMIT,
-                    "the program was stopped after %.0f statements (option maxsteps)", lim);
+                    "the program was stopped after %.0f statement%s (option maxsteps)", lim, lim == 1 ? "" : "s");
     return PRAY_OK;
 }
 
@@ -13277,15 +13278,16 @@ pray_status render_part(void *ud, pray_ctx *c, pray_object *root, pray_light *li
     char msg[200];
     if (sp->n) {
         if (sp->n > H) {
-            snprintf(msg, sizeof msg, "--part %d/%d: an image of %d rows cannot be cut into %d parts", sp->k, sp->n,
-                     H, sp->n);
+            snprintf(msg, sizeof msg, "--part %d/%d: an image of %d row%s cannot be cut into %d parts", sp->k, sp->n,
+                     H, H == 1 ? "" : "s", sp->n);
             return pray_set_error(c, PRAY_ERR_ARG, msg);
         }
         sp->y0 = (int)((unsigned long)(sp->k - 1) * (unsigned long)H / (unsigned long)sp->n);
         sp->y1 = (int)((unsigned long)sp->k * (unsigned long)H / (unsigned long)sp->n);
     } else {
         if (sp->row1 > H) {
-            snprintf(msg, sizeof msg, "--rows %d:%d is not inside the image of %d rows", sp->row0, sp->row1, H);
+            snprintf(msg, sizeof msg, "--rows %d:%d is not inside the image of %d row%s", sp->row0, sp->row1, H,
+                     H == 1 ? "" : "s");
             return pray_set_error(c, PRAY_ERR_ARG, msg);
         }
         sp->y0 = sp->row0;
@@ -13502,8 +13504,8 @@ int read_part(pray_ctx *c, Part *pt) {
             return 1;
         }
         if (pt->rows != pt->row1 - pt->row0) {
-            fprintf(stderr, "pray: error: '%s' holds %d rows, but its note says rows %d:%d\n", pt->name, pt->rows,
-                    pt->row0, pt->row1);
+            fprintf(stderr, "pray: error: '%s' holds %d row%s, but its note says rows %d:%d\n", pt->name, pt->rows,
+                    pt->rows == 1 ? "" : "s", pt->row0, pt->row1);
             return 1;
         }
     }
@@ -13658,7 +13660,7 @@ int main(int argc, char **argv) {
         fprintf(stderr, "pray: error: out of memory\n");
         return 1;
     }
-    const char *program = NULL;
+    const char *program = NULL, *output = NULL;  // output: as -o or -D output= named it
     int stats = 0, quiet = 0, rc = 0;
     Split sp;
     memset(&sp, 0, sizeof sp);
@@ -13728,7 +13730,10 @@ int main(int argc, char **argv) {
                 break;
             }
             i++;
-            if (a[1] == 'o') st = pray_option_fix(c, "output", next);
+            if (a[1] == 'o') {
+                st = pray_option_fix(c, "output", next);
+                output = next;
+            }
             else if (a[1] == '-') st = pray_option_fix(c, "threads", next);
             else if (a[1] == 's') {
                 char w[32], h[32];
@@ -13757,6 +13762,7 @@ int main(int argc, char **argv) {
                 memcpy(name, next, (size_t)(eq - next));
                 name[eq - next] = 0;
                 st = pray_option_fix(c, name, eq + 1);
+                if (strcmp(name, "output") == 0) output = eq + 1;
                 free(name);
             }
         } else if (a[0] == '-' && a[1] != 0) {
@@ -13773,6 +13779,11 @@ int main(int argc, char **argv) {
         }
     }
     if (rc == 0 && !program) rc = usage_error("no program given%s", "");
+    if (rc == 0 && output && image_format(output) == FMT_PNG && pray_option_get(c, "bits") != 8) {
+        fprintf(stderr, "pray: error: option 'bits': %.0f, but PNG output has 8 bits only ('%s': use .tif or .ppm)\n",
+                pray_option_get(c, "bits"), *ShownPath(output));
+        rc = 2;
+    }
     if (rc != 0) {
         pray_free(c);
         return rc;

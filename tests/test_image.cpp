@@ -884,6 +884,27 @@ TEST_CASE("command line: no output replaces a file the program read (an include,
     pray_free(c);
 }
 
+TEST_CASE("command line: 16 bits with a PNG output is an error of the options (exit 2), found before the program runs") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    if (std::string(pray_features()).find("png") == std::string::npos) return;
+    TempDir d;
+    spit(d / "p.ray", "print \"ran\"\nrendertiff nothing\n");
+    const std::string cd = "cd " + sq(d.path) + " && " + fs::absolute(testkit::pray_program()).string() + " -s 8x8 ";
+    std::string out;
+    for (const char *args : {"-D bits=16 -o x.png", "-o x.png -D bits=16", "-D output=x.PNG -D bits=16"}) {
+        CAPTURE(args);
+        CHECK(run_cmd(cd + args + " p.ray", &out) == 2);
+        std::string name = strstr(args, "PNG") ? "x.PNG" : "x.png";
+        CHECK(out == "pray: error: option 'bits': 16, but PNG output has 8 bits only ('" + name + "': use .tif or .ppm)\n");
+    }
+    // a program's own option is found where it renders
+    spit(d / "q.ray", "option \"bits\", 16\nrendertiff nothing\n");
+    CHECK(run_cmd(cd + "-o x.png q.ray", &out) == 1);
+    CHECK(out == "q.ray:2:1: error: PNG output has 8 bits only\n");
+    CHECK(run_cmd(cd + "-D bits=16 -o x.tif p.ray", &out) == 0);
+    CHECK(d.listing() == "p.ray q.ray x.tif");
+}
+
 TEST_CASE("command line: a FIFO, a directory or a device as program or texture is an error, never a hang") {
     REQUIRE_MESSAGE(have_pray(), NO_PRAY);
     TempDir d;
