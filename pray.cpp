@@ -13128,7 +13128,7 @@ pray_status pray_render_file(const char *program, const char *const *options, in
 
 #ifdef PRAY_MAIN
 // =============================================================================================
-// [SECTION] 16 Command-line program (public API only)
+// [SECTION] 16 Command-line program (the public API; files opened and compared as the library does)
 // =============================================================================================
 #if !PRAY_HAS_INTERP || !PRAY_HAS_STDIO
 #error "the command-line program needs the interpreter and stdio"
@@ -13327,10 +13327,15 @@ void hash_bytes(unsigned long h[2], const void *p, size_t n) {
 }
 
 // The id of a render: the program's bytes and the arguments that shape its images (not -o,
-// --threads, --quiet, --stats, nor the choice of rows and frames).
-void render_id(char out[17], const char *program, int argc, char **argv) {
+// --threads, --quiet, --stats, nor the choice of rows and frames). The program is opened as the
+// run will open it (open_read: no waiting on a FIFO, no endless device); when that fails, the run
+// says why.
+void render_id(pray_ctx *c, char out[17], const char *program, int argc, char **argv) {
     unsigned long h[2] = {2166136261UL, 3735928559UL};
-    FILE *f = strcmp(program, "-") == 0 ? NULL : fopen(program, "rb");
+    char *opened = NULL;
+    FILE *f = strcmp(program, "-") == 0 ? NULL : open_read(c, "", 0, program, FIND_AS_NAMED, &opened, NULL);
+    mem_free(c, opened);
+    pray_clear_error(c);
     if (f) {
         char buf[8192];
         size_t n;
@@ -13792,7 +13797,7 @@ int main(int argc, char **argv) {
     pray_set_warning(c, to_stderr, NULL);
     if (sp.row1 || sp.n || sp.frame1) pray_set_render(c, render_part, &sp);
     if (sp.row1 || sp.n) {
-        render_id(sp.id, program, argc, argv);
+        render_id(c, sp.id, program, argc, argv);
         pray_set_frame(c, write_part, &sp);
     }
     FrameLog flog;

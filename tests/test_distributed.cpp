@@ -432,6 +432,15 @@ TEST_CASE("command line: --join opens parts as programs, reads no more than thei
                      q(part), &out) == 3);
         CHECK(out == "pray: error: cannot read '" + part + "': not a regular file\n");
     }
+    // the same as the program of --part and --rows, whose id is a hash of its bytes
+    REQUIRE(mkfifo((d / "fifo.ray").c_str(), 0600) == 0);
+    for (const char *split : {"--part 1/2", "--rows 0:4"}) {
+        CAPTURE(split);
+        CHECK(sh("timeout 20 " + pray_cmd(std::string("-s 8x8 ") + split + " -o " + q(d / "x.ppm") + " " +
+                                          q(d / "fifo.ray")), &out) == 3);
+        CHECK(out == "pray: error: cannot read '" + d / "fifo.ray" + "': not a regular file\n");
+    }
+    fs::remove(d / "fifo.ray");
     // a part cut short or longer than its header says (in both formats)
     spit(d / "short.ppm", p2.substr(0, p2.size() - 1));
     spit(d / "long.ppm", p2 + "x");
