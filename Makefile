@@ -20,6 +20,7 @@
 #   make tsan       ThreadSanitizer: a render cancelled from another thread, two contexts at once
 #   make fuzz       build the libFuzzer harness and fuzz for FUZZ_SECONDS (needs clang)
 #   make fuzz-tiff  the same for the TIFF reader (textures and font atlases)
+#   make fuzz-join  the same for the row parts that pray --join reads
 #   make fuzz-long  the program harness on long inputs, from generated chains of 20000 operators
 #   make clean
 
@@ -40,7 +41,7 @@ TESTS = tests/pray_tests$(EXE)
 TESTS_FLOAT = tests/pray_tests_float$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
-.PHONY: FORCE all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff fuzz-long textures gallery ports pov suite charts mpi mpi-deps check-mpi
+.PHONY: FORCE all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff fuzz-join fuzz-long textures gallery ports pov suite charts mpi mpi-deps check-mpi
 
 all: $(PRAY)
 
@@ -210,6 +211,15 @@ fuzz-tiff: build/fuzz/fuzz_tiff
 	@mkdir -p build/fuzz/corpus_tiff build/fuzz/artifacts
 	build/fuzz/fuzz_tiff -max_total_time=$(FUZZ_SECONDS) -max_len=65536 -timeout=10 \
 	  -artifact_prefix=build/fuzz/artifacts/tiff- build/fuzz/corpus_tiff tests/fuzz/corpus_tiff tests/fuzz/crashes
+# --join: the input cut into row parts at "<part>", joined by the command line's main (the
+# harness includes pray.cpp with PRAY_MAIN).
+build/fuzz/fuzz_join: tests/fuzz/fuzz_join.cpp pray.cpp pray.hpp
+	@mkdir -p build/fuzz
+	$(FUZZ_CXX) $(FUZZFLAGS) -I. tests/fuzz/fuzz_join.cpp -o $@
+fuzz-join: build/fuzz/fuzz_join
+	@mkdir -p build/fuzz/corpus_join build/fuzz/artifacts
+	build/fuzz/fuzz_join -max_total_time=$(FUZZ_SECONDS) -max_len=16384 -timeout=10 -dict=tests/fuzz/join.dict \
+	  -artifact_prefix=build/fuzz/artifacts/join- build/fuzz/corpus_join tests/fuzz/corpus_join
 
 # The textures of the examples, made by pray itself.
 textures: $(PRAY)

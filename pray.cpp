@@ -485,6 +485,13 @@ struct Block {
 };
 
 struct Coherence;  // image sequences (10b): what a program's last frame left for its next
+// A file a running program read (include, texture, font): its identity where files have one,
+// and its name as opened (compared where they have none). No image may replace it (9c: is_input).
+struct ReadFile {
+    ReadFile *next;
+    FileId id;
+    char *name;
+};
 
 // A texture the host registered under a name (pray_texture_register).
 struct TexName {
@@ -556,6 +563,7 @@ struct pray_ctx {
     size_t run_dir_len;      // (0: the current directory), for texture files
     FileId prog_id;          // the program file being run, which no image may replace
     const char *prog_name;   // its name (compared where files have no identity)
+    ReadFile *inputs;        // the files the last run read: includes, textures, fonts (note_input)
     char *volatile temp_name;  // the temporary file being written now (pray_temp_file)
     unsigned temp_serial;    // makes temporary names unique
     double written;          // bytes of image files written by this run (option maxoutput)
@@ -1272,7 +1280,7 @@ pray_object *csg_make(pray_ctx *c, int op, pray_object *a, pray_object *b) {
     // a tree may use one part many times over; what it stands for must stay renderable
     double lim = c->cur.opt.v[OPT_MAXPRIMS];
     if ((double)a->nprims + (double)b->nprims > lim) {
-        fail(c, PRAY_ERR_LIMIT, "object of more than %.0f primitives (option maxprims)", lim);
+        fail(c, PRAY_ERR_LIMIT, "object of more than %.0f primitive%s (option maxprims)", lim, lim == 1 ? "" : "s");
         return NULL;
     }
     pray_object *o = obj_new(c, op, NULL);
@@ -6676,14 +6684,61 @@ int open_confined(const char *dir, char *name, bool *link, const char **at) {
 }
 #endif
 
-// The one way pray opens a file to read: programs, textures and fonts. The file is opened once
-// (without waiting on a FIFO) and must be a regular file; `id` gets its identity where the system
-// has one. `dir` (dlen bytes, ending in a separator) is the program's directory: FIND_BESIDE
+// Is `path` the file opened as `name` with identity `id`? By identity where files have one, else
+// by name.
+bool same_file(const char *path, const FileId &id, const char *name) {
+    FileId pid;
+    if (id.valid) return name_id(path, &pid) && same_id(pid, id);
+    const char *a = path, *b = name;
+    while (a[0] == '.' && (a[1] == '/' || a[1] == '\\')) a += 2;
+    while (b[0] == '.' && (b[1] == '/' || b[1] == '\\')) b += 2;
+#if defined(_WIN32) || defined(__DJGPP__)
+    for (; *a && *b; a++, b++) {
+        int x = *a == '\\' ? '/' : tolower((unsigned char)*a), y = *b == '\\' ? '/' : tolower((unsigned char)*b);
+        if (x != y) return false;
+    }
+    return *a == *b;
+#else
+    return strcmp(a, b) == 0;
+#endif
+}
+
+// Record a file the running program opened, once. False when out of memory.
+bool note_input(pray_ctx *c, const char *name, const FileId &id) {
+    for (ReadFile *r = c->inputs; r; r = r->next)
+        if (id.valid ? same_id(id, r->id) : strcmp(name, r->name) == 0) return true;
+    ReadFile *r = (ReadFile *)mem_alloc(c, sizeof(ReadFile));
+    char *nm = r ? mem_strdup(c, name, strlen(name)) : NULL;
+    if (!nm) {
+        mem_free(c, r);
+        return false;
+    }
+    r->next = c->inputs;
+    r->id = id;
+    r->name = nm;
+    c->inputs = r;
+    return true;
+}
+
+// Would writing `path` replace a file the running program read?
+bool is_input(pray_ctx *c, const char *path) {
+    for (ReadFile *r = c->inputs; r; r = r->next)
+        if (same_file(path, r->id, r->name)) return true;
+    return false;
+}
+
+// The one way pray opens a file to read: programs, textures, fonts, included files and the parts
+// of --join. The file is opened once (without waiting on a FIFO) and must be a regular file; `id`
+// (may be NULL) gets its identity where the system has one. While a program runs, the file is
+// recorded as one it read (note_input). `dir` (dlen bytes, ending in a separator) is the program's directory: FIND_BESIDE
 // looks for a relative name as written, then beside the program; FIND_CONFINED beside the program
 // only, without following links where the system allows (PRAY_FILES_AT; elsewhere links are
 // followed). `*path` gets the name opened (context memory, also on failure: free with mem_free).
 // NULL on failure, message set.
 FILE *open_read(pray_ctx *c, const char *dir, size_t dlen, const char *name, int how, char **path, FileId *id) {
+    FileId own;
+    if (!id) id = &own;
+    id->valid = 0;
     size_t n = strlen(name);
     char *p = (char *)mem_alloc(c, 2 * (dlen + n + 2));  // the path, and room for a walk
     *path = p;
@@ -6745,6 +6800,10 @@ FILE *open_read(pray_ctx *c, const char *dir, size_t dlen, const char *name, int
              at ? *Shown(at) : "", at ? "'" : "");
     else if (!f) fail(c, PRAY_ERR_IO, "cannot open '%s': %s", *ShownPath(first), strerror(err));
     if (first != p) memmove(p, first, strlen(first) + 1);
+    if (f && c->running && !note_input(c, p, *id)) {
+        fclose(f);
+        return NULL;
+    }
     return f;
 }
 
@@ -6827,12 +6886,22 @@ pray_texture *texture_file(pray_ctx *c, const char *dir, size_t dlen, const char
 #endif
 }
 
+// What a run leaves for the next one to start afresh: its decoded textures, and the record of the
+// files it read.
 void texture_cache_clear(pray_ctx *c) {
     while (c->textures) {
         pray_texture *t = c->textures;
         c->textures = t->next;
         release_handle(c, t);
     }
+#if PRAY_HAS_STDIO
+    while (c->inputs) {
+        ReadFile *r = c->inputs;
+        c->inputs = r->next;
+        mem_free(c, r->name);
+        mem_free(c, r);
+    }
+#endif
 }
 
 // Where the host's registration of exactly `name` is kept (pray_texture_register), else where
@@ -8119,7 +8188,8 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         run_parallel(nt, worker_main, args, starts);
         job.mu.destroy();
         if (job.over)
-            st = fail(c, PRAY_ERR_LIMIT, "a sample of the image needs more than %ld rays (option maxrays)", s->maxrays);
+            st = fail(c, PRAY_ERR_LIMIT, "a sample of the image needs more than %ld ray%s (option maxrays)", s->maxrays,
+                      s->maxrays == 1 ? "" : "s");
         else if (job.cancelled)
             st = cancelled(c) ? fail_cancelled(c) : fail(c, PRAY_ERR_CANCELLED, "cancelled by the progress callback");
     }
@@ -9001,23 +9071,7 @@ void file_put(void *ud, const void *p, size_t n) {
 }
 
 // Is `path` the program being run? By identity where files have one, else by name.
-bool is_program(pray_ctx *c, const char *path) {
-    if (!c->prog_name) return false;
-    FileId id;
-    if (c->prog_id.valid) return name_id(path, &id) && same_id(id, c->prog_id);
-    const char *a = path, *b = c->prog_name;
-    while (a[0] == '.' && (a[1] == '/' || a[1] == '\\')) a += 2;
-    while (b[0] == '.' && (b[1] == '/' || b[1] == '\\')) b += 2;
-#if defined(_WIN32) || defined(__DJGPP__)
-    for (; *a && *b; a++, b++) {
-        int x = *a == '\\' ? '/' : tolower((unsigned char)*a), y = *b == '\\' ? '/' : tolower((unsigned char)*b);
-        if (x != y) return false;
-    }
-    return *a == *b;
-#else
-    return strcmp(a, b) == 0;
-#endif
-}
+bool is_program(pray_ctx *c, const char *path) { return c->prog_name && same_file(path, c->prog_id, c->prog_name); }
 
 // Create a temporary file beside `path`, exclusively, never through a link, under a name no
 // other writer uses: ".NAME.XXXXXX" + PRAY_TEMP_SUFFIX (NAME: the file's name, cut to 32 bytes,
@@ -9982,8 +10036,8 @@ pray_status image_limits(pray_ctx *c) {
     if ((double)W * H * aa * aa > lim) {
         char how[40] = "";
         if (aa > 1) snprintf(how, sizeof how, " with antialias %.0f", aa);
-        return fail(c, PRAY_ERR_LIMIT, "image of %d x %d pixels%s is over the limit of %.0f samples (option maxpixels)",
-                    W, H, how, lim);
+        return fail(c, PRAY_ERR_LIMIT, "image of %d x %d pixels%s is over the limit of %.0f sample%s (option maxpixels)",
+                    W, H, how, lim, lim == 1 ? "" : "s");
     }
     return PRAY_OK;
 }
@@ -10253,6 +10307,9 @@ pray_status write_image_file(pray_ctx *c, const pray_image *img, const char *pat
 #if PRAY_HAS_STDIO
     if (is_program(c, path))
         return fail(c, PRAY_ERR_IO, "cannot write '%s': it is the program being run (choose another output name)",
+                    *ShownPath(path));
+    if (c->running && is_input(c, path))
+        return fail(c, PRAY_ERR_IO, "cannot write '%s': the program reads it (choose another output name)",
                     *ShownPath(path));
     // written under a temporary name, then renamed: the file is whole or not there
     char *tmp = NULL;
@@ -10625,8 +10682,8 @@ pray_status lex_string(Lexer &L) {
         st = lex_text_char(L, &n);
         if (st) break;
         if ((double)t.a.n + n > L.maxstring) {
-            st = perr(L.c, L.name, line, col, PRAY_ERR_LIMIT, "string longer than %.0f bytes (option maxstring)",
-                      L.maxstring);
+            st = perr(L.c, L.name, line, col, PRAY_ERR_LIMIT, "string longer than %.0f byte%s (option maxstring)",
+                      L.maxstring, L.maxstring == 1 ? "" : "s");
             break;
         }
         if (!t.add(L.c, (const char *)L.p, (size_t)n)) {
@@ -10666,8 +10723,8 @@ pray_status check_line_lengths(Lexer &L) {
             line++;
             col = 0;
         } else if ((*q & 0xC0) != 0x80 && ++col > lim) {
-            return perr(L.c, L.name, line, (int)col, PRAY_ERR_LIMIT, "line longer than %.0f characters (option maxline)",
-                        lim);
+            return perr(L.c, L.name, line, (int)col, PRAY_ERR_LIMIT, "line longer than %.0f character%s (option maxline)",
+                        lim, lim == 1 ? "" : "s");
         }
     }
     return PRAY_OK;
@@ -12107,7 +12164,7 @@ pray_status concat(Interp &I, const Expr *e, const Value &a, const Value &b, Val
     double lim = I.c->cur.opt.v[OPT_MAXSTRING];
     if (ok && t.a.n > lim) {
         t.a.release(I.c);
-        return rerr(I, e, PRAY_ERR_LIMIT, "string longer than %.0f bytes (option maxstring)", lim);
+        return rerr(I, e, PRAY_ERR_LIMIT, "string longer than %.0f byte%s (option maxstring)", lim, lim == 1 ? "" : "s");
     }
     Str *s = ok ? str_new(I.c, t.str(), (size_t)t.a.n) : NULL;
     t.a.release(I.c);
@@ -12448,7 +12505,7 @@ PRAY_NOINLINE pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
     double most = c->cur.opt.v[OPT_MAXFRAMES];
     if (most > 0 && I.frames >= most) {
         release_handle(c, all);
-        fail(c, PRAY_ERR_LIMIT, "more than %.0f frames (option maxframes)", most);
+        fail(c, PRAY_ERR_LIMIT, "more than %.0f frame%s (option maxframes)", most, most == 1 ? "" : "s");
         return api_err(I, s->line, s->col);
     }
     // the output option, else the program's name with .tif; the frame's name adds _NNNN
@@ -12544,7 +12601,7 @@ pray_status step(Interp &I, const Stmt *s) {
     double lim = I.c->cur.opt.v[OPT_MAXSTEPS];
     if (lim > 0 && I.steps > lim)
         return perr(I.c, I.name, s->line, s->col, PRAY_ERR_LIMIT,
-                    "the program was stopped after %.0f statements (option maxsteps)", lim);
+                    "the program was stopped after %.0f statement%s (option maxsteps)", lim, lim == 1 ? "" : "s");
     return PRAY_OK;
 }
 
@@ -12582,8 +12639,8 @@ pray_status include_steps(Interp &I, const char *text, size_t n) {
     I.steps += lines;
     double lim = I.c->cur.opt.v[OPT_MAXSTEPS];
     if (lim > 0 && I.steps > lim)
-        return fail(I.c, PRAY_ERR_LIMIT, "the program was stopped after %.0f statements (option maxsteps; each line "
-                    "an include reads counts as one)", lim);
+        return fail(I.c, PRAY_ERR_LIMIT, "the program was stopped after %.0f statement%s (option maxsteps; each line "
+                    "an include reads counts as one)", lim, lim == 1 ? "" : "s");
     return PRAY_OK;
 }
 
@@ -13184,7 +13241,7 @@ pray_status pray_render_file(const char *program, const char *const *options, in
 
 #ifdef PRAY_MAIN
 // =============================================================================================
-// [SECTION] 16 Command-line program (public API only)
+// [SECTION] 16 Command-line program (the public API; files opened and compared as the library does)
 // =============================================================================================
 #if !PRAY_HAS_INTERP || !PRAY_HAS_STDIO
 #error "the command-line program needs the interpreter and stdio"
@@ -13334,15 +13391,16 @@ pray_status render_part(void *ud, pray_ctx *c, pray_object *root, pray_light *li
     char msg[200];
     if (sp->n) {
         if (sp->n > H) {
-            snprintf(msg, sizeof msg, "--part %d/%d: an image of %d rows cannot be cut into %d parts", sp->k, sp->n,
-                     H, sp->n);
+            snprintf(msg, sizeof msg, "--part %d/%d: an image of %d row%s cannot be cut into %d parts", sp->k, sp->n,
+                     H, H == 1 ? "" : "s", sp->n);
             return pray_set_error(c, PRAY_ERR_ARG, msg);
         }
         sp->y0 = (int)((unsigned long)(sp->k - 1) * (unsigned long)H / (unsigned long)sp->n);
         sp->y1 = (int)((unsigned long)sp->k * (unsigned long)H / (unsigned long)sp->n);
     } else {
         if (sp->row1 > H) {
-            snprintf(msg, sizeof msg, "--rows %d:%d is not inside the image of %d rows", sp->row0, sp->row1, H);
+            snprintf(msg, sizeof msg, "--rows %d:%d is not inside the image of %d row%s", sp->row0, sp->row1, H,
+                     H == 1 ? "" : "s");
             return pray_set_error(c, PRAY_ERR_ARG, msg);
         }
         sp->y0 = sp->row0;
@@ -13382,10 +13440,15 @@ void hash_bytes(unsigned long h[2], const void *p, size_t n) {
 }
 
 // The id of a render: the program's bytes and the arguments that shape its images (not -o,
-// --threads, --quiet, --stats, nor the choice of rows and frames).
-void render_id(char out[17], const char *program, int argc, char **argv) {
+// --threads, --quiet, --stats, nor the choice of rows and frames). The program is opened as the
+// run will open it (open_read: no waiting on a FIFO, no endless device); when that fails, the run
+// says why.
+void render_id(pray_ctx *c, char out[17], const char *program, int argc, char **argv) {
     unsigned long h[2] = {2166136261UL, 3735928559UL};
-    FILE *f = strcmp(program, "-") == 0 ? NULL : fopen(program, "rb");
+    char *opened = NULL;
+    FILE *f = strcmp(program, "-") == 0 ? NULL : open_read(c, "", 0, program, FIND_AS_NAMED, &opened, NULL);
+    mem_free(c, opened);
+    pray_clear_error(c);
     if (f) {
         char buf[8192];
         size_t n;
@@ -13414,52 +13477,43 @@ void render_id(char out[17], const char *program, int argc, char **argv) {
 // ---- pray --join OUT PART... ----
 struct Part {
     const char *name;
+    FileId id;            // which no output may replace
     unsigned char *file;  // the whole file
     const unsigned char *samples;
     int width, rows, bits, big_endian;
     int row0, row1, height, frame;
-    char id[17];
+    char id_text[17];
 };
 
 unsigned rd16(const unsigned char *p) { return (unsigned)p[0] | (unsigned)p[1] << 8; }
 unsigned long rd32(const unsigned char *p) { return (unsigned long)rd16(p) | (unsigned long)rd16(p + 2) << 16; }
 
-// Read a part written by pray --rows: a TIFF or PPM file as pray writes them, with its note.
-// Returns 0, or the exit status after printing the error.
-int read_part(Part *pt) {
-    FILE *f = fopen(pt->name, "rb");
+// The most a part's header takes, its note included: the samples start within this many bytes.
+const size_t PART_HEAD = 2048;
+
+// Read a part written by pray --rows: a TIFF or PPM file as pray writes them, with its note. It
+// is opened as programs are (open_read: a regular file, no waiting on a FIFO); its header is read
+// first, and then no more than the samples it claims. Returns 0, or the exit status after
+// printing the error.
+int read_part(pray_ctx *c, Part *pt) {
+    char *opened = NULL;
+    FILE *f = open_read(c, "", 0, pt->name, FIND_AS_NAMED, &opened, &pt->id);
+    mem_free(c, opened);
     if (!f) {
-        fprintf(stderr, "pray: error: cannot read '%s': %s\n", pt->name, strerror(errno));
-        return 3;
+        fprintf(stderr, "pray: %s\n", pray_error(c));
+        return exit_code(pray_last_status(c));
     }
-    size_t size = 0, cap = 0;
-    unsigned char *buf = NULL;
-    for (;;) {
-        if (size == cap) {
-            cap = cap ? cap * 2 : 65536;
-            unsigned char *nb = (unsigned char *)realloc(buf, cap);
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                fprintf(stderr, "pray: error: out of memory reading '%s'\n", pt->name);
-                return 1;
-            }
-            buf = nb;
-        }
-        size_t n = fread(buf + size, 1, cap - size, f);
-        if (n == 0) break;
-        size += n;
-    }
-    int bad = ferror(f);
-    fclose(f);
-    pt->file = buf;
-    if (bad) {
-        fprintf(stderr, "pray: error: cannot read '%s'\n", pt->name);
+    unsigned char buf[PART_HEAD];
+    size_t size = fread(buf, 1, sizeof buf, f);
+    if (ferror(f)) {
+        fclose(f);
+        fprintf(stderr, "pray: error: cannot read '%s': %s\n", pt->name, strerror(errno ? errno : EIO));
         return 3;
     }
     char note[PRAY_NOTE_MAX + 1] = "";
     size_t data = 0;
     int maxval = 0;
+    double whole = 0;
     if (size >= 8 && memcmp(buf, "II*\0", 4) == 0) {  // TIFF: the tags pray writes
         unsigned long ifd = rd32(buf + 4), tiff_data = 0, bytes = 0, desc = 0, desc_n = 0, bps_at = 0;
         unsigned comp = 0, photo = 0, spp = 0;
@@ -13512,16 +13566,46 @@ int read_part(Part *pt) {
         text[k] = 0;
         int used = 0;
         if (head != 2 || sscanf(text, "%d %d\n%d\n%n", &pt->width, &pt->rows, &maxval, &used) != 3 ||
-            used != (int)k || (maxval != 255 && maxval != 65535) || pt->width < 1 || pt->rows < 1)
+            used != (int)k || (maxval != 255 && maxval != 65535) || pt->width < 1 || pt->rows < 1 ||
+            pt->width > 65536 || pt->rows > 65536)
             goto not_pray;
         pt->bits = maxval == 255 ? 8 : 16;
         pt->big_endian = 1;
         data = i + k;
     } else
         goto not_pray;
-    if (data > size || (size - data) / 3 / (size_t)(pt->bits / 8) / (size_t)pt->width < (size_t)pt->rows)
-        goto not_pray;
-    pt->samples = buf + data;
+    // the whole file: the header and the samples it claims, no more and no less
+    whole = (double)data + (double)pt->width * pt->rows * 3 * (pt->bits / 8);
+    if (data > size || whole > (double)(size_t)-1 / 2) goto not_pray;
+    {
+        long end = fseek(f, 0, SEEK_END) == 0 ? ftell(f) : -1;
+        if (end >= 0 && (double)end != whole) {
+            fclose(f);
+            if ((double)end < whole)
+                fprintf(stderr, "pray: error: '%s' is cut short: its header says %.0f bytes, the file has %ld\n",
+                        pt->name, whole, end);
+            else
+                fprintf(stderr, "pray: error: '%s' has %ld bytes, more than the %.0f its header says\n", pt->name,
+                        end, whole);
+            return 1;
+        }
+        size_t n = (size_t)whole;
+        pt->file = (unsigned char *)malloc(n + 1);
+        if (!pt->file) {
+            fclose(f);
+            fprintf(stderr, "pray: error: out of memory reading '%s'\n", pt->name);
+            return 1;
+        }
+        size_t got = fseek(f, 0, SEEK_SET) == 0 ? fread(pt->file, 1, n + 1, f) : 0;
+        int bad = ferror(f);
+        fclose(f);
+        if (bad || got != n) {
+            fprintf(stderr, "pray: error: cannot read '%s': %s\n", pt->name,
+                    bad ? strerror(errno ? errno : EIO) : "its size changed while it was read");
+            return 3;
+        }
+        pt->samples = pt->file + data;
+    }
     {
         int used = 0;
         if (!note[0]) {
@@ -13531,20 +13615,21 @@ int read_part(Part *pt) {
         }
         for (char *ch = note; *ch; ch++)
             if (*ch < 32 || *ch > 126) *ch = '?';  // shown in the message below
-        if (sscanf(note, PART_NOTE "%n", &pt->row0, &pt->row1, &pt->height, &pt->frame, pt->id, &used) != 5 ||
-            used != (int)strlen(note) || strlen(pt->id) != 16 || pt->row0 < 0 || pt->row1 <= pt->row0 ||
+        if (sscanf(note, PART_NOTE "%n", &pt->row0, &pt->row1, &pt->height, &pt->frame, pt->id_text, &used) != 5 ||
+            used != (int)strlen(note) || strlen(pt->id_text) != 16 || pt->row0 < 0 || pt->row1 <= pt->row0 ||
             pt->row1 > pt->height || pt->frame < 0) {
             fprintf(stderr, "pray: error: '%s' is not a row part: its note is '%s'\n", pt->name, note);
             return 1;
         }
         if (pt->rows != pt->row1 - pt->row0) {
-            fprintf(stderr, "pray: error: '%s' holds %d rows, but its note says rows %d:%d\n", pt->name, pt->rows,
-                    pt->row0, pt->row1);
+            fprintf(stderr, "pray: error: '%s' holds %d row%s, but its note says rows %d:%d\n", pt->name, pt->rows,
+                    pt->rows == 1 ? "" : "s", pt->row0, pt->row1);
             return 1;
         }
     }
     return 0;
 not_pray:
+    fclose(f);
     fprintf(stderr, "pray: error: '%s' is not a TIFF or PPM file as pray writes them\n", pt->name);
     return 1;
 }
@@ -13561,18 +13646,24 @@ int join_parts(pray_ctx *c, const char *out, char **names, int n) {
     }
     for (int i = 0; i < n && rc == 0; i++) {
         p[i].name = names[i];
-        rc = read_part(&p[i]);
+        rc = read_part(c, &p[i]);
     }
+    for (int i = 0; i < n && rc == 0; i++)  // the output may not replace a part
+        if (same_file(out, p[i].id, p[i].name)) {
+            fprintf(stderr, "pray: error: cannot write '%s': it is the part '%s' (choose another output name)\n", out,
+                    p[i].name);
+            rc = 3;
+        }
     for (int i = 1; i < n && rc == 0; i++) {
         const Part &a = p[0], &b = p[i];
         if (b.width != a.width || b.bits != a.bits || b.height != a.height || b.frame != a.frame ||
-            strcmp(b.id, a.id) != 0) {
+            strcmp(b.id_text, a.id_text) != 0) {
             fprintf(stderr, "pray: error: '%s' and '%s' are parts of different images: ", a.name, b.name);
             if (b.width != a.width) fprintf(stderr, "%d and %d pixels wide\n", a.width, b.width);
             else if (b.bits != a.bits) fprintf(stderr, "%d and %d bits\n", a.bits, b.bits);
             else if (b.height != a.height) fprintf(stderr, "of %d and %d rows\n", a.height, b.height);
             else if (b.frame != a.frame) fprintf(stderr, "frames %d and %d\n", a.frame, b.frame);
-            else fprintf(stderr, "renders %s and %s (another program or other options)\n", a.id, b.id);
+            else fprintf(stderr, "renders %s and %s (another program or other options)\n", a.id_text, b.id_text);
             rc = 1;
         }
     }
@@ -13645,8 +13736,8 @@ int join_parts(pray_ctx *c, const char *out, char **names, int n) {
     return rc;
 }
 
-// SIGINT and SIGTERM while an image is written: remove its temporary file, then die of the
-// signal as the default would. Only async-signal-safe calls.
+// A signal that ends pray while an image is written (SIGINT, SIGTERM, SIGHUP, SIGQUIT): remove
+// its temporary file, then die of the signal as the default would. Only async-signal-safe calls.
 pray_ctx *volatile the_ctx;
 extern "C" void on_signal(int sig) {
     const char *t = the_ctx ? pray_temp_file(the_ctx) : NULL;
@@ -13659,15 +13750,35 @@ extern "C" void on_signal(int sig) {
     raise(sig);
 }
 
+// Catch those signals during a run of `c` (c NULL: give them back their default). Systems without
+// some of them (DOS, Windows) catch the others.
+void catch_signals(pray_ctx *c) {
+    void (*h)(int) = c ? on_signal : SIG_DFL;
+    if (c) the_ctx = c;
+    signal(SIGINT, h);
+    signal(SIGTERM, h);
+#ifdef SIGHUP
+    signal(SIGHUP, h);
+#endif
+#ifdef SIGQUIT
+    signal(SIGQUIT, h);
+#endif
+    if (!c) the_ctx = NULL;
+}
+
 } // namespace
 
 int main(int argc, char **argv) {
+#ifdef SIGXFSZ
+    // a file over the size limit (ulimit -f): a write error (EFBIG) like any other, not death
+    signal(SIGXFSZ, SIG_IGN);
+#endif
     pray_ctx *c = pray_new();
     if (!c) {
         fprintf(stderr, "pray: error: out of memory\n");
         return 1;
     }
-    const char *program = NULL;
+    const char *program = NULL, *output = NULL;  // output: as -o or -D output= named it
     int stats = 0, quiet = 0, rc = 0;
     Split sp;
     memset(&sp, 0, sizeof sp);
@@ -13677,13 +13788,9 @@ int main(int argc, char **argv) {
         else {
             for (int i = 3; i < argc && rc == 0; i++)
                 if (argv[i][0] == '-' && argv[i][1]) rc = usage_error("--join takes file names only, not '%s'", argv[i]);
-            the_ctx = c;
-            signal(SIGINT, on_signal);
-            signal(SIGTERM, on_signal);
+            catch_signals(c);
             if (rc == 0) rc = join_parts(c, argv[2], argv + 3, argc - 3);
-            signal(SIGINT, SIG_DFL);
-            signal(SIGTERM, SIG_DFL);
-            the_ctx = NULL;
+            catch_signals(NULL);
         }
         pray_free(c);
         return rc;
@@ -13741,7 +13848,10 @@ int main(int argc, char **argv) {
                 break;
             }
             i++;
-            if (a[1] == 'o') st = pray_option_fix(c, "output", next);
+            if (a[1] == 'o') {
+                st = pray_option_fix(c, "output", next);
+                output = next;
+            }
             else if (a[1] == '-') st = pray_option_fix(c, "threads", next);
             else if (a[1] == 's') {
                 char w[32], h[32];
@@ -13770,6 +13880,7 @@ int main(int argc, char **argv) {
                 memcpy(name, next, (size_t)(eq - next));
                 name[eq - next] = 0;
                 st = pray_option_fix(c, name, eq + 1);
+                if (strcmp(name, "output") == 0) output = eq + 1;
                 free(name);
             }
         } else if (a[0] == '-' && a[1] != 0) {
@@ -13786,6 +13897,11 @@ int main(int argc, char **argv) {
         }
     }
     if (rc == 0 && !program) rc = usage_error("no program given%s", "");
+    if (rc == 0 && output && image_format(output) == FMT_PNG && pray_option_get(c, "bits") != 8) {
+        fprintf(stderr, "pray: error: option 'bits': %.0f, but PNG output has 8 bits only ('%s': use .tif or .ppm)\n",
+                pray_option_get(c, "bits"), *ShownPath(output));
+        rc = 2;
+    }
     if (rc != 0) {
         pray_free(c);
         return rc;
@@ -13794,20 +13910,16 @@ int main(int argc, char **argv) {
     pray_set_warning(c, to_stderr, NULL);
     if (sp.row1 || sp.n || sp.frame1) pray_set_render(c, render_part, &sp);
     if (sp.row1 || sp.n) {
-        render_id(sp.id, program, argc, argv);
+        render_id(c, sp.id, program, argc, argv);
         pray_set_frame(c, write_part, &sp);
     }
     FrameLog flog;
     memset(&flog, 0, sizeof flog);
     flog.c = c;
     if (stats && !sp.row1 && !sp.n) pray_set_frame(c, log_frame, &flog);
-    the_ctx = c;
-    signal(SIGINT, on_signal);
-    signal(SIGTERM, on_signal);
+    catch_signals(c);
     pray_status st = pray_run_file(c, program);
-    signal(SIGINT, SIG_DFL);
-    signal(SIGTERM, SIG_DFL);
-    the_ctx = NULL;
+    catch_signals(NULL);
     if (st != PRAY_OK) {
         const char *m = pray_error(c);
         if (strncmp(m, "error: ", 7) == 0) fprintf(stderr, "pray: %s\n", m);

@@ -8,6 +8,7 @@
 #include "testkit.hpp"
 #include "tempfiles.hpp"
 
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -390,7 +391,7 @@ TEST_CASE("command line: bad splits and parts that do not belong together: a cle
         {p123 + " " + q(d / "plain.tif"), 1,
          "pray: error: '" + d / "plain.tif" + "' is not a row part: it has no note of its rows (pray --rows or --part writes them)\n"},
         {p123 + " " + q(d / "junk.tif"), 1, "pray: error: '" + d / "junk.tif" + "' is not a TIFF or PPM file as pray writes them\n"},
-        {p123 + " " + q(d / "none.tif"), 3, "pray: error: cannot read '" + d / "none.tif" + "': No such file or directory\n"},
+        {p123 + " " + q(d / "none.tif"), 3, "pray: error: cannot open '" + d / "none.tif" + "': No such file or directory\n"},
     };
     for (const Join &j : joins) {
         CAPTURE(j.parts);
@@ -415,4 +416,84 @@ TEST_CASE("command line: bad splits and parts that do not belong together: a cle
     CHECK(sh(testkit::pray_shell() + " --join " + q(d / "out.tif") + p123 + " " + q(d / "p4.tif"), &out) == 0);
     REQUIRE(sh(pray_cmd("-s 32x32 -o " + q(d / "whole.tif") + csg), &out) == 0);
     CHECK(slurp(d / "out.tif") == slurp(d / "whole.tif"));
+}
+
+TEST_CASE("command line: --join opens parts as programs, reads no more than their headers claim, never writes over one") {
+    Dir d;
+    std::string out;
+    for (const char *k : {"1", "2"})
+        REQUIRE(sh(pray_cmd(std::string("-s 16x16 --part ") + k + "/2 -o " + q(d / (std::string("p") + k + ".ppm")) +
+                            " examples/csg.ray"), &out) == 0);
+    REQUIRE(sh(pray_cmd("-s 16x16 --part 2/2 -o " + q(d / "p2.tif") + " examples/csg.ray"), &out) == 0);
+    const std::string p1 = slurp(d / "p1.ppm"), p2 = slurp(d / "p2.ppm"), t2 = slurp(d / "p2.tif");
+    REQUIRE(p2.size() == 16 * 8 * 3 + p2.find("\n255\n") + 5);
+    // what is not a regular file is refused at once: a FIFO (which waited for a writer for ever),
+    // a device that never ends (which grew memory until the allocator failed), a directory
+    REQUIRE(mkfifo((d / "fifo.ppm").c_str(), 0600) == 0);
+    fs::create_directory(d / "dir.ppm");
+    for (std::string part : {d / "fifo.ppm", std::string("/dev/zero"), d / "dir.ppm"}) {
+        CAPTURE(part);
+        CHECK(sh("timeout 20 " + testkit::pray_shell() + " --join " + q(d / "out.ppm") + " " + q(d / "p1.ppm") + " " +
+                     q(part), &out) == 3);
+        CHECK(out == "pray: error: cannot read '" + part + "': not a regular file\n");
+    }
+    // the same as the program of --part and --rows, whose id is a hash of its bytes
+    REQUIRE(mkfifo((d / "fifo.ray").c_str(), 0600) == 0);
+    for (const char *split : {"--part 1/2", "--rows 0:4"}) {
+        CAPTURE(split);
+        CHECK(sh("timeout 20 " + pray_cmd(std::string("-s 8x8 ") + split + " -o " + q(d / "x.ppm") + " " +
+                                          q(d / "fifo.ray")), &out) == 3);
+        CHECK(out == "pray: error: cannot read '" + d / "fifo.ray" + "': not a regular file\n");
+    }
+    fs::remove(d / "fifo.ray");
+    // a part cut short or longer than its header says (in both formats)
+    spit(d / "short.ppm", p2.substr(0, p2.size() - 1));
+    spit(d / "long.ppm", p2 + "x");
+    spit(d / "short.tif", t2.substr(0, t2.size() - 7));
+    spit(d / "long.tif", t2 + std::string(100000, 'x'));
+    struct Size {
+        const char *name;
+        std::string message;
+    } sizes[] = {
+        {"short.ppm", "is cut short: its header says " + std::to_string(p2.size()) + " bytes, the file has " +
+                          std::to_string(p2.size() - 1)},
+        {"long.ppm", "has " + std::to_string(p2.size() + 1) + " bytes, more than the " + std::to_string(p2.size()) +
+                         " its header says"},
+        {"short.tif", "is cut short: its header says " + std::to_string(t2.size()) + " bytes, the file has " +
+                          std::to_string(t2.size() - 7)},
+        {"long.tif", "has " + std::to_string(t2.size() + 100000) + " bytes, more than the " +
+                         std::to_string(t2.size()) + " its header says"},
+    };
+    for (const Size &z : sizes) {
+        CAPTURE(z.name);
+        CHECK(sh(testkit::pray_shell() + " --join " + q(d / "out.ppm") + " " + q(d / "p1.ppm") + " " + q(d / z.name),
+                 &out) == 1);
+        CHECK(out == "pray: error: '" + d / z.name + "' " + z.message + "\n");
+    }
+    // the output may not replace a part: by name, by another name of the same file, through a link
+    fs::create_symlink("p1.ppm", d / "alias.ppm");
+    fs::create_hard_link(d / "p2.ppm", d / "hard.ppm");
+    struct Over {
+        std::string out, parts, part;
+    } overs[] = {
+        {d / "p1.ppm", q(d / "p1.ppm") + " " + q(d / "p1.ppm") + " " + q(d / "p2.ppm"), d / "p1.ppm"},
+        {d / "p2.ppm", q(d / "p1.ppm") + " " + q(d / "p2.ppm"), d / "p2.ppm"},
+        {d.path + "/./p2.ppm", q(d / "p1.ppm") + " " + q(d / "p2.ppm"), d / "p2.ppm"},
+        {d / "alias.ppm", q(d / "p1.ppm") + " " + q(d / "p2.ppm"), d / "p1.ppm"},
+        {d / "hard.ppm", q(d / "p1.ppm") + " " + q(d / "p2.ppm"), d / "p2.ppm"},
+    };
+    for (const Over &o : overs) {
+        CAPTURE(o.out);
+        CHECK(sh(testkit::pray_shell() + " --join " + q(o.out) + " " + o.parts, &out) == 3);
+        CHECK(out == "pray: error: cannot write '" + o.out + "': it is the part '" + o.part +
+                         "' (choose another output name)\n");
+    }
+    CHECK(slurp(d / "p1.ppm") == p1);
+    CHECK(slurp(d / "p2.ppm") == p2);
+    CHECK(d.listing() == "alias.ppm dir.ppm fifo.ppm hard.ppm long.ppm long.tif p1.ppm p2.ppm p2.tif short.ppm short.tif");
+    // the good join: the parts untouched, in either format
+    CHECK(sh(testkit::pray_shell() + " --join " + q(d / "out.ppm") + " " + q(d / "p1.ppm") + " " + q(d / "p2.tif"), &out) == 0);
+    CHECK(out == "");
+    REQUIRE(sh(pray_cmd("-s 16x16 -o " + q(d / "whole.ppm") + " examples/csg.ray"), &out) == 0);
+    CHECK(slurp(d / "out.ppm") == slurp(d / "whole.ppm"));
 }

@@ -9,6 +9,7 @@
 #include "tempfiles.hpp"
 
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -723,24 +724,27 @@ TEST_CASE("command line: renders to one output at once leave one whole image (8 
     }
 }
 
-TEST_CASE("command line: SIGINT or SIGTERM while writing removes the temporary file (60 runs)") {
+TEST_CASE("command line: SIGINT, SIGTERM, SIGHUP or SIGQUIT while writing removes the temporary file (80 runs)") {
     REQUIRE_MESSAGE(have_pray(), NO_PRAY);
     TempDir d;
     spit(d / "p.ray", "rendertiff nothing\n");
     std::string prog = fs::absolute(testkit::pray_program()).string(), out = d / "out.ppm", ray = d / "p.ray";
+    // a closed terminal or a dropped ssh (SIGHUP) and Ctrl-\ (SIGQUIT) end pray as SIGINT and SIGTERM do
+    const int sigs[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+    const char *const names[] = {"SIGINT", "SIGTERM", "SIGHUP", "SIGQUIT"};
     // the test's own handlers (doctest's) must not run in a child before it becomes ./pray:
     // the signals wait, blocked, until the child has their default disposition
-    sigset_t both, before;
-    sigemptyset(&both);
-    sigaddset(&both, SIGINT);
-    sigaddset(&both, SIGTERM);
-    sigprocmask(SIG_BLOCK, &both, &before);
+    sigset_t all, before;
+    sigemptyset(&all);
+    for (int s : sigs) sigaddset(&all, s);
+    sigprocmask(SIG_BLOCK, &all, &before);
     auto start = [&]() {
         pid_t pid = fork();
         if (pid == 0) {
-            signal(SIGINT, SIG_DFL);
-            signal(SIGTERM, SIG_DFL);
-            sigprocmask(SIG_UNBLOCK, &both, NULL);
+            for (int s : sigs) signal(s, SIG_DFL);
+            struct rlimit none = {0, 0};  // SIGQUIT dumps no core
+            setrlimit(RLIMIT_CORE, &none);
+            sigprocmask(SIG_UNBLOCK, &all, NULL);
             execl(prog.c_str(), "pray", "--quiet", "-s", "1200x1200", "-D", "bits=16", "-o", out.c_str(), ray.c_str(),
                   (char *)NULL);
             _exit(127);
@@ -757,17 +761,18 @@ TEST_CASE("command line: SIGINT or SIGTERM while writing removes the temporary f
     long total = (long)std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now() - t0).count();
     fs::remove(out);
     srand(12345);
-    int killed = 0, finished = 0;
-    for (int i = 0; i < 60; i++) {
+    int killed[4] = {0, 0, 0, 0}, finished = 0;
+    for (int i = 0; i < 80; i++) {
         CAPTURE(i);
+        CAPTURE(names[i % 4]);
         pid = start();
         REQUIRE(pid > 0);
         usleep((useconds_t)(rand() % (total + 1)));
-        kill(pid, i % 2 ? SIGINT : SIGTERM);
+        kill(pid, sigs[i % 4]);
         waitpid(pid, &status, 0);
         if (WIFSIGNALED(status)) {
-            killed++;
-            CHECK((WTERMSIG(status) == SIGINT || WTERMSIG(status) == SIGTERM));  // died of the signal
+            killed[i % 4]++;
+            CHECK(WTERMSIG(status) == sigs[i % 4]);  // died of the signal
         } else
             finished++;
         CHECK(temporaries(d) == "");
@@ -777,8 +782,33 @@ TEST_CASE("command line: SIGINT or SIGTERM while writing removes the temporary f
         }
     }
     sigprocmask(SIG_SETMASK, &before, NULL);
-    MESSAGE("killed ", killed, ", finished ", finished, " of 60 runs of ", total / 1000, " ms");
-    CHECK(killed > 10);
+    MESSAGE("killed by SIGINT ", killed[0], ", SIGTERM ", killed[1], ", SIGHUP ", killed[2], ", SIGQUIT ", killed[3],
+            "; finished ", finished, " of 80 runs of ", total / 1000, " ms");
+    for (int k = 0; k < 4; k++) {
+        CAPTURE(names[k]);
+        CHECK(killed[k] > 3);
+    }
+}
+
+TEST_CASE("command line: a file over the size limit (ulimit -f, SIGXFSZ) is a write error, nothing left") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    TempDir d;
+    spit(d / "p.ray", "rendertiff nothing\n");
+    const std::string prog = fs::absolute(testkit::pray_program()).string();
+    std::string out;
+    // 200 blocks of 512 bytes: the 600 x 600 image of 1 MiB does not fit, the part of 8 rows does
+    const std::string limit = "cd " + sq(d.path) + " && ulimit -f 200 && ";
+    CHECK(run_cmd(limit + prog + " --quiet -s 600x600 -o out.ppm p.ray", &out) == 3);
+    CHECK(out == "p.ray:1:1: error: cannot write 'out.ppm': File too large\n");
+    CHECK(d.listing() == "p.ray");
+    // a part small enough, one too large, and --join of two parts too large together
+    CHECK(run_cmd(limit + prog + " --quiet -s 600x600 --rows 0:8 -o a.ppm p.ray", &out) == 0);
+    CHECK(run_cmd(limit + prog + " --quiet -s 600x600 --rows 8:600 -o b.ppm p.ray", &out) == 3);
+    CHECK(out == "p.ray:1:1: error: cannot write 'b.ppm': File too large\n");
+    CHECK(run_cmd("cd " + sq(d.path) + " && " + prog + " --quiet -s 600x600 --rows 8:600 -o b.ppm p.ray", &out) == 0);
+    CHECK(run_cmd(limit + prog + " --join out.ppm a.ppm b.ppm", &out) == 3);
+    CHECK(out == "pray: error: cannot write 'out.ppm': File too large\n");
+    CHECK(d.listing() == "a.ppm b.ppm p.ray");
 }
 
 TEST_CASE("command line: pray refuses to write over its own program") {
@@ -803,6 +833,76 @@ TEST_CASE("command line: pray refuses to write over its own program") {
     CHECK(d.listing() == "alias.ppm p.ppm scene.tif");
     // another output is fine
     CHECK(run_cmd(testkit::pray_shell() + " -s 8x8 -o " + sq(d / "q.ppm") + " " + sq(d / "p.ppm"), &out) == 0);
+}
+
+TEST_CASE("command line: no output replaces a file the program read (an include, a texture)") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    TempDir d;
+    const std::string cd = "cd " + sq(d.path) + " && " + fs::absolute(testkit::pray_program()).string() + " -s 8x8 ";
+    std::string out;
+    spit(d / "bg.ray", "rendertiff nothing\n");
+    REQUIRE(run_cmd(cd + "-o tex.tif bg.ray", &out) == 0);
+    const std::string tex = slurp(d / "tex.tif");
+    spit(d / "lib.ppm", "S = sphere(color({1}), [0, 0, 0], 1)\n");
+    spit(d / "mid.ray", "include \"lib.ppm\"\n");
+    spit(d / "p.ray", "include \"lib.ppm\"\nrendertiff S, none\n");
+    spit(d / "q.ray", "include \"mid.ray\"\nrendertiff S, none\n");
+    spit(d / "t.ray", "T = tiff(color({0}), color({1}), \"tex.tif\")\n"
+                      "rendertiff planemap(T, [0, 0, 0], <0, 0, 1>, <1, 0, 0>, <0, 1, 0>), none\n");
+    fs::create_hard_link(d / "lib.ppm", d / "hard.ppm");
+    const std::string refused = "': the program reads it (choose another output name)\n";
+    struct Case {
+        const char *args;
+        std::string message;
+    } cases[] = {
+        {"-o lib.ppm p.ray", "p.ray:2:1: error: cannot write 'lib.ppm" + refused},
+        {"-o ./lib.ppm p.ray", "p.ray:2:1: error: cannot write './lib.ppm" + refused},
+        {"-o hard.ppm p.ray", "p.ray:2:1: error: cannot write 'hard.ppm" + refused},  // the same file
+        {"--untrusted -o lib.ppm p.ray", "p.ray:2:1: error: cannot write 'lib.ppm" + refused},
+        {"-o lib.ppm q.ray", "q.ray:2:1: error: cannot write 'lib.ppm" + refused},  // included by an include
+        {"-o tex.tif t.ray", "t.ray:2:1: error: cannot write 'tex.tif" + refused},  // a texture
+    };
+    for (const Case &k : cases) {
+        CAPTURE(k.args);
+        CHECK(run_cmd(cd + k.args, &out) == 3);
+        CHECK(out == k.message);
+    }
+    CHECK(slurp(d / "lib.ppm") == "S = sphere(color({1}), [0, 0, 0], 1)\n");
+    CHECK(slurp(d / "tex.tif") == tex);
+    CHECK(d.listing() == "bg.ray hard.ppm lib.ppm mid.ray p.ray q.ray t.ray tex.tif");
+    // another output is fine, and what one run read binds no later run of the same context
+    CHECK(run_cmd(cd + "-o other.ppm p.ray", &out) == 0);
+    pray_ctx *c = pray_new();
+    REQUIRE(c);
+    REQUIRE(pray_option_fix(c, "width", "4") == PRAY_OK);
+    REQUIRE(pray_option_fix(c, "height", "4") == PRAY_OK);
+    REQUIRE(pray_option_fix(c, "output", (d / "lib.ppm").c_str()) == PRAY_OK);
+    CHECK(pray_run_file(c, (d / "p.ray").c_str()) == PRAY_ERR_IO);
+    CHECK(std::string(pray_error(c)).find(refused.substr(3, 20)) != std::string::npos);
+    CHECK(pray_run_file(c, (d / "bg.ray").c_str()) == PRAY_OK);
+    CHECK(whole_ppm(slurp(d / "lib.ppm")) == 4);
+    pray_free(c);
+}
+
+TEST_CASE("command line: 16 bits with a PNG output is an error of the options (exit 2), found before the program runs") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    if (std::string(pray_features()).find("png") == std::string::npos) return;
+    TempDir d;
+    spit(d / "p.ray", "print \"ran\"\nrendertiff nothing\n");
+    const std::string cd = "cd " + sq(d.path) + " && " + fs::absolute(testkit::pray_program()).string() + " -s 8x8 ";
+    std::string out;
+    for (const char *args : {"-D bits=16 -o x.png", "-o x.png -D bits=16", "-D output=x.PNG -D bits=16"}) {
+        CAPTURE(args);
+        CHECK(run_cmd(cd + args + " p.ray", &out) == 2);
+        std::string name = strstr(args, "PNG") ? "x.PNG" : "x.png";
+        CHECK(out == "pray: error: option 'bits': 16, but PNG output has 8 bits only ('" + name + "': use .tif or .ppm)\n");
+    }
+    // a program's own option is found where it renders
+    spit(d / "q.ray", "option \"bits\", 16\nrendertiff nothing\n");
+    CHECK(run_cmd(cd + "-o x.png q.ray", &out) == 1);
+    CHECK(out == "q.ray:2:1: error: PNG output has 8 bits only\n");
+    CHECK(run_cmd(cd + "-D bits=16 -o x.tif p.ray", &out) == 0);
+    CHECK(d.listing() == "p.ray q.ray x.tif");
 }
 
 TEST_CASE("command line: a FIFO, a directory or a device as program or texture is an error, never a hang") {
