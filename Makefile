@@ -99,11 +99,12 @@ TESTS_NOSTDIO = tests/pray_tests_nostdio$(EXE)
 $(TESTS_NOSTDIO): tests/test_main.cpp tests/test_buffers.cpp tests/*.hpp pray.cpp pray.hpp
 	$(CXX) $(TESTFLAGS) -DPRAY_NO_STDIO tests/test_main.cpp tests/test_buffers.cpp pray.cpp -o $@ $(LDLIBS) -lpthread
 
-# The C example: pray.hpp must be usable from C.
+# The C example, built as the README says: pray.hpp is usable from C, and pray.cpp compiled with
+# the C++ compiler's defaults (exceptions on) links with the C compiler, needing no C++ runtime.
 tests/embed$(EXE): examples/embed.c pray.cpp pray.hpp build/png
 	$(CC) -std=c99 -pedantic -Wall -Wextra -Werror -I. -c examples/embed.c -o tests/embed.o
-	$(CXX) -std=c++98 $(CXXFLAGS) -c pray.cpp -o tests/pray.o
-	$(CXX) tests/embed.o tests/pray.o -o $@ $(LDLIBS)
+	$(CXX) -c pray.cpp -o tests/pray.o
+	$(CC) tests/embed.o tests/pray.o -o $@ $(LDLIBS)
 embed: tests/embed$(EXE)
 
 check: deps $(PRAY) textures $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embed$(EXE)

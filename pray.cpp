@@ -623,19 +623,19 @@ inline void cancel_set(pray_ctx *c, int why) {
 #endif
 }
 
-// A public call that pray_cancel can stop. The outermost one forgets a cancel made before it
-// started and starts the clock of option maxtime; the work checks `cancelled` in its loops
-// (statements, voxels, rows of the image) and `over_time` where it is long (statements, rows).
-struct Call {
-    pray_ctx *c;
-    explicit Call(pray_ctx *x) : c(x) {
-        if (c->calls++ == 0) {
-            cancel_set(c, CANCEL_NONE);
-            c->started = clock_seconds();
-        }
+// A public call that pray_cancel can stop, between call_enter and call_leave. The outermost one
+// forgets a cancel made before it started and starts the clock of option maxtime; the work checks
+// `cancelled` in its loops (statements, voxels, rows of the image) and `over_time` where it is
+// long (statements, rows).
+// (Entered and left by hand, not by a destructor: then pray.cpp needs no C++ runtime, however it
+// is compiled; a cleanup on the way out of a function would need the exception personality.)
+void call_enter(pray_ctx *c) {
+    if (c->calls++ == 0) {
+        cancel_set(c, CANCEL_NONE);
+        c->started = clock_seconds();
     }
-    ~Call() { c->calls--; }
-};
+}
+void call_leave(pray_ctx *c) { c->calls--; }
 inline bool cancelled(const pray_ctx *c) { return cancel_flag(c) != CANCEL_NONE; }
 // The run has taken longer than option maxtime allows: every check of `cancelled` stops it.
 bool over_time(pray_ctx *c) {
@@ -10082,13 +10082,8 @@ bool scene_ok(pray_ctx *c, pray_object *root, pray_light *lights, const char *fn
 }
 } // namespace
 
-pray_status pray_render(pray_ctx *c, pray_object *root, pray_light *lights, pray_image *out) {
-    if (out) {
-        out->width = out->height = 0;
-        out->pixels = NULL;
-    }
-    if (!c) return PRAY_ERR_ARG;
-    Call call(c);
+// pray_render's work, between call_enter and call_leave
+static pray_status render_call(pray_ctx *c, pray_object *root, pray_light *lights, pray_image *out) {
     if (!out) return fail(c, PRAY_ERR_ARG, "pray_render: no image to render into");
     if (c->render_fn && c->running && !c->in_render_fn) {  // a program's frame, rendered by the host
         c->in_render_fn = 1;
@@ -10124,10 +10119,21 @@ pray_status pray_render(pray_ctx *c, pray_object *root, pray_light *lights, pray
     return st;
 }
 
-pray_status pray_render_into(pray_ctx *c, pray_object *root, pray_light *lights, const pray_rect *rect,
-                             const pray_buffers *out) {
+pray_status pray_render(pray_ctx *c, pray_object *root, pray_light *lights, pray_image *out) {
+    if (out) {
+        out->width = out->height = 0;
+        out->pixels = NULL;
+    }
     if (!c) return PRAY_ERR_ARG;
-    Call call(c);
+    call_enter(c);
+    pray_status r = render_call(c, root, lights, out);
+    call_leave(c);
+    return r;
+}
+
+// pray_render_into's work, between call_enter and call_leave
+static pray_status render_into_call(pray_ctx *c, pray_object *root, pray_light *lights, const pray_rect *rect,
+                                    const pray_buffers *out) {
     if (!out) return fail(c, PRAY_ERR_ARG, "pray_render_into: no buffers");
     if (!out->rgb && !out->primitive && !out->depth && !out->normal)
         return fail(c, PRAY_ERR_ARG, "pray_render_into: every buffer is NULL");
@@ -10146,6 +10152,15 @@ pray_status pray_render_into(pray_ctx *c, pray_object *root, pray_light *lights,
     if (b.stride > (size_t)-1 / 3 / (size_t)r.height)
         return fail(c, PRAY_ERR_ARG, "pray_render_into: the stride %lu is too large", (unsigned long)b.stride);
     return render_into(c, root, lights, r, b);
+}
+
+pray_status pray_render_into(pray_ctx *c, pray_object *root, pray_light *lights, const pray_rect *rect,
+                             const pray_buffers *out) {
+    if (!c) return PRAY_ERR_ARG;
+    call_enter(c);
+    pray_status r = render_into_call(c, root, lights, rect, out);
+    call_leave(c);
+    return r;
 }
 
 pray_status pray_camera_ray(pray_ctx *c, double px, double py, pray_vec *origin, pray_vec *dir) {
@@ -10172,9 +10187,8 @@ struct pray_scene {
     Scratch w;
 };
 
-pray_scene *pray_prepare(pray_ctx *c, pray_object *root) {
-    if (!c || !object_ok(c, root, "pray_prepare")) return NULL;
-    Call call(c);
+// pray_prepare's work, between call_enter and call_leave
+static pray_scene *prepare_call(pray_ctx *c, pray_object *root) {
     pray_scene *q = (pray_scene *)mem_zalloc(c, sizeof(pray_scene));
     if (!q) return NULL;
     if (scene_build(c, &q->s, root, NULL, false) || !scratch_init(c, &q->w, &q->s)) {
@@ -10182,6 +10196,14 @@ pray_scene *pray_prepare(pray_ctx *c, pray_object *root) {
         return NULL;
     }
     return q;
+}
+
+pray_scene *pray_prepare(pray_ctx *c, pray_object *root) {
+    if (!c || !object_ok(c, root, "pray_prepare")) return NULL;
+    call_enter(c);
+    pray_scene *r = prepare_call(c, root);
+    call_leave(c);
+    return r;
 }
 
 namespace {
@@ -10248,9 +10270,8 @@ void pray_image_free(pray_ctx *c, pray_image *img) {
     img->width = img->height = 0;
 }
 
-pray_status pray_write_tiff(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
-    if (!c) return PRAY_ERR_ARG;
-    Call call(c);
+// pray_write_tiff's work, between call_enter and call_leave
+static pray_status write_tiff_call(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
     if (!image_ok(c, img)) return c->status;
     if (!fn) return fail(c, PRAY_ERR_ARG, "pray_write_tiff: no write function");
     if (bits != 8 && bits != 16) return fail(c, PRAY_ERR_ARG, "bits must be 8 or 16");
@@ -10258,9 +10279,16 @@ pray_status pray_write_tiff(pray_ctx *c, const pray_image *img, int bits, pray_w
     return write_tiff(c, img, bits, s);
 }
 
-pray_status pray_write_ppm(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
+pray_status pray_write_tiff(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
     if (!c) return PRAY_ERR_ARG;
-    Call call(c);
+    call_enter(c);
+    pray_status r = write_tiff_call(c, img, bits, fn, ud);
+    call_leave(c);
+    return r;
+}
+
+// pray_write_ppm's work, between call_enter and call_leave
+static pray_status write_ppm_call(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
     if (!image_ok(c, img)) return c->status;
     if (!fn) return fail(c, PRAY_ERR_ARG, "pray_write_ppm: no write function");
     if (bits != 8 && bits != 16) return fail(c, PRAY_ERR_ARG, "bits must be 8 or 16");
@@ -10268,9 +10296,16 @@ pray_status pray_write_ppm(pray_ctx *c, const pray_image *img, int bits, pray_wr
     return write_ppm(c, img, bits, s);
 }
 
-pray_status pray_write_png(pray_ctx *c, const pray_image *img, pray_write_fn fn, void *ud) {
+pray_status pray_write_ppm(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
     if (!c) return PRAY_ERR_ARG;
-    Call call(c);
+    call_enter(c);
+    pray_status r = write_ppm_call(c, img, bits, fn, ud);
+    call_leave(c);
+    return r;
+}
+
+// pray_write_png's work, between call_enter and call_leave
+static pray_status write_png_call(pray_ctx *c, const pray_image *img, pray_write_fn fn, void *ud) {
     if (!image_ok(c, img)) return c->status;
     if (!fn) return fail(c, PRAY_ERR_ARG, "pray_write_png: no write function");
 #if PRAY_HAS_PNG
@@ -10281,6 +10316,14 @@ pray_status pray_write_png(pray_ctx *c, const pray_image *img, pray_write_fn fn,
     (void)ud;
     return fail(c, PRAY_ERR_ARG, "this build cannot write PNG");
 #endif
+}
+
+pray_status pray_write_png(pray_ctx *c, const pray_image *img, pray_write_fn fn, void *ud) {
+    if (!c) return PRAY_ERR_ARG;
+    call_enter(c);
+    pray_status r = write_png_call(c, img, fn, ud);
+    call_leave(c);
+    return r;
 }
 
 namespace {
@@ -10345,18 +10388,33 @@ pray_status write_image_file(pray_ctx *c, const pray_image *img, const char *pat
 }
 } // namespace
 
+// pray_write_image's work, between call_enter and call_leave
+static pray_status write_image_call(pray_ctx *c, const pray_image *img, const char *path, int bits) {
+    return write_image_file(c, img, path, bits, NULL);
+}
+
 pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *path, int bits) {
     if (!c) return PRAY_ERR_ARG;
-    Call call(c);
-    return write_image_file(c, img, path, bits, NULL);
+    call_enter(c);
+    pray_status r = write_image_call(c, img, path, bits);
+    call_leave(c);
+    return r;
+}
+
+// pray_write_image_note's work, between call_enter and call_leave
+static pray_status write_image_note_call(pray_ctx *c, const pray_image *img, const char *path, int bits,
+                                         const char *note) {
+    if (!note) return fail(c, PRAY_ERR_ARG, "pray_write_image_note: no note");
+    return write_image_file(c, img, path, bits, note);
 }
 
 pray_status pray_write_image_note(pray_ctx *c, const pray_image *img, const char *path, int bits,
                                   const char *note) {
     if (!c) return PRAY_ERR_ARG;
-    Call call(c);
-    if (!note) return fail(c, PRAY_ERR_ARG, "pray_write_image_note: no note");
-    return write_image_file(c, img, path, bits, note);
+    call_enter(c);
+    pray_status r = write_image_note_call(c, img, path, bits, note);
+    call_leave(c);
+    return r;
 }
 
 pray_status pray_image_new(pray_ctx *c, int width, int height, pray_image *out) {
@@ -13115,10 +13173,8 @@ void reset_run(pray_ctx *c) {
 // on it would reset the one that called it.
 pray_status refuse_nested_run(pray_ctx *c) { return fail(c, PRAY_ERR_ARG, "the context is running a program"); }
 
-pray_status pray_run_string(pray_ctx *c, const char *name, const char *text, size_t len) {
-    if (!c) return PRAY_ERR_ARG;
-    if (c->running) return refuse_nested_run(c);
-    Call call(c);
+// pray_run_string's work, between call_enter and call_leave
+static pray_status run_string_call(pray_ctx *c, const char *name, const char *text, size_t len) {
     reset_run(c);
     if (!text) return fail(c, PRAY_ERR_ARG, "no program text");
 #if PRAY_HAS_INTERP
@@ -13144,6 +13200,15 @@ pray_status pray_run_string(pray_ctx *c, const char *name, const char *text, siz
 #endif
 }
 
+pray_status pray_run_string(pray_ctx *c, const char *name, const char *text, size_t len) {
+    if (!c) return PRAY_ERR_ARG;
+    if (c->running) return refuse_nested_run(c);
+    call_enter(c);
+    pray_status r = run_string_call(c, name, text, len);
+    call_leave(c);
+    return r;
+}
+
 #if PRAY_HAS_STDIO
 namespace {
 // Read a program into t, on the context's allocator: its memory cap holds as for everything else.
@@ -13167,10 +13232,8 @@ bool read_program(pray_ctx *c, FILE *f, Text *t) {
 #endif
 
 // A path of "-" reads standard input, named stdin.ray in messages.
-pray_status pray_run_file(pray_ctx *c, const char *path) {
-    if (!c) return PRAY_ERR_ARG;
-    if (c->running) return refuse_nested_run(c);
-    Call call(c);
+// pray_run_file's work, between call_enter and call_leave
+static pray_status run_file_call(pray_ctx *c, const char *path) {
     if (!path) return fail(c, PRAY_ERR_ARG, "no program file");
 #if PRAY_HAS_STDIO
     bool in = strcmp(path, "-") == 0;
@@ -13211,6 +13274,15 @@ pray_status pray_run_file(pray_ctx *c, const char *path) {
 #else
     return fail(c, PRAY_ERR_IO, "this build has no file access");
 #endif
+}
+
+pray_status pray_run_file(pray_ctx *c, const char *path) {
+    if (!c) return PRAY_ERR_ARG;
+    if (c->running) return refuse_nested_run(c);
+    call_enter(c);
+    pray_status r = run_file_call(c, path);
+    call_leave(c);
+    return r;
 }
 
 int pray_frames(const pray_ctx *c) { return c ? c->frames : 0; }

@@ -566,7 +566,10 @@ pray_status pray_texture_register(pray_ctx *ctx, const char *name, pray_texture 
 
    2. Building
    Copy pray.hpp and pray.cpp into your project and compile pray.cpp with it. It needs a C++98
-   compiler and the C library's math; no exceptions or RTTI. `-DPRAY_MAIN` adds main().
+   compiler and the C library's math; no exceptions or RTTI, and no C++ runtime whatever the
+   flags: `c++ -c pray.cpp` then `cc app.c pray.o -lm` (plus -lpthread where the C library keeps
+   threads apart) links a C program. It refuses -ffast-math and its kin (it needs infinities and
+   NaN). `-DPRAY_MAIN` adds main().
    With CMake: add_subdirectory of pray's directory or find_package(pray), then link the target
    pray::pray; an installed pray is also known to pkg-config as "pray" (README.md).
 
