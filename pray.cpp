@@ -174,6 +174,9 @@ unsigned _stklen = 4u * 1024 * 1024;
 #elif defined(PRAY_HAS_UNISTD) && defined(_POSIX_THREADS) && _POSIX_THREADS > 0
 #include <pthread.h>
 #define PRAY_HAS_THREADS 1
+#if defined(__linux__)
+#include <sched.h>  // sched_getaffinity (declared where the C library has GNU's extensions)
+#endif
 #else
 #define PRAY_HAS_THREADS 0
 #endif
@@ -450,13 +453,25 @@ void run_parallel(int n, ThreadFn fn, void **args, void *starts) {
 #endif
 }
 
-// Processors to use when the option threads is 0 (automatic).
+// Processors to use when the option threads is 0 (automatic): those the process may run on (its
+// affinity: taskset, a cpuset, Slurm's or mpirun's binding), as nproc counts them, where the
+// system says; else the machine's.
 int cpu_count() {
 #if PRAY_HAS_THREADS && defined(_WIN32)
+    DWORD_PTR mine = 0, all = 0;
+    if (GetProcessAffinityMask(GetCurrentProcess(), &mine, &all) && mine) {
+        int n = 0;
+        for (; mine; mine &= mine - 1) n++;
+        return n;
+    }
     SYSTEM_INFO si;
     GetSystemInfo(&si);
     return (int)si.dwNumberOfProcessors;
 #elif PRAY_HAS_THREADS && defined(_SC_NPROCESSORS_ONLN)
+#if defined(__linux__) && defined(CPU_COUNT)
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof set, &set) == 0 && CPU_COUNT(&set) > 0) return CPU_COUNT(&set);
+#endif
     long n = sysconf(_SC_NPROCESSORS_ONLN);
     return n > 0 ? (int)n : 1;
 #else

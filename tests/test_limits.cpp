@@ -832,3 +832,22 @@ TEST_CASE("the N-th allocation fails, for every N: out of memory, no leak, until
         CHECK(ok >= 1);
     }
 }
+
+#if defined(__linux__)
+TEST_CASE("threads=0 counts the processors the process may run on (its affinity), not the machine's") {
+    std::string out;
+    FILE *p = popen(("command -v taskset >/dev/null || exit 0; taskset -c 0 " + testkit::pray_shell() +
+                     " --stats --threads 0 -s 16x16 -o limits_affinity.ppm examples/redsph.ray 2>&1")
+                        .c_str(),
+                    "r");
+    REQUIRE(p);
+    char buf[4096];
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, p)) > 0) out.append(buf, n);
+    pclose(p);
+    std::remove("limits_affinity.ppm");
+    if (out.empty()) return;  // (no taskset here)
+    CHECK_MESSAGE(out.find(" on 1 thread\n") != std::string::npos, out);
+    CHECK_MESSAGE(out.find(" threads\n") == std::string::npos, out);
+}
+#endif

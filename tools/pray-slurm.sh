@@ -18,8 +18,11 @@
 # PRAY names the program (default: pray in the directory above this script's, else pray on the
 # PATH; sbatch runs a copy of the script from its spool directory, so export PRAY or put pray on
 # the PATH there).
+# Each task asks for 4 CPUs (change --cpus-per-task, or give sbatch -c) and renders with as many
+# threads as Slurm gave it (SLURM_CPUS_PER_TASK; pray would also count the CPUs it is bound to).
 #SBATCH --job-name=pray
 #SBATCH --ntasks=1
+#SBATCH --cpus-per-task=4
 #SBATCH --output=pray-%A_%a.log
 set -eu
 if [ $# -lt 2 ]; then
@@ -39,7 +42,7 @@ parts=$out.parts
 if [ -n "${SLURM_ARRAY_TASK_ID:-}" ]; then
     k=$SLURM_ARRAY_TASK_ID
     if [ "${SPLIT:-rows}" = frames ]; then
-        exec "$PRAY" --quiet --frames "$k:$((k + 1))" -o "$out" "$@" "$prog"
+        exec "$PRAY" --quiet --threads "${SLURM_CPUS_PER_TASK:-0}" --frames "$k:$((k + 1))" -o "$out" "$@" "$prog"
     fi
     n=${PARTS:-${SLURM_ARRAY_TASK_COUNT:-}}
     if [ -z "$n" ]; then
@@ -47,7 +50,7 @@ if [ -n "${SLURM_ARRAY_TASK_ID:-}" ]; then
         exit 2
     fi
     mkdir -p "$parts"
-    exec "$PRAY" --quiet --part "$k/$n" -o "$parts/part$k.$ext" "$@" "$prog"
+    exec "$PRAY" --quiet --threads "${SLURM_CPUS_PER_TASK:-0}" --part "$k/$n" -o "$parts/part$k.$ext" "$@" "$prog"
 fi
 
 # the join
