@@ -9973,6 +9973,13 @@ void pray_light_release(pray_ctx *c, pray_light *l) {
 void pray_texture_release(pray_ctx *c, pray_texture *t) {
     if (c && t && handle_ok(c, t, H_TEXTURE, "pray_texture_release", "texture")) release_handle(c, t);
 }
+pray_status pray_retain(pray_ctx *c, void *h) {
+    if (!c) return PRAY_ERR_ARG;
+    if (!h) return fail(c, PRAY_ERR_ARG, "pray_retain: no handle");
+    if (!handle_ok(c, h, 0, "pray_retain", "handle")) return c->status;
+    retain(h);
+    return PRAY_OK;
+}
 
 namespace {
 // What is wrong with a camera, or NULL.

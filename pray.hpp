@@ -94,7 +94,8 @@ typedef struct pray_texture pray_texture; /* a decoded TIFF image, for textures 
      running a program"): a program runs on a context one at a time;
    - never pray_free.
    The image a frame callback gets lives until the callback returns; the handles a render
-   function gets (root, lights) belong to the running program and live until its run ends.
+   function gets (root, lights) belong to the running program and live until its run ends,
+   unless the host takes a reference of its own (pray_retain).
    Other contexts may be used freely from any callback. */
 
 /* Memory: like Lua's lua_Alloc. nsize == 0 frees ptr and returns NULL; otherwise returns a block
@@ -344,6 +345,11 @@ void pray_model_release(pray_ctx *ctx, pray_model *model);
 void pray_light_release(pray_ctx *ctx, pray_light *light);
 void pray_texture_release(pray_ctx *ctx, pray_texture *tex);
 void pray_release(pray_ctx *ctx, void *handle);
+/* Take one more reference to a handle of any of the four kinds: it lives until it has been
+   released once more (or pray_free). So a host keeps what a callback lends it, such as the
+   root and lights a render function gets from a running program, past the run. PRAY_ERR_ARG
+   for NULL, a handle of another context or not a handle. */
+pray_status pray_retain(pray_ctx *ctx, void *handle);
 
 /* Camera and background, as the statements of the same names. pray_lookat: a perspective
    camera at `eye` looking at `point`, `up` (not parallel to point - eye) the image's up, `angle`

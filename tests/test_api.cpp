@@ -4,6 +4,7 @@
 
 #include "testkit.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -760,6 +761,65 @@ TEST_CASE("api: callbacks cannot start a run on the context running a program, n
                                         "of this context's (pray_render, pray_image_new)");
     CHECK(frames.empty());
     CHECK(m.calls == 1);
+    pray_free(d);
+    pray_free(c);
+}
+
+namespace {
+// A render function that keeps the program's scene: renders the frame, then takes references
+// to its root and lights.
+struct Kept {
+    pray_object *root = nullptr;
+    pray_light *lights = nullptr;
+    std::vector<float> seen;  // the frame as rendered inside the run
+};
+pray_status keep_scene(void *ud, pray_ctx *c, pray_object *root, pray_light *lights, int, pray_image *out) {
+    Kept *k = (Kept *)ud;
+    pray_status st = pray_render(c, root, lights, out);
+    if (st == PRAY_OK) k->seen = pixels_of(*out);
+    if (st == PRAY_OK && (pray_retain(c, root) != PRAY_OK || pray_retain(c, lights) != PRAY_OK)) st = PRAY_ERR_ARG;
+    k->root = root;
+    k->lights = lights;
+    return st;
+}
+} // namespace
+
+TEST_CASE("api: pray_retain keeps a program's scene past its run, to render again with another camera") {
+    pray_ctx *c = pray_new();
+    pray_option(c, "width", 24);
+    pray_option(c, "height", 24);
+    Kept k;
+    std::vector<testkit::Frame> frames;
+    pray_set_frame(c, testkit::frame_sink, &frames);
+    pray_set_render(c, keep_scene, &k);
+    const char *prog = "M = phong({0.8, 0.2, 0.1}, {0.3}, 8)\n"
+                       "O = (sphere(M, [0, 0, 0], 0.5) | box(M, [-0.9, -0.9, -0.9], [-0.4, -0.4, -0.4])) - sphere(M, [0.3, 0.3, 0.3], 0.3)\n"
+                       "rendertiff O, dirlight({1}, <1, 1, 1>) + pointlight({0.5}, [2, -1, 3])\n"
+                       "O = nothing\n";  // (the program lets go of its own)
+    REQUIRE(pray_run_string(c, "kept.ray", prog, strlen(prog)) == PRAY_OK);
+    REQUIRE(frames.size() == 1);
+    REQUIRE(k.root);
+    pray_set_render(c, nullptr, nullptr);
+    // the same camera: the same pixels; another camera: another picture of the same scene
+    pray_image img;
+    REQUIRE(pray_render(c, k.root, k.lights, &img) == PRAY_OK);
+    CHECK(pixels_of(img) == k.seen);
+    pray_image_free(c, &img);
+    pray_vec eye = {3, -2, 1}, at = {0, 0, 0}, up = {0, 0, 1};
+    REQUIRE(pray_lookat(c, eye, at, up, 40) == PRAY_OK);
+    REQUIRE(pray_render(c, k.root, k.lights, &img) == PRAY_OK);
+    CHECK(pixels_of(img) != k.seen);
+    float most = 0;
+    for (float v : pixels_of(img)) most = std::max(most, v);
+    CHECK(most > 0.2f);  // (the scene is there)
+    pray_image_free(c, &img);
+    pray_object_release(c, k.root);
+    pray_light_release(c, k.lights);
+    CHECK(pray_retain(c, nullptr) == PRAY_ERR_ARG);
+    pray_ctx *d = pray_new();
+    pray_object *o = ball(d);
+    CHECK(pray_retain(c, o) == PRAY_ERR_ARG);  // another context's
+    CHECK(std::string(pray_error(c)) == "error: pray_retain: the handle belongs to another context");
     pray_free(d);
     pray_free(c);
 }

@@ -31,6 +31,8 @@ done
 echo "== (a) add_subdirectory"
 b=$tmp/sub
 run cmake -S "$here/consumer" -B "$b" -DPRAY_SOURCE_DIR="$src" -DCMAKE_EXPORT_COMPILE_COMMANDS=ON
+grep -q 'pray: the project sets no CMAKE_BUILD_TYPE' "$tmp/log" ||
+  fail "no warning that pray is built without optimisation in a parent without a build type"
 run cmake --build "$b"
 run "$b/consumer"
 cat "$tmp/log"
