@@ -5260,11 +5260,12 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     if (want > 0 && st == PRAY_OK) {
         for (int l = 0; l < 3; l++) a->g.top[l] = (real)((double)a->g.org[l] + a->g.n[l] * (double)a->g.h);
         a->g.voxel = (int *)mem_zalloc(c, sizeof(int) * (size_t)nv);
-        // nested grids take what the budget leaves: as many voxels as their primitives ask for
+        // nested grids take what the budget leaves, and no more voxels than the image has rays
         GridPlan gp;
         gp.eff = eff;
         gp.round = 64 * REAL_EPS * (mag + ext);
         gp.budget = (budget - (double)nv * (2 * sizeof(int) + 1)) / 16;
+        gp.budget = gp.budget < rays / 2 ? gp.budget : rays / 2;
         if (!a->g.voxel || !bucket(c, a->g.n, np, VoxelRange(a->g, eff, NULL, margin), cand, start) ||
             !grid_lists(b, a->g, gp, cand, start, margin, want + 4, opt_int(c, OPT_NEST)))
             st = c->status;
