@@ -4,7 +4,9 @@
 #   - --part K/N of every example stacked again by --join, and --frames,
 #   - the GNU parallel recipe and the Slurm script tools/pray-slurm.sh (its tasks run here with
 #     SLURM_ARRAY_TASK_ID set),
-#   - and failures: every rank stops, with the message of the rank that failed, nothing written.
+#   - failures: every rank stops, with the message of the rank that failed, nothing written,
+#   - and signals: pray-mpi killed by SIGINT, SIGTERM, SIGHUP or SIGQUIT at points spread over a
+#     run leaves no temporary file and never a part of the image.
 # Every examples/*.ray but redsphx.ray (the thesis' program with its mistakes, an error by
 # design) at SIZE pixels with antialias 2 and adaptive undersampling on.
 #
@@ -181,6 +183,39 @@ if [ $rc1 = 1 ] && [ $rc = 1 ] && grep -q "pray-mpi: rank [12]: .*over the limit
 else
     bad "a render failing on a worker: exit $rc (pray: $rc1), $(cat "$d/err")"
 fi
+
+echo "== signals: SIGINT, SIGTERM, SIGHUP or SIGQUIT while rank 0 writes leave no temporary file"
+d=$tmp/sig
+mkdir -p "$d"
+printf 'rendertiff nothing\n' >"$d/p.ray"
+sig_run() { "$PRAY_MPI" -q -s 2000x2000 -D bits=16 -o "$d/out.ppm" "$d/p.ray" >/dev/null 2>&1; }
+t0=$(date +%s%N)
+sig_run
+t1=$(date +%s%N)
+rm -f "$d/out.ppm"
+ms=$(((t1 - t0) / 1000000))
+killed=0
+for sig in INT TERM HUP QUIT; do
+    for k in 1 2 3 4 5 6; do
+        (ulimit -c 0; exec "$PRAY_MPI" -q -s 2000x2000 -D bits=16 -o "$d/out.ppm" "$d/p.ray") >/dev/null 2>&1 &
+        pid=$!
+        sleep "$(awk "BEGIN { print $ms * $k / 7000 }")"
+        kill -$sig $pid 2>/dev/null
+        wait $pid 2>/dev/null
+        [ $? -gt 128 ] && killed=$((killed + 1))
+        left=$(ls -A "$d" | grep '\.tmp$')
+        if [ -n "$left" ]; then
+            bad "SIG$sig at $k/7 of a run of $ms ms left $left"
+            rm -f "$d"/.*.tmp
+        elif [ -f "$d/out.ppm" ] && [ "$(wc -c <"$d/out.ppm")" != $((6 * 2000 * 2000 + 19)) ]; then
+            bad "SIG$sig at $k/7 of a run of $ms ms left a part of the image"
+        else
+            ok
+        fi
+        rm -f "$d/out.ppm"
+    done
+done
+[ $killed -gt 0 ] || bad "no run of $ms ms was killed by a signal"
 
 echo "distributed: $pass passed, $failn failed"
 [ $failn = 0 ]

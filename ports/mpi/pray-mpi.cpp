@@ -50,14 +50,21 @@ enum { GIVE_BAND = 1, GIVE_FRAME = 2, NO_MORE = 3 };
 
 int rank, nranks;
 
-// SIGINT and SIGTERM (mpirun passes them on) while rank 0 writes an image: remove the temporary
-// file, then die of the signal, as pray does.
+// SIGINT, SIGTERM, SIGHUP and SIGQUIT (mpirun passes them on) while rank 0 writes an image: remove
+// the temporary file, then die of the signal, as pray does.
 pray_ctx *volatile the_ctx;
 extern "C" void on_signal(int sig) {
     const char *t = the_ctx ? pray_temp_file(the_ctx) : NULL;
     if (t) unlink(t);
     signal(sig, SIG_DFL);
     raise(sig);
+}
+void catch_signals(pray_ctx *c) {
+    void (*h)(int) = c ? on_signal : SIG_DFL;
+    if (c) the_ctx = c;
+    const int sigs[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT};
+    for (int i = 0; i < 4; i++) signal(sigs[i], h);
+    if (!c) the_ctx = NULL;
 }
 
 int exit_code(pray_status st) {
@@ -429,17 +436,9 @@ int run(int argc, char **argv) {
         }
         pray_set_render(c, worker_render, &w);
     }
-    if (rank == 0) {
-        the_ctx = c;
-        signal(SIGINT, on_signal);
-        signal(SIGTERM, on_signal);
-    }
+    if (rank == 0) catch_signals(c);
     st = pray_run_file(c, program);
-    if (rank == 0) {
-        signal(SIGINT, SIG_DFL);
-        signal(SIGTERM, SIG_DFL);
-        the_ctx = NULL;
-    }
+    if (rank == 0) catch_signals(NULL);
     if (st != PRAY_OK) die(c, st);
     if (rank == 0 && nranks > 1) {
         // every rank gets its last answer: rows, "done" for the last frame; frames, "no more"
@@ -465,6 +464,7 @@ int run(int argc, char **argv) {
 } // namespace
 
 int main(int argc, char **argv) {
+    signal(SIGXFSZ, SIG_IGN);  // a file over the size limit (ulimit -f): a write error, as in pray
     MPI_Init(&argc, &argv);
     MPI_Comm_rank(MPI_COMM_WORLD, &rank);
     MPI_Comm_size(MPI_COMM_WORLD, &nranks);
