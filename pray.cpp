@@ -10252,14 +10252,16 @@ int pray_intersect(pray_ctx *c, pray_scene *q, pray_vec origin, pray_vec dir, do
     }
     if (owner_of(q) != c) return fail(c, PRAY_ERR_ARG, "pray_intersect: the scene belongs to another context"), -1;
     if (max_hits > 0 && !hits) return fail(c, PRAY_ERR_ARG, "pray_intersect: no room for the hits"), -1;
-    // the direction divided by its largest component: a tiny or a huge one is a direction too
+    // the direction brought to the size of 1: a tiny or a huge one is a direction too
     double m = fabs(dir.x) > fabs(dir.y) ? fabs(dir.x) : fabs(dir.y);
     m = fabs(dir.z) > m ? fabs(dir.z) : m;
     if (!vfinite(origin) || !vfinite(dir) || m == 0 || tmax != tmax) {
         fail(c, PRAY_ERR_ARG, "pray_intersect: the ray must have a finite origin and a finite, non-zero direction");
         return -1;
     }
-    pray_vec d = {dir.x / m, dir.y / m, dir.z / m};
+    int e;  // (scaled by a power of two, exactly: a direction of ordinary size keeps its bits)
+    frexp(m, &e);
+    pray_vec d = {ldexp(dir.x, -e), ldexp(dir.y, -e), ldexp(dir.z, -e)};
     CollectHits ch;
     ch.s = &q->s;
     ch.ray.o = r3of(origin);
