@@ -10259,8 +10259,8 @@ int pray_intersect(pray_ctx *c, pray_scene *q, pray_vec origin, pray_vec dir, do
         fail(c, PRAY_ERR_ARG, "pray_intersect: the ray must have a finite origin and a finite, non-zero direction");
         return -1;
     }
-    int e;  // (scaled by a power of two, exactly: a direction of ordinary size keeps its bits)
-    frexp(m, &e);
+    int e = 0;  // (a direction of ordinary size is left as it is, bit for bit)
+    if (m < 1e-18 || m > 1e18) frexp(m, &e);
     pray_vec d = {ldexp(dir.x, -e), ldexp(dir.y, -e), ldexp(dir.z, -e)};
     CollectHits ch;
     ch.s = &q->s;
