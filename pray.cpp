@@ -12714,6 +12714,7 @@ PRAY_NOINLINE pray_status include_loop(Interp &I, const char *path, int loop) {
 }
 #endif
 
+#if PRAY_HAS_STDIO
 // Reading a file costs the run a statement (option maxsteps) for each of its lines, however few
 // statements they hold: an include of a long file in a loop is bounded as its statements are.
 pray_status include_steps(Interp &I, const char *text, size_t n) {
@@ -12726,6 +12727,7 @@ pray_status include_steps(Interp &I, const char *text, size_t n) {
                     "an include reads counts as one)", lim, lim == 1 ? "" : "s");
     return PRAY_OK;
 }
+#endif
 
 // include "F": the statements of file F, read beside the file that names it, run here as the
 // program's own are (checked whole first, then read and run a statement at a time).
