@@ -553,6 +553,8 @@ struct pray_ctx {
     double written;          // bytes of image files written by this run (option maxoutput)
     pray_object *drop;       // given up by a program's rendertiff: released once flattened (scene_build)
     int eye_inside;          // the camera's eye is inside the solid last rendered (render_scene)
+    int no_light, dark;      // no light reaches any surface the eye saw in it (render_scene);
+                             // dark: the same of the last frame rendered, kept
     volatile sig_atomic_t cancel;  // pray_cancel: the running call stops at its next check
     int calls;               // cancellable public calls running (a run renders and writes)
     Coherence *coh;          // image sequences (option coherence): the frame before, or NULL
@@ -1870,6 +1872,7 @@ struct Scene {
     int prune;        // drop parts that bounds show cannot matter
     int leaves;       // primitives met so far while flattening
     int tori;         // tori among the primitives (each may cross a ray four times)
+    int iface;        // two different materials may meet inside the solid (scene_interfaces)
     Accel *accel;     // NULL: the brute-force reference
     Array<Light> lights;
     int parallel;
@@ -2780,6 +2783,62 @@ pray_status scene_compact(pray_ctx *c, Scene *s) {
     return st;
 }
 
+// ---- where materials meet (language 12) ----
+bool model_same(const pray_model *a, const pray_model *b);
+
+// The solids of two primitives neither overlap nor touch but at a point, for certain: spheres,
+// and a sphere or a box against a half-space whose normal is along an axis (so that balls
+// resting on a floor or on one another, and boxes above it, are apart). False: perhaps not.
+bool solids_apart(const Prim &a, const Prim &b) {
+    if (b.kind == O_PLANE && a.kind != O_PLANE) return solids_apart(b, a);
+    if (a.kind == O_SPHERE && b.kind == O_SPHERE && !a.fr && !b.fr) {
+        R3 v = a.p - b.p;
+        real r = a.r + b.r;
+        return dot(v, v) >= r * r;
+    }
+    if (a.kind != O_PLANE) return false;
+    if (b.kind == O_SPHERE && !b.fr) return dot(a.n, b.p) - a.d >= b.r;
+    if (!a.axis) return false;
+    int l = a.axis == &R3::x ? 0 : a.axis == &R3::y ? 1 : 2;
+    real n = a.n.*a.axis;  // (the half-space is n x_l <= d; the box's nearest point to it)
+    return (n > 0 ? n * b.box.lo[l] : n * b.box.hi[l]) >= a.d;
+}
+
+struct BoxStart {
+    real lo;
+    int i;
+};
+int box_start_cmp(const void *pa, const void *pb) {
+    const BoxStart *a = (const BoxStart *)pa, *b = (const BoxStart *)pb;
+    if (a->lo != b->lo) return a->lo < b->lo ? -1 : 1;
+    return a->i - b->i;
+}
+
+// Scene::iface: may two primitives of different models (as values) overlap or touch? Only then
+// can a ray meet a face between two materials inside the solid. The boxes in order of their
+// lower x, each against those that start before it ends; the answer at the first such pair.
+pray_status scene_interfaces(pray_ctx *c, Scene *s) {
+    int n = s->prims.n, k = 1;
+    s->iface = 0;
+    while (k < n && (s->prims[k].mat == s->prims[0].mat || model_same(s->prims[k].mat, s->prims[0].mat))) k++;
+    if (k >= n) return PRAY_OK;  // one material
+    BoxStart *v = (BoxStart *)mem_alloc(c, sizeof(BoxStart) * (size_t)n);
+    if (!v) return c->status;
+    for (int i = 0; i < n; i++) v[i].lo = s->prims[i].box.lo[0], v[i].i = i;
+    qsort(v, (size_t)n, sizeof(BoxStart), box_start_cmp);
+    for (int a = 0; a < n && !s->iface; a++) {
+        const Prim &p = s->prims[v[a].i];
+        for (int b = a + 1; b < n && v[b].lo <= p.box.hi[0]; b++) {
+            const Prim &q = s->prims[v[b].i];
+            if (p.mat == q.mat || !box_overlap(p.box, q.box) || model_same(p.mat, q.mat) || solids_apart(p, q)) continue;
+            s->iface = 1;
+            break;
+        }
+    }
+    mem_free(c, v);
+    return PRAY_OK;
+}
+
 // =============================================================================================
 // [SECTION] 8 Ray/primitive intersection; primitives in a frame (box, rod, cone, torus, stretched)
 // =============================================================================================
@@ -3224,6 +3283,7 @@ struct Counters {
     double ebuf;  // primary rays answered by the eye's buffer
     double cache; // shadow rays answered by the shadow cache
     double notes, cells;  // image sequences: rays and region cells noted in records (10b)
+    double seen[2];  // surfaces met by primary rays that take light: no light reaches them, some does
 };
 enum { RAY_PRIMARY, RAY_SHADOW, RAY_REFLECT, RAY_REFRACT };
 
@@ -3379,8 +3439,48 @@ struct Hit {
     real t;
     int prim;
     int prim_enter;  // the ray enters the primitive there
-    int root_enter;  // the ray enters the whole solid there
+    int root_enter;  // the ray enters the whole solid there (1 too on a face between materials)
+    int mat;         // the primitive whose model shades the surface: prim, or on a face between
+                     // two materials inside the solid (language 12) the one whose material is entered
+    int from;        // on such a face, the primitive whose material the ray leaves; else -1
 };
+
+// A hit where the whole solid is entered or left: shaded with the primitive's own model.
+inline Hit solid_hit(real t, int prim, int prim_enter, bool root_enter) {
+    Hit h;
+    h.t = t;
+    h.prim = h.mat = prim;
+    h.prim_enter = prim_enter;
+    h.root_enter = root_enter;
+    h.from = -1;
+    return h;
+}
+
+// Two primitives of different materials (language 12: models that differ as values).
+inline bool other_material(const Scene *s, int p, int q) {
+    return s->prims[p].mat != s->prims[q].mat && !model_same(s->prims[p].mat, s->prims[q].mat);
+}
+
+// The primitive whose material fills the solid where the ray is, the root being inside
+// (language 12): in a union the last child the ray is in, in an intersection its last child
+// that is not a complement, in a difference its first; -1 in a complement (no primitive puts
+// the point there). Reads the statuses of a full sweep (section 9).
+int owner(const Scene *s, const Scratch *w) {
+    int e = s->root;
+    while (e_is_node(e)) {
+        const Node &nd = s->nodes[e_index(e)];
+        const int *k = &s->kids[nd.k0];
+        int i = nd.op == O_DIFF ? 0 : nd.n - 1;
+        if (nd.op == O_UNION)
+            for (; i >= 0; i--)
+                if (e_is_node(k[i]) ? w->nstat[e_index(k[i])] : w->pstat[e_index(k[i])]) break;
+        if (nd.op == O_INTER)
+            while (i > 0 && e_is_node(k[i]) && s->nodes[e_index(k[i])].op == O_COMPL) i--;
+        if (nd.op == O_COMPL || i < 0) return -1;
+        e = k[i];
+    }
+    return e_index(e);
+}
 
 // A crossing of a primitive at t, when t is in (a, b] and before tmax: noted for a sweep
 // (`prim`: the primitive, or its place in a list with a plan, 9b).
@@ -3449,26 +3549,35 @@ int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit
     bool root = sweep_start(s, w, ray, tmax, self, &nc);
     if (nc > 1) sort_crossings(w->cross, nc);
     int hits = 0;
+    // where materials meet (Scene::iface): the material the ray is in while inside (owner)
+    int mat = s->iface && root ? owner(s, w) : -1;
     for (int i = 0; i < nc;) {
         real t = w->cross[i].t;
         bool before = root;
-        int last = -1;
+        int last = -1, moved = -1;
         for (; i < nc && w->cross[i].t == t; i++) {
             const Cross &x = w->cross[i];
             bool st = x.enter != 0;
             if ((w->pstat[x.prim] != 0) == st) continue;
             w->pstat[x.prim] = st;
+            moved = i;
             if (propagate(s, w, 2 * x.prim, st)) {
                 root = !root;
                 last = i;
             }
         }
         if (root != before && last >= 0) {
-            Hit h;
-            h.t = t;
-            h.prim = w->cross[last].prim;
-            h.prim_enter = w->cross[last].enter;
-            h.root_enter = root;
+            hits++;
+            if (!visit(solid_hit(t, w->cross[last].prim, w->cross[last].enter, root))) break;
+        }
+        if (!s->iface || moved < 0) continue;
+        int was = mat;
+        mat = root ? owner(s, w) : -1;
+        if (root && before && was >= 0 && mat >= 0 && other_material(s, was, mat)) {
+            // a face between two materials inside the solid: a surface of the one entered
+            Hit h = solid_hit(t, w->cross[moved].prim, w->cross[moved].enter, true);
+            h.mat = mat;
+            h.from = was;
             hits++;
             if (!visit(h)) break;
         }
@@ -3496,7 +3605,7 @@ struct ShadowHit {
     pray_rgb f;
     real t;
     bool operator()(const Hit &x) {
-        const Prim &q = s->prims[x.prim];
+        const Prim &q = s->prims[x.mat];
         f = cmul(f, q.mat->kind == M_FLAT ? q.mat->transmit : transmit_at(q, ray->o + ray->d * x.t));
         if (!czero(f)) return true;
         t = x.t;
@@ -5463,14 +5572,8 @@ bool eval_flat(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
                 fixed = true;
             }
         }
-        if (root != before && last >= 0) {
-            Hit h;
-            h.t = t;
-            h.prim = prims[w->cross[last].prim];
-            h.prim_enter = w->cross[last].enter;
-            h.root_enter = root;
-            if (!visit(h)) return true;
-        }
+        if (root != before && last >= 0 && !visit(solid_hit(t, prims[w->cross[last].prim], w->cross[last].enter, root)))
+            return true;
         if (w->root_fixed) return true;
     }
     return false;
@@ -5561,12 +5664,7 @@ int eval_plain(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
         tf = t0;
     }
     if (first < 0) return 0;
-    Hit h;
-    h.t = tf;
-    h.prim = first;
-    h.prim_enter = first_enter;
-    h.root_enter = 1;
-    if (!visit(h)) return 1;
+    if (!visit(solid_hit(tf, first, first_enter, true))) return 1;
     *pa = tf;  // the visitor goes on through the solid: the rest by the flat sweep
     return -1;
 }
@@ -5646,14 +5744,8 @@ bool eval_full(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
                 (!st ? sp.kind != SPAN2 || x.t >= w->span2[2 * x.prim + 1] : sp.t1 >= REAL_INF))
                 settle(s, w, 2 * x.prim, st);
         }
-        if (root != before && last >= 0) {
-            Hit h;
-            h.t = t;
-            h.prim = w->cross[last].prim;
-            h.prim_enter = w->cross[last].enter;
-            h.root_enter = root;
-            if (!visit(h)) return true;
-        }
+        if (root != before && last >= 0 && !visit(solid_hit(t, w->cross[last].prim, w->cross[last].enter, root)))
+            return true;
         if (w->root_fixed) return true;
     }
     return false;
@@ -6046,15 +6138,11 @@ bool drive_lists(const Scene *s, Scratch *w, const Ray &ray, real tmax, const So
 // crosses (section 10b).
 void region_note(Scratch *w, const Ray &ray, real end);
 
-// The one way a ray reaches the accelerated scene (drive_lists); a pixel being traced for an
-// image sequence notes the part of the ray the lists were evaluated on, up to where the visitor
-// stopped: what it brought back depends on nothing else.
+// The lists of a ray (drive_lists); a pixel being traced for an image sequence notes the part
+// of the ray the lists were evaluated on, up to where the visitor stopped: what it brought back
+// depends on nothing else.
 template <class Visit, class Source>
-bool drive(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, const Source *src) {
-    if (s->root < 0) {
-        if (w->rbits) region_note(w, ray, tmax);
-        return true;
-    }
+bool drive_outer(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, const Source *src) {
     ray_begin(s, w);
     Stretches<Visit> out(s, w, ray, tmax, self, visit);
     bool done = drive_lists(s, w, ray, tmax, src, out);
@@ -6065,19 +6153,76 @@ bool drive(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visi
     return done;
 }
 
-// All hits along the ray in (0, tmax), by the reference or the accelerated path.
+// Where materials meet inside the solid (Scene::iface), the lists leave out the faces between
+// them: they trace a ray while it is outside the solid only. This visitor passes their hits on
+// until the ray is inside: it started there (its first hit leaves the solid), or the visitor goes
+// on into the solid; then `inside` is set, and the reference sweep (section 9) takes the rest of
+// the ray, after `done`.
 template <class Visit>
-void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
+struct Outside {
+    Visit &v;
+    real done;
+    int hits, inside;
+    explicit Outside(Visit &v_) : v(v_), done(-REAL_INF), hits(0), inside(0) {}
+    bool operator()(const Hit &h) {
+        hits++;
+        if (!h.root_enter || v(h)) inside = 1;
+        else done = h.t;
+        if (inside && h.root_enter) done = h.t;
+        return false;
+    }
+};
+template <class Visit>
+inline real visit_end(const Outside<Visit> &o) { return o.inside ? REAL_INF : visit_end(o.v); }
+
+// The hits of the reference sweep after t = done.
+template <class Visit>
+struct After {
+    Visit &v;
+    real done;
+    After(Visit &v_, real done_) : v(v_), done(done_) {}
+    bool operator()(const Hit &h) { return h.t <= done || v(h); }
+};
+
+// The one way a ray reaches the accelerated scene. `inside`: whether the ray starts inside the
+// solid (1), outside (0), or unknown (-1); it matters where materials meet (Outside).
+template <class Visit, class Source>
+bool drive(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, const Source *src, int inside) {
+    if (s->root < 0) {
+        if (w->rbits) region_note(w, ray, tmax);
+        return true;
+    }
+    if (!s->iface) return drive_outer(s, w, ray, tmax, self, visit, src);
+    real done = -REAL_INF;
+    if (inside != 1) {
+        Outside<Visit> o(visit);
+        drive_outer(s, w, ray, tmax, self, o, src);
+        if (!o.inside && (o.hits || inside == 0 || !starts_inside(s, w, ray))) return true;
+        done = o.done;
+    }
+    After<Visit> rest(visit, done);
+    sweep(s, w, ray, tmax, self, rest);
+    if (w->rbits) {
+        real e = visit_end(visit);
+        region_note(w, ray, e < tmax ? e : tmax);
+    }
+    return true;
+}
+
+// All hits along the ray in (0, tmax), by the reference or the accelerated path; `inside` as
+// for drive.
+template <class Visit>
+void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, int inside = -1) {
     if (!s->accel) {
         sweep(s, w, ray, tmax, self, visit);
         return;
     }
     if (s->accel->g.n[0] == 0) {
-        drive(s, w, ray, tmax, self, visit, (const GridSource *)NULL);
+        drive(s, w, ray, tmax, self, visit, (const GridSource *)NULL, inside);
         return;
     }
     GridSource grid(s->accel, ray);
-    drive(s, w, ray, tmax, self, visit, &grid);
+    drive(s, w, ray, tmax, self, visit, &grid, inside);
 }
 
 // The shadow cache (option shadowcache): the voxel where the last shadow ray towards the same
@@ -6134,10 +6279,10 @@ bool blocker_of(const Accel *A, R3 p, Blocker *bk) {
 
 // The hits along a shadow ray towards light `light`: the shadow cache's answer when it has one;
 // else through the light buffer's voxel when the ray starts in one; else as any other ray.
-void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, ShadowHit &visit) {
+void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, ShadowHit &visit, int inside) {
     const Accel *A = s->accel;
     if (!A || A->g.n[0] == 0) {
-        find_hits(s, w, ray, tmax, self, visit);
+        find_hits(s, w, ray, tmax, self, visit, inside);
         return;
     }
     Blocker *bk = w->blocker + light;
@@ -6146,8 +6291,8 @@ void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
     zone.L = A->lbuf ? lightbuf_find(A->lbuf[light], A->outer, ray.o, tmax, &zone.ta, &zone.tb) : -1;
     if (zone.L >= 0) {  // (the outer list alone when the ray misses the grid's box)
         w->k.lbuf += 1;
-        drive(s, w, ray, tmax, self, visit, &zone);
-    } else find_hits(s, w, ray, tmax, self, visit);
+        drive(s, w, ray, tmax, self, visit, &zone, inside);
+    } else find_hits(s, w, ray, tmax, self, visit, inside);
     if (A->cache && !(czero(visit.f) && blocker_of(A, ray.o + ray.d * visit.t, bk))) bk->list = -1;
 }
 
@@ -6155,13 +6300,13 @@ void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
 // that holds its direction, when the eye has a buffer and the cell has runs; else as any other
 // ray.
 template <class Visit>
-void primary_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, Visit &visit) {
+void primary_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, Visit &visit, int inside) {
     const Accel *A = s->accel;
     const LightBuf *B = A ? A->eye : NULL;
     const LightFace *F = B ? &B->f[cube_face(ray.d)] : NULL;
     real g2 = F ? dot(ray.d, F->e[2]) : 0;
     if (!F || !(g2 > 0) || ray.o.x != B->o.x || ray.o.y != B->o.y || ray.o.z != B->o.z) {
-        find_hits(s, w, ray, tmax, -1, visit);
+        find_hits(s, w, ray, tmax, -1, visit, inside);
         return;
     }
     EyeSource eye;
@@ -6175,12 +6320,12 @@ void primary_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, Visit &
             eye.end = B->runs + B->runs[F->cbase + cell + 1];
         }
         if (in < 0 || (eye.run && eye.run[0] < 0)) {
-            find_hits(s, w, ray, tmax, -1, visit);
+            find_hits(s, w, ray, tmax, -1, visit, inside);
             return;
         }
     }
     w->k.ebuf += 1;
-    drive(s, w, ray, tmax, -1, visit, eye.run ? &eye : NULL);
+    drive(s, w, ray, tmax, -1, visit, eye.run ? &eye : NULL, inside);
 }
 
 // =============================================================================================
@@ -7025,6 +7170,7 @@ static const unsigned char FONT6X9[95][9] = {
 struct Tracer {
     const Scene *s;
     Scratch *w;
+    int eye_in;   // primary rays start inside the solid: 1, outside: 0, unknown: -1 (drive)
     pray_rgb bg;  // background of the current pixel's row
     long left;    // rays the current sample may still take (Scene::maxrays)
     double lost;  // the most the rays left out of the current sample could have added
@@ -7264,6 +7410,39 @@ R3 shading_normal(const Prim &q, R3 x, const Shade &sh, R3 ds, R3 dt, bool outwa
     return n;
 }
 
+// The direction a ray along d takes on through a surface whose unit normal n faces it, for the
+// ratio eta of the indices (the side it comes from over the side it enters), by Snell's law;
+// false at total internal reflection.
+bool refract_dir(R3 d, R3 n, double eta, R3 *out) {
+    real ci = -dot(n, d);
+    double k = 1.0 - eta * eta * (1.0 - (double)ci * ci);
+    if (k < 0) return false;
+    *out = unit(d * (real)eta + n * (real)(eta * ci - sqrt(k)));
+    return true;
+}
+
+// The model of primitive q at x, and the texture coordinates and their directions there.
+void shade_at(const Prim &q, R3 x, Shade *sh, double *ts, double *tt, R3 *ds, R3 *dt) {
+    *ts = *tt = 0;
+    *ds = *dt = r3(0, 0, 0);
+    if (q.mat->kind == M_FLAT) shade_of(q.mat, 0, 0, sh);
+    else {
+        tex_coords(q, x, ts, tt, ds, dt);
+        shade_of(q.mat, *ts, *tt, sh);
+    }
+}
+
+// The ratio of the refractive indices across hit h at x (m: the model that shades it): the
+// material the ray leaves over the one it enters; empty space counts 1.
+double hit_eta(const Scene *s, const Hit &h, R3 x, const Shade &m) {
+    if (h.from < 0) return h.root_enter ? 1.0 / m.index : m.index;
+    Shade f;
+    double ts, tt;
+    R3 ds, dt;
+    shade_at(s->prims[h.from], x, &f, &ts, &tt, &ds, &dt);
+    return f.index / m.index;
+}
+
 // Whether a ray spawned by a ray of the given level, which passes on `weight` of what it brings
 // back to the sample, is traced: unless what it could add (Scene::most) fits in what is left of
 // the sample's allowance for rays left out (Scene::cut), which it then takes.
@@ -7277,7 +7456,10 @@ inline bool worth_tracing(Tracer &tr, int level, double weight) {
 
 // The colour a ray brings back; `seen`, when given, receives what it saw; `weight`: how much of
 // it reaches the sample, at most, in any channel.
-pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *seen = NULL, double weight = 1) {
+// `inside`: whether the ray starts inside the solid (1, 0, -1 unknown; drive), for rays other
+// than primary ones.
+pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *seen = NULL, double weight = 1,
+               int inside = -1) {
     const Scene *s = tr.s;
     if (seen) seen->hit = -1, seen->lit_only = 0, seen->st[0] = seen->st[1] = 0;
     if (level > s->depth) return cmake(0, 0, 0);
@@ -7289,24 +7471,22 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
     tr.w->k.rays[kind] += 1;
     FirstHit fh;
     fh.found = false;
-    if (kind == RAY_PRIMARY) primary_hits(s, tr.w, ray, REAL_INF, fh);
-    else find_hits(s, tr.w, ray, REAL_INF, self, fh);
+    if (kind == RAY_PRIMARY) primary_hits(s, tr.w, ray, REAL_INF, fh, tr.eye_in);
+    else find_hits(s, tr.w, ray, REAL_INF, self, fh, inside);
     if (!fh.found) return tr.bg;
     const Hit &h = fh.h;
-    const Prim &q = s->prims[h.prim];
+    const Prim &q = s->prims[h.prim], &qm = s->prims[h.mat];  // the face, and its material
     R3 x = ray.o + ray.d * h.t;
     Shade sh;
     const Shade *m = &sh;
-    double ts = 0, tt = 0;
-    R3 ds = r3(0, 0, 0), dt = ds;
-    if (q.mat->kind == M_FLAT) shade_of(q.mat, 0, 0, &sh);
-    else {
-        tex_coords(q, x, &ts, &tt, &ds, &dt);
-        shade_of(q.mat, ts, tt, &sh);
-    }
+    double ts, tt;
+    R3 ds, dt;
+    shade_at(qm, x, &sh, &ts, &tt, &ds, &dt);
     bool outward = h.prim_enter == h.root_enter;
     R3 n = shading_normal(q, x, sh, ds, dt, outward, ray.d);
-    bool record = seen && q.mat->kind != M_FLAT && s->lights.n <= SEEN_LIGHTS && model_lit_only(q.mat);
+    bool record = seen && qm.mat->kind != M_FLAT && s->lights.n <= SEEN_LIGHTS && model_lit_only(qm.mat);
+    // rays back to the side the ray came from start inside the solid where it was inside
+    int back = !h.root_enter || h.from >= 0, lights_in = 0;
     if (seen) {
         seen->hit = h.prim;
         seen->enter = h.prim_enter;
@@ -7335,28 +7515,26 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
             sh.ray = &sr;
             sh.f = cmake(1, 1, 1);
             tr.w->k.rays[RAY_SHADOW] += 1;
-            shadow_hits(s, tr.w, sr, dist, h.prim, i, sh);
+            shadow_hits(s, tr.w, sr, dist, h.prim, i, sh, back);
             li = cmul(li, sh.f);
         }
+        lights_in += !czero(li);
         if (record) {
             seen->lights |= 1u << i;
             seen->light[i] = li;
         }
         if (!czero(li)) phong_light(&col, m, li, n, l, ndl, ray.d);
     }
+    if (kind == RAY_PRIMARY && lit) tr.w->k.seen[lights_in > 0] += 1;  // (the warning of section 12)
     pray_rgb refl = m->reflect;
     if (!czero(m->transmit) && level < s->depth) {
-        double eta = h.root_enter ? 1.0 / m->index : m->index;
-        real ci = -dot(n, ray.d);
-        double k = 1.0 - eta * eta * (1.0 - (double)ci * ci);
         double wt = weight * rgb_maxabs(m->transmit);
-        if (k < 0) {
+        Ray rr;
+        if (!refract_dir(ray.d, n, hit_eta(s, h, x, sh), &rr.d)) {
             refl = cadd(refl, m->transmit);  // total internal reflection
         } else if (worth_tracing(tr, level, wt)) {
-            Ray rr;
             rr.o = x;
-            rr.d = unit(ray.d * (real)eta + n * (real)(eta * ci - sqrt(k)));
-            col = cadd(col, cmul(m->transmit, trace(tr, rr, level + 1, h.prim, RAY_REFRACT, NULL, wt)));
+            col = cadd(col, cmul(m->transmit, trace(tr, rr, level + 1, h.prim, RAY_REFRACT, NULL, wt, h.root_enter)));
         }
     }
     double wr = weight * rgb_maxabs(refl);
@@ -7364,7 +7542,7 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
         Ray rr;
         rr.o = x;
         rr.d = unit(ray.d - n * (2 * dot(n, ray.d)));
-        col = cadd(col, cmul(refl, trace(tr, rr, level + 1, h.prim, RAY_REFLECT, NULL, wr)));
+        col = cadd(col, cmul(refl, trace(tr, rr, level + 1, h.prim, RAY_REFLECT, NULL, wr, back)));
     }
     return col;
 }
@@ -7477,7 +7655,8 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     }
     // snapped before compaction, over every primitive flattened, so that the reference and the
     // simplified scene give the same surviving primitives the same numbers
-    if (s->root == -3 || snap_coincident(c, s) || merge_chains(c, s) || scene_compact(c, s)) return c->status;
+    if (s->root == -3 || snap_coincident(c, s) || merge_chains(c, s) || scene_compact(c, s) || scene_interfaces(c, s))
+        return c->status;
     if (cancelled(c)) return fail_cancelled(c);
     for (int i = 0; lights && i < lights->n; i++) {
         const LightSrc &src = lights->src[i];
@@ -7645,10 +7824,20 @@ void public_hit(const Scene *s, const Ray &ray, const Hit &h, pray_hit *o) {
     const Prim &q = s->prims[h.prim];
     o->t = (double)h.t;
     o->primitive = q.id;
-    o->entering = h.root_enter;
-    R3 ng = prim_normal(q, ray.o + ray.d * h.t);
+    o->entering = h.from >= 0 ? 2 : h.root_enter;
+    R3 x = ray.o + ray.d * h.t, ng = prim_normal(q, x);
     R3 nn = h.prim_enter == h.root_enter ? ng : ng * (real)-1;
     o->normal = vmake((double)nn.x, (double)nn.y, (double)nn.z);
+    // the refracted ray, as trace spawns it
+    Shade sh;
+    double ts, tt;
+    R3 ds, dt, rd = r3(0, 0, 0);
+    shade_at(s->prims[h.mat], x, &sh, &ts, &tt, &ds, &dt);
+    if (!czero(sh.transmit)) {
+        R3 n = shading_normal(q, x, sh, ds, dt, h.prim_enter == h.root_enter, ray.d);
+        if (!refract_dir(ray.d, n, hit_eta(s, h, x, sh), &rd)) rd = r3(0, 0, 0);
+    }
+    o->refracted = vmake((double)rd.x, (double)rd.y, (double)rd.z);
 }
 
 // Where pixel (i, j) of the image is kept in the caller's buffers, in pixels.
@@ -8053,6 +8242,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         scratch_release(c, &w);
     }
     int made = 0;
+    double seen[2] = {0, 0};  // primary rays' surfaces that take light: dark, lit
     for (; st == PRAY_OK && made < nt; made++) {
         Worker &k = worker_at(wbuf, stride, made);
         k.job = &job;
@@ -8061,6 +8251,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         else if (job.adaptive > 0 && !k.cache.reserve(c, (job.tile + 1) * (job.tile + 1))) st = c->status;
         k.tr.s = s;
         k.tr.w = &k.w;
+        k.tr.eye_in = s->parallel ? -1 : c->eye_inside;  // (a parallel camera's rays start apart)
         k.w.rg = job.rg;
         args[made] = &k;
     }
@@ -8089,6 +8280,8 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         c->stats.rays_lightbuf += k.lbuf;
         c->stats.rays_eyebuf += k.ebuf;
         c->stats.rays_shadowcache += k.cache;
+        seen[0] += k.seen[0];
+        seen[1] += k.seen[1];
         if (job.redo) {
             c->stats.pixels_reused += worker_at(wbuf, stride, i).kept;
             c->stats.pixels_retraced += worker_at(wbuf, stride, i).traced;
@@ -8104,6 +8297,10 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
     }
     if (out.rgb) c->stats.rays_primary_full += (double)r.width * r.height * s->antialias * s->antialias;
     if (job.redo && st == PRAY_OK) c->stats.frames_coherent += 1;
+    // no light reaches anything the eye sees (a frame that takes pixels over from the frame
+    // before, which had the same lights and camera, keeps that frame's answer for them)
+    if (st == PRAY_OK)
+        c->no_light = c->dark = s->lights.n > 0 && !seen[1] && (seen[0] || job.redo) && (!job.redo || c->dark);
     c->stats.threads = nt;
     mem_free(c, wbuf);
     mem_free(c, args);
@@ -12404,9 +12601,10 @@ PRAY_NOINLINE pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
     // holds it any more, its tree is freed before the rest of the scene is built (not when the
     // host renders the frame: it may render the tree more than once, a band at a time)
     c->drop = c->render_fn ? NULL : (pray_object *)a[0].ref;
-    c->eye_inside = 0;
+    c->eye_inside = c->no_light = 0;
     pray_status st = pray_render(c, (pray_object *)a[0].ref, all, &img);
     if (st == PRAY_OK && c->eye_inside) warn(I, s, "the eye is inside the rendered solid");
+    if (st == PRAY_OK && c->no_light) warn(I, s, "no light reaches anything the eye sees");
     if (c->drop == NULL && !c->render_fn) a[0].ref = NULL, a[0].t = V_NONE;
     c->drop = NULL;
     release_handle(c, all);
