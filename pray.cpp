@@ -1872,7 +1872,8 @@ struct Scene {
     int prune;        // drop parts that bounds show cannot matter
     int leaves;       // primitives met so far while flattening
     int tori;         // tori among the primitives (each may cross a ray four times)
-    int iface;        // two different materials may meet inside the solid (scene_interfaces)
+    int iface;        // two different materials may meet inside the solid (scene_interfaces); 2:
+                      // and some material lets light through (so that rays go on into solids)
     Accel *accel;     // NULL: the brute-force reference
     Array<Light> lights;
     int parallel;
@@ -2804,38 +2805,52 @@ bool solids_apart(const Prim &a, const Prim &b) {
     return (n > 0 ? n * b.box.lo[l] : n * b.box.hi[l]) >= a.d;
 }
 
-struct BoxStart {
-    real lo;
-    int i;
-};
-int box_start_cmp(const void *pa, const void *pb) {
-    const BoxStart *a = (const BoxStart *)pa, *b = (const BoxStart *)pb;
-    if (a->lo != b->lo) return a->lo < b->lo ? -1 : 1;
-    return a->i - b->i;
-}
-
 // Scene::iface: may two primitives of different models (as values) overlap or touch? Only then
-// can a ray meet a face between two materials inside the solid. The boxes in order of their
-// lower x, each against those that start before it ends; the answer at the first such pair.
+// can a ray meet a face between two materials inside the solid. The boxes in n buckets of their
+// lower x (a counting sort), each against those after it that start in a bucket up to the one of
+// its upper x; the answer at the first such pair.
 pray_status scene_interfaces(pray_ctx *c, Scene *s) {
     int n = s->prims.n, k = 1;
     s->iface = 0;
     while (k < n && (s->prims[k].mat == s->prims[0].mat || model_same(s->prims[k].mat, s->prims[0].mat))) k++;
     if (k >= n) return PRAY_OK;  // one material
-    BoxStart *v = (BoxStart *)mem_alloc(c, sizeof(BoxStart) * (size_t)n);
-    if (!v) return c->status;
-    for (int i = 0; i < n; i++) v[i].lo = s->prims[i].box.lo[0], v[i].i = i;
-    qsort(v, (size_t)n, sizeof(BoxStart), box_start_cmp);
+    int *key = (int *)mem_alloc(c, sizeof(int) * 2 * (size_t)n), *at = (int *)mem_zalloc(c, sizeof(int) * ((size_t)n + 1));
+    if (!key || !at) {
+        mem_free(c, key);
+        mem_free(c, at);
+        return c->status;
+    }
+    int *order = key + n;
+    double x0 = HUGE_VAL, x1 = -HUGE_VAL;  // the finite lower ends
+    for (int i = 0; i < n; i++) {
+        double x = (double)s->prims[i].box.lo[0];
+        if (x > -REAL_BIG) x0 = x < x0 ? x : x0, x1 = x > x1 ? x : x1;
+    }
+    double scale = x1 > x0 ? (n - 1) / (x1 - x0) : 0;
+    struct Bucket {  // (of x, clamped: 0 below x0, n - 1 above x1)
+        double x0, scale;
+        int last;
+        int operator()(real x) const {
+            double f = ((double)x - x0) * scale;
+            return !(f > 0) ? 0 : f >= last ? last : (int)f;
+        }
+    } bucket = {x0, scale, n - 1};
+    for (int i = 0; i < n; i++) at[(key[i] = bucket(s->prims[i].box.lo[0])) + 1]++;
+    for (int j = 0; j < n; j++) at[j + 1] += at[j];
+    for (int i = 0; i < n; i++) order[at[key[i]]++] = i;
     for (int a = 0; a < n && !s->iface; a++) {
-        const Prim &p = s->prims[v[a].i];
-        for (int b = a + 1; b < n && v[b].lo <= p.box.hi[0]; b++) {
-            const Prim &q = s->prims[v[b].i];
+        const Prim &p = s->prims[order[a]];
+        for (int b = a + 1, end = bucket(p.box.hi[0]); b < n && key[order[b]] <= end; b++) {
+            const Prim &q = s->prims[order[b]];
             if (p.mat == q.mat || !box_overlap(p.box, q.box) || model_same(p.mat, q.mat) || solids_apart(p, q)) continue;
             s->iface = 1;
             break;
         }
     }
-    mem_free(c, v);
+    mem_free(c, key);
+    mem_free(c, at);
+    for (int i = 0; i < n && s->iface == 1; i++)
+        if (model_clear(s->prims[i].mat) > 0) s->iface = 2;
     return PRAY_OK;
 }
 
@@ -3438,11 +3453,11 @@ void sort_crossings(Cross *x, int n) {
 struct Hit {
     real t;
     int prim;
-    int prim_enter;  // the ray enters the primitive there
-    int root_enter;  // the ray enters the whole solid there (1 too on a face between materials)
-    int mat;         // the primitive whose model shades the surface: prim, or on a face between
-                     // two materials inside the solid (language 12) the one whose material is entered
-    int from;        // on such a face, the primitive whose material the ray leaves; else -1
+    int mat;   // the primitive whose model shades the surface: prim, or on a face between two
+               // materials inside the solid (language 12) the one whose material is entered
+    int from;  // on such a face, the primitive whose material the ray leaves; else -1
+    unsigned char prim_enter;  // the ray enters the primitive there
+    unsigned char root_enter;  // the ray enters the whole solid there (1 too on a face between materials)
 };
 
 // A hit where the whole solid is entered or left: shaded with the primitive's own model.
@@ -3450,7 +3465,7 @@ inline Hit solid_hit(real t, int prim, int prim_enter, bool root_enter) {
     Hit h;
     h.t = t;
     h.prim = h.mat = prim;
-    h.prim_enter = prim_enter;
+    h.prim_enter = (unsigned char)prim_enter;
     h.root_enter = root_enter;
     h.from = -1;
     return h;
@@ -6138,11 +6153,15 @@ bool drive_lists(const Scene *s, Scratch *w, const Ray &ray, real tmax, const So
 // crosses (section 10b).
 void region_note(Scratch *w, const Ray &ray, real end);
 
-// The lists of a ray (drive_lists); a pixel being traced for an image sequence notes the part
-// of the ray the lists were evaluated on, up to where the visitor stopped: what it brought back
-// depends on nothing else.
+// The one way a ray reaches the accelerated scene (drive_lists); a pixel being traced for an
+// image sequence notes the part of the ray the lists were evaluated on, up to where the visitor
+// stopped: what it brought back depends on nothing else.
 template <class Visit, class Source>
-bool drive_outer(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, const Source *src) {
+bool drive(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, const Source *src) {
+    if (s->root < 0) {
+        if (w->rbits) region_note(w, ray, tmax);
+        return true;
+    }
     ray_begin(s, w);
     Stretches<Visit> out(s, w, ray, tmax, self, visit);
     bool done = drive_lists(s, w, ray, tmax, src, out);
@@ -6184,46 +6203,22 @@ struct After {
     bool operator()(const Hit &h) { return h.t <= done || v(h); }
 };
 
-// The one way a ray reaches the accelerated scene. `inside`: whether the ray starts inside the
-// solid (1), outside (0), or unknown (-1); it matters where materials meet (Outside).
-template <class Visit, class Source>
-bool drive(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, const Source *src, int inside) {
-    if (s->root < 0) {
-        if (w->rbits) region_note(w, ray, tmax);
-        return true;
-    }
-    if (!s->iface) return drive_outer(s, w, ray, tmax, self, visit, src);
-    real done = -REAL_INF;
-    if (inside != 1) {
-        Outside<Visit> o(visit);
-        drive_outer(s, w, ray, tmax, self, o, src);
-        if (!o.inside && (o.hits || inside == 0 || !starts_inside(s, w, ray))) return true;
-        done = o.done;
-    }
-    After<Visit> rest(visit, done);
-    sweep(s, w, ray, tmax, self, rest);
-    if (w->rbits) {
-        real e = visit_end(visit);
-        region_note(w, ray, e < tmax ? e : tmax);
-    }
-    return true;
-}
-
-// All hits along the ray in (0, tmax), by the reference or the accelerated path; `inside` as
-// for drive.
+// All hits along the ray in (0, tmax), by the reference or the accelerated path (where
+// materials meet, through across).
 template <class Visit>
-void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, int inside = -1) {
+void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
     if (!s->accel) {
         sweep(s, w, ray, tmax, self, visit);
         return;
     }
     if (s->accel->g.n[0] == 0) {
-        drive(s, w, ray, tmax, self, visit, (const GridSource *)NULL, inside);
+        drive(s, w, ray, tmax, self, visit, (const GridSource *)NULL);
         return;
     }
     GridSource grid(s->accel, ray);
-    drive(s, w, ray, tmax, self, visit, &grid, inside);
+    drive(s, w, ray, tmax, self, visit, &grid);
 }
+
 
 // The shadow cache (option shadowcache): the voxel where the last shadow ray towards the same
 // light met an opaque surface (Scratch::blocker) is likely to hold one that stops this ray too.
@@ -6279,34 +6274,40 @@ bool blocker_of(const Accel *A, R3 p, Blocker *bk) {
 
 // The hits along a shadow ray towards light `light`: the shadow cache's answer when it has one;
 // else through the light buffer's voxel when the ray starts in one; else as any other ray.
-void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, ShadowHit &visit, int inside) {
+// (The shadow ray's own visitor, also where Outside passes its hits on: across.)
+inline ShadowHit &shadow_of(ShadowHit &v) { return v; }
+inline ShadowHit &shadow_of(Outside<ShadowHit> &o) { return o.v; }
+
+template <class Visit>
+void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, Visit &visit) {
     const Accel *A = s->accel;
     if (!A || A->g.n[0] == 0) {
-        find_hits(s, w, ray, tmax, self, visit, inside);
+        find_hits(s, w, ray, tmax, self, visit);
         return;
     }
     Blocker *bk = w->blocker + light;
-    if (A->cache && bk->list >= 0 && shadow_probe(s, w, ray, tmax, self, light, visit)) return;
+    ShadowHit &v = shadow_of(visit);
+    if (A->cache && bk->list >= 0 && shadow_probe(s, w, ray, tmax, self, light, v)) return;
     ZoneSource zone;
     zone.L = A->lbuf ? lightbuf_find(A->lbuf[light], A->outer, ray.o, tmax, &zone.ta, &zone.tb) : -1;
     if (zone.L >= 0) {  // (the outer list alone when the ray misses the grid's box)
         w->k.lbuf += 1;
-        drive(s, w, ray, tmax, self, visit, &zone, inside);
-    } else find_hits(s, w, ray, tmax, self, visit, inside);
-    if (A->cache && !(czero(visit.f) && blocker_of(A, ray.o + ray.d * visit.t, bk))) bk->list = -1;
+        drive(s, w, ray, tmax, self, visit, &zone);
+    } else find_hits(s, w, ray, tmax, self, visit);
+    if (A->cache && !(czero(v.f) && blocker_of(A, ray.o + ray.d * v.t, bk))) bk->list = -1;
 }
 
 // The hits along a primary ray, which starts at the eye: through the cell of the eye's buffer
 // that holds its direction, when the eye has a buffer and the cell has runs; else as any other
 // ray.
 template <class Visit>
-void primary_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, Visit &visit, int inside) {
+void primary_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, Visit &visit) {
     const Accel *A = s->accel;
     const LightBuf *B = A ? A->eye : NULL;
     const LightFace *F = B ? &B->f[cube_face(ray.d)] : NULL;
     real g2 = F ? dot(ray.d, F->e[2]) : 0;
     if (!F || !(g2 > 0) || ray.o.x != B->o.x || ray.o.y != B->o.y || ray.o.z != B->o.z) {
-        find_hits(s, w, ray, tmax, -1, visit, inside);
+        find_hits(s, w, ray, tmax, -1, visit);
         return;
     }
     EyeSource eye;
@@ -6320,12 +6321,45 @@ void primary_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, Visit &
             eye.end = B->runs + B->runs[F->cbase + cell + 1];
         }
         if (in < 0 || (eye.run && eye.run[0] < 0)) {
-            find_hits(s, w, ray, tmax, -1, visit, inside);
+            find_hits(s, w, ray, tmax, -1, visit);
             return;
         }
     }
     w->k.ebuf += 1;
-    drive(s, w, ray, tmax, -1, visit, eye.run ? &eye : NULL, inside);
+    drive(s, w, ray, tmax, -1, visit, eye.run ? &eye : NULL);
+}
+
+// The lists' way of a ray that Outside watches (across): a primary ray's (route 1) or any
+// ray's (0); a shadow ray's towards light `route`.
+template <class Visit>
+inline void lists(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Outside<Visit> &o, int route) {
+    if (route == 1) primary_hits(s, w, ray, tmax, o);
+    else find_hits(s, w, ray, tmax, self, o);
+}
+inline void lists(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Outside<ShadowHit> &o, int route) {
+    shadow_hits(s, w, ray, tmax, self, route, o);
+}
+
+// A ray of a scene where materials meet (Scene::iface), instead of find_hits, shadow_hits or
+// primary_hits (`route`, as for lists): the lists while the ray is outside the solid, then the
+// reference sweep (Outside). `inside`: whether the ray starts inside the solid (1), outside (0),
+// or unknown (-1).
+template <class Visit>
+PRAY_NOINLINE void across(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, int inside,
+                          int route) {
+    real done = -REAL_INF;
+    if (s->accel && inside != 1) {
+        Outside<Visit> o(visit);
+        lists(s, w, ray, tmax, self, o, route);
+        if (!o.inside && (o.hits || inside == 0 || !starts_inside(s, w, ray))) return;
+        done = o.done;
+    }
+    After<Visit> rest(visit, done);
+    sweep(s, w, ray, tmax, self, rest);
+    if (w->rbits && s->accel) {
+        real e = visit_end(visit);
+        region_note(w, ray, e < tmax ? e : tmax);
+    }
 }
 
 // =============================================================================================
@@ -7413,7 +7447,7 @@ R3 shading_normal(const Prim &q, R3 x, const Shade &sh, R3 ds, R3 dt, bool outwa
 // The direction a ray along d takes on through a surface whose unit normal n faces it, for the
 // ratio eta of the indices (the side it comes from over the side it enters), by Snell's law;
 // false at total internal reflection.
-bool refract_dir(R3 d, R3 n, double eta, R3 *out) {
+inline bool refract_dir(R3 d, R3 n, double eta, R3 *out) {
     real ci = -dot(n, d);
     double k = 1.0 - eta * eta * (1.0 - (double)ci * ci);
     if (k < 0) return false;
@@ -7431,6 +7465,10 @@ void shade_at(const Prim &q, R3 x, Shade *sh, double *ts, double *tt, R3 *ds, R3
         shade_of(q.mat, *ts, *tt, sh);
     }
 }
+
+// Rays back to the side a ray came from, reflected or towards a light, start inside the solid
+// where the ray was inside before hit h.
+inline int inside_before(const Hit &h) { return !h.root_enter || h.from >= 0; }
 
 // The ratio of the refractive indices across hit h at x (m: the model that shades it): the
 // material the ray leaves over the one it enters; empty space counts 1.
@@ -7471,8 +7509,12 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
     tr.w->k.rays[kind] += 1;
     FirstHit fh;
     fh.found = false;
-    if (kind == RAY_PRIMARY) primary_hits(s, tr.w, ray, REAL_INF, fh, tr.eye_in);
-    else find_hits(s, tr.w, ray, REAL_INF, self, fh, inside);
+    // where materials meet, a ray that starts inside the solid is traced across them (a first hit
+    // from outside is where the solid is entered, as before)
+    if (kind == RAY_PRIMARY) inside = tr.eye_in;
+    if (s->iface && inside) across(s, tr.w, ray, REAL_INF, self, fh, inside, kind == RAY_PRIMARY);
+    else if (kind == RAY_PRIMARY) primary_hits(s, tr.w, ray, REAL_INF, fh);
+    else find_hits(s, tr.w, ray, REAL_INF, self, fh);
     if (!fh.found) return tr.bg;
     const Hit &h = fh.h;
     const Prim &q = s->prims[h.prim], &qm = s->prims[h.mat];  // the face, and its material
@@ -7485,8 +7527,7 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
     bool outward = h.prim_enter == h.root_enter;
     R3 n = shading_normal(q, x, sh, ds, dt, outward, ray.d);
     bool record = seen && qm.mat->kind != M_FLAT && s->lights.n <= SEEN_LIGHTS && model_lit_only(qm.mat);
-    // rays back to the side the ray came from start inside the solid where it was inside
-    int back = !h.root_enter || h.from >= 0, lights_in = 0;
+    int lights_in = 0;
     if (seen) {
         seen->hit = h.prim;
         seen->enter = h.prim_enter;
@@ -7515,22 +7556,23 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
             sh.ray = &sr;
             sh.f = cmake(1, 1, 1);
             tr.w->k.rays[RAY_SHADOW] += 1;
-            shadow_hits(s, tr.w, sr, dist, h.prim, i, sh, back);
+            if (s->iface == 2 || (s->iface && inside_before(h)))  // (it may go on into a solid)
+                across(s, tr.w, sr, dist, h.prim, sh, inside_before(h), i);
+            else shadow_hits(s, tr.w, sr, dist, h.prim, i, sh);
             li = cmul(li, sh.f);
         }
-        lights_in += !czero(li);
         if (record) {
             seen->lights |= 1u << i;
             seen->light[i] = li;
         }
-        if (!czero(li)) phong_light(&col, m, li, n, l, ndl, ray.d);
+        if (!czero(li)) phong_light(&col, m, li, n, l, ndl, ray.d), lights_in = 1;
     }
-    if (kind == RAY_PRIMARY && lit) tr.w->k.seen[lights_in > 0] += 1;  // (the warning of section 12)
+    if (kind == RAY_PRIMARY && lit) tr.w->k.seen[lights_in] += 1;  // (the warning of section 12)
     pray_rgb refl = m->reflect;
     if (!czero(m->transmit) && level < s->depth) {
         double wt = weight * rgb_maxabs(m->transmit);
         Ray rr;
-        if (!refract_dir(ray.d, n, hit_eta(s, h, x, sh), &rr.d)) {
+        if (!refract_dir(ray.d, n, h.from < 0 ? (h.root_enter ? 1.0 / m->index : m->index) : hit_eta(s, h, x, sh), &rr.d)) {
             refl = cadd(refl, m->transmit);  // total internal reflection
         } else if (worth_tracing(tr, level, wt)) {
             rr.o = x;
@@ -7542,7 +7584,7 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
         Ray rr;
         rr.o = x;
         rr.d = unit(ray.d - n * (2 * dot(n, ray.d)));
-        col = cadd(col, cmul(refl, trace(tr, rr, level + 1, h.prim, RAY_REFLECT, NULL, wr, back)));
+        col = cadd(col, cmul(refl, trace(tr, rr, level + 1, h.prim, RAY_REFLECT, NULL, wr, inside_before(h))));
     }
     return col;
 }
@@ -7866,7 +7908,8 @@ void put_first_hit(Worker &k, int i, int j) {
     ray.d = unit(ray.d);
     FirstHit fh;
     fh.found = false;
-    find_hits(job->s, &k.w, ray, REAL_INF, -1, fh);
+    if (job->s->iface) across(job->s, &k.w, ray, REAL_INF, -1, fh, -1, 0);
+    else find_hits(job->s, &k.w, ray, REAL_INF, -1, fh);
     pray_hit h;
     h.primitive = -1;
     h.t = HUGE_VAL;
@@ -10300,7 +10343,9 @@ int pray_intersect(pray_ctx *c, pray_scene *q, pray_vec origin, pray_vec dir, do
     ch.out = hits;
     ch.max = max_hits;
     ch.n = 0;
-    find_hits(&q->s, &q->w, ch.ray, tmax >= HUGE_VAL ? REAL_INF : (real)tmax, -1, ch);
+    real t = tmax >= HUGE_VAL ? REAL_INF : (real)tmax;
+    if (q->s.iface) across(&q->s, &q->w, ch.ray, t, -1, ch, -1, 0);
+    else find_hits(&q->s, &q->w, ch.ray, t, -1, ch);
     return ch.n;
 }
 
