@@ -1872,8 +1872,7 @@ struct Scene {
     int prune;        // drop parts that bounds show cannot matter
     int leaves;       // primitives met so far while flattening
     int tori;         // tori among the primitives (each may cross a ray four times)
-    int iface;        // two different materials may meet inside the solid (scene_interfaces); 2:
-                      // and some material lets light through (so that rays go on into solids)
+    int iface;        // two different materials may meet inside the solid (scene_interfaces)
     Accel *accel;     // NULL: the brute-force reference
     Array<Light> lights;
     int parallel;
@@ -2849,8 +2848,6 @@ pray_status scene_interfaces(pray_ctx *c, Scene *s) {
     }
     mem_free(c, key);
     mem_free(c, at);
-    for (int i = 0; i < n && s->iface == 1; i++)
-        if (model_clear(s->prims[i].mat) > 0) s->iface = 2;
     return PRAY_OK;
 }
 
@@ -3329,6 +3326,7 @@ struct Scratch {
     Cross *cross;
     Hull *hull;  // per solid of a list with a plan (at most one per node)
     unsigned char *pstat, *nstat, *nfirst;
+    unsigned char *away;  // per node: a ray of across misses its box (sweep_start)
     int *cnt;
     Counters k;
     // per ray, stamped with the ray number (thesis 3.5: no explicit unfreezing)
@@ -3366,6 +3364,7 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->pstat = (unsigned char *)thread_alloc(c, np);
     w->nstat = (unsigned char *)thread_alloc(c, nn);
     w->nfirst = (unsigned char *)thread_alloc(c, nn);
+    w->away = (unsigned char *)thread_alloc(c, nn);
     w->cnt = (int *)thread_alloc(c, sizeof(int) * nn);
     w->span = (Span *)thread_alloc(c, sizeof(Span) * np);
     w->nfrozen = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
@@ -3373,7 +3372,7 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->nfixval = (unsigned char *)thread_alloc(c, nn);
     w->blocker = (Blocker *)thread_alloc(c, sizeof(Blocker) * (size_t)(s->lights.n + 1));
     if (w->blocker) shadow_cache_clear(s, w);
-    return w->blocker && w->cross && (w->span2 || !s->tori) && w->hull && w->pstat && w->nstat && w->nfirst && w->cnt && w->span &&
+    return w->blocker && w->cross && (w->span2 || !s->tori) && w->hull && w->pstat && w->nstat && w->nfirst && w->away && w->cnt && w->span &&
            w->nfrozen && w->nfixed && w->nfixval;
 }
 
@@ -3389,6 +3388,7 @@ void scratch_release(pray_ctx *c, Scratch *w) {
     mem_free(c, w->pstat);
     mem_free(c, w->nstat);
     mem_free(c, w->nfirst);
+    mem_free(c, w->away);
     mem_free(c, w->cnt);
 }
 
@@ -3507,18 +3507,37 @@ inline void add_cross(Scratch *w, int *nc, real t, int prim, int enter, real a, 
     x.enter = enter;
 }
 
+bool ray_box(const Ray &r, const real *inv, const real *lo, const real *hi, real *t0, real *t1);
+inline void ray_inverse(const Ray &ray, real *inv);
+
+// Does the part (0, tmax) of the ray miss the box (whose solid is then outside all along it)?
+inline bool misses(const Ray &ray, const real *inv, real tmax, const Box &b) {
+    real t0, t1;
+    return box_finite(b) && !(ray_box(ray, inv, b.lo, b.hi, &t0, &t1) && t1 > 0 && t0 < tmax);
+}
+
 // The start of a sweep: the status of every primitive and node at the start of the ray (just
 // after it, for a start on a surface) into w, and the crossings in (0, tmax) into w->cross
-// (*ncross of them, unsorted). Returns the root's status. The root must be an element.
-bool sweep_start(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int *ncross) {
+// (*ncross of them, unsorted). Returns the root's status. The root must be an element. `cull`
+// (across, not the reference): the primitives and nodes whose boxes the ray misses are outside
+// without a test.
+bool sweep_start(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int *ncross, bool cull = false) {
     int nc = 0;
     int np = s->prims.n;
-    for (int j = 0; j < s->nodes.n; j++) {
+    real inv[3];
+    if (cull) ray_inverse(ray, inv);
+    for (int j = s->nodes.n - 1; j >= 0; j--) {  // (parents first)
+        const Node &nd = s->nodes[j];
         w->cnt[j] = 0;
         w->nfirst[j] = 0;
+        w->away[j] = cull && ((nd.parent >= 0 && w->away[nd.parent]) || misses(ray, inv, tmax, nd.box));
     }
     for (int i = 0; i < np; i++) {
         const Prim &q = s->prims[i];
+        if (cull && ((q.parent >= 0 && w->away[q.parent]) || misses(ray, inv, tmax, q.box))) {
+            w->pstat[i] = 0;
+            continue;
+        }
         real t[4] = {0, 0, 0, 0};
         w->k.tests += 1;
         int k = prim_span(q, ray, twin(s, i, self), &t[0], &t[1], &t[2]);
@@ -3538,7 +3557,7 @@ bool sweep_start(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
     }
     for (int j = 0; j < s->nodes.n; j++) {
         const Node &nd = s->nodes[j];
-        bool st = node_status(nd, w->cnt[j], w->nfirst[j]);
+        bool st = !w->away[j] && node_status(nd, w->cnt[j], w->nfirst[j]);
         w->nstat[j] = st;
         if (st && nd.parent >= 0) {
             if (nd.first && s->nodes[nd.parent].op == O_DIFF) w->nfirst[nd.parent] = 1;
@@ -3555,13 +3574,28 @@ bool starts_inside(const Scene *s, Scratch *w, const Ray &ray) {
     return s->root < 0 ? s->root == E_ALL : sweep_start(s, w, ray, 0, -1, &nc);
 }
 
+// The face where materials meet at the crossings [g0, g1) of a sweep, all at one t: the last of
+// them that its primitive's status took, of a primitive within every box above it (so that a
+// sweep which leaves out the parts whose boxes the ray misses, across, takes the same one).
+int face_of(const Scene *s, const Scratch *w, const Ray &ray, real tmax, int g0, int g1) {
+    real inv[3];
+    ray_inverse(ray, inv);
+    for (int k = g1 - 1; k > g0; k--) {
+        const Cross &x = w->cross[k];
+        int p = s->prims[x.prim].parent;
+        while (p >= 0 && !misses(ray, inv, tmax, s->nodes[p].box)) p = s->nodes[p].parent;
+        if (p < 0 && (w->pstat[x.prim] != 0) == (x.enter != 0)) return k;
+    }
+    return g0;
+}
+
 // Visit the visible surfaces along the ray in (0, tmax) in order; `visit` returns false to stop.
 // Returns the number of hits visited.
 template <class Visit>
-int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
+int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, bool cull = false) {
     if (s->root < 0) return 0;
     int nc = 0;
-    bool root = sweep_start(s, w, ray, tmax, self, &nc);
+    bool root = sweep_start(s, w, ray, tmax, self, &nc, cull);
     if (nc > 1) sort_crossings(w->cross, nc);
     int hits = 0;
     // where materials meet (Scene::iface): the material the ray is in while inside (owner)
@@ -3569,7 +3603,7 @@ int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit
     for (int i = 0; i < nc;) {
         real t = w->cross[i].t;
         bool before = root;
-        int last = -1, moved = -1;
+        int last = -1, moved = -1, g0 = i;
         for (; i < nc && w->cross[i].t == t; i++) {
             const Cross &x = w->cross[i];
             bool st = x.enter != 0;
@@ -3590,7 +3624,8 @@ int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit
         mat = root ? owner(s, w) : -1;
         if (root && before && was >= 0 && mat >= 0 && other_material(s, was, mat)) {
             // a face between two materials inside the solid: a surface of the one entered
-            Hit h = solid_hit(t, w->cross[moved].prim, w->cross[moved].enter, true);
+            const Cross &x = w->cross[face_of(s, w, ray, tmax, g0, i)];
+            Hit h = solid_hit(t, x.prim, x.enter, true);
             h.mat = mat;
             h.from = was;
             hits++;
@@ -3620,7 +3655,8 @@ struct ShadowHit {
     pray_rgb f;
     real t;
     bool operator()(const Hit &x) {
-        const Prim &q = s->prims[x.mat];
+        if (x.from >= 0) return true;  // (a face between materials inside the solid: trace)
+        const Prim &q = s->prims[x.prim];
         f = cmul(f, q.mat->kind == M_FLAT ? q.mat->transmit : transmit_at(q, ray->o + ray->d * x.t));
         if (!czero(f)) return true;
         t = x.t;
@@ -6185,9 +6221,8 @@ struct Outside {
     explicit Outside(Visit &v_) : v(v_), done(-REAL_INF), hits(0), inside(0) {}
     bool operator()(const Hit &h) {
         hits++;
-        if (!h.root_enter || v(h)) inside = 1;
-        else done = h.t;
-        if (inside && h.root_enter) done = h.t;
+        if (!h.root_enter) inside = 1;          // it was inside from its start
+        else if (v(h)) inside = 1, done = h.t;  // the visitor goes on into the solid
         return false;
     }
 };
@@ -6203,8 +6238,8 @@ struct After {
     bool operator()(const Hit &h) { return h.t <= done || v(h); }
 };
 
-// All hits along the ray in (0, tmax), by the reference or the accelerated path (where
-// materials meet, through across).
+// All hits along the ray in (0, tmax), by the reference or the accelerated path. (Where
+// materials meet, a ray that may be inside the solid goes through across.)
 template <class Visit>
 void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
     if (!s->accel) {
@@ -6218,7 +6253,6 @@ void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, 
     GridSource grid(s->accel, ray);
     drive(s, w, ray, tmax, self, visit, &grid);
 }
-
 
 // The shadow cache (option shadowcache): the voxel where the last shadow ray towards the same
 // light met an opaque surface (Scratch::blocker) is likely to hold one that stops this ray too.
@@ -6274,27 +6308,21 @@ bool blocker_of(const Accel *A, R3 p, Blocker *bk) {
 
 // The hits along a shadow ray towards light `light`: the shadow cache's answer when it has one;
 // else through the light buffer's voxel when the ray starts in one; else as any other ray.
-// (The shadow ray's own visitor, also where Outside passes its hits on: across.)
-inline ShadowHit &shadow_of(ShadowHit &v) { return v; }
-inline ShadowHit &shadow_of(Outside<ShadowHit> &o) { return o.v; }
-
-template <class Visit>
-void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, Visit &visit) {
+void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, ShadowHit &visit) {
     const Accel *A = s->accel;
     if (!A || A->g.n[0] == 0) {
         find_hits(s, w, ray, tmax, self, visit);
         return;
     }
     Blocker *bk = w->blocker + light;
-    ShadowHit &v = shadow_of(visit);
-    if (A->cache && bk->list >= 0 && shadow_probe(s, w, ray, tmax, self, light, v)) return;
+    if (A->cache && bk->list >= 0 && shadow_probe(s, w, ray, tmax, self, light, visit)) return;
     ZoneSource zone;
     zone.L = A->lbuf ? lightbuf_find(A->lbuf[light], A->outer, ray.o, tmax, &zone.ta, &zone.tb) : -1;
     if (zone.L >= 0) {  // (the outer list alone when the ray misses the grid's box)
         w->k.lbuf += 1;
         drive(s, w, ray, tmax, self, visit, &zone);
     } else find_hits(s, w, ray, tmax, self, visit);
-    if (A->cache && !(czero(v.f) && blocker_of(A, ray.o + ray.d * v.t, bk))) bk->list = -1;
+    if (A->cache && !(czero(visit.f) && blocker_of(A, ray.o + ray.d * visit.t, bk))) bk->list = -1;
 }
 
 // The hits along a primary ray, which starts at the eye: through the cell of the eye's buffer
@@ -6329,33 +6357,22 @@ void primary_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, Visit &
     drive(s, w, ray, tmax, -1, visit, eye.run ? &eye : NULL);
 }
 
-// The lists' way of a ray that Outside watches (across): a primary ray's (route 1) or any
-// ray's (0); a shadow ray's towards light `route`.
-template <class Visit>
-inline void lists(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Outside<Visit> &o, int route) {
-    if (route == 1) primary_hits(s, w, ray, tmax, o);
-    else find_hits(s, w, ray, tmax, self, o);
-}
-inline void lists(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Outside<ShadowHit> &o, int route) {
-    shadow_hits(s, w, ray, tmax, self, route, o);
-}
-
-// A ray of a scene where materials meet (Scene::iface), instead of find_hits, shadow_hits or
-// primary_hits (`route`, as for lists): the lists while the ray is outside the solid, then the
-// reference sweep (Outside). `inside`: whether the ray starts inside the solid (1), outside (0),
-// or unknown (-1).
+// A ray of a scene where materials meet (Scene::iface), instead of find_hits or primary_hits
+// (`primary`): the lists while the ray is outside the solid, then the reference sweep (Outside).
+// `inside`: whether the ray starts inside the solid (1), outside (0), or unknown (-1).
 template <class Visit>
 PRAY_NOINLINE void across(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, int inside,
-                          int route) {
+                          bool primary) {
     real done = -REAL_INF;
     if (s->accel && inside != 1) {
         Outside<Visit> o(visit);
-        lists(s, w, ray, tmax, self, o, route);
+        if (primary) primary_hits(s, w, ray, tmax, o);
+        else find_hits(s, w, ray, tmax, self, o);
         if (!o.inside && (o.hits || inside == 0 || !starts_inside(s, w, ray))) return;
         done = o.done;
     }
     After<Visit> rest(visit, done);
-    sweep(s, w, ray, tmax, self, rest);
+    sweep(s, w, ray, tmax, self, rest, s->accel != NULL);  // (the reference's way, with boxes)
     if (w->rbits && s->accel) {
         real e = visit_end(visit);
         region_note(w, ray, e < tmax ? e : tmax);
@@ -7204,7 +7221,7 @@ static const unsigned char FONT6X9[95][9] = {
 struct Tracer {
     const Scene *s;
     Scratch *w;
-    int eye_in;   // primary rays start inside the solid: 1, outside: 0, unknown: -1 (drive)
+    int eye_in;   // primary rays start inside the solid: 1, outside: 0, unknown: -1 (across)
     pray_rgb bg;  // background of the current pixel's row
     long left;    // rays the current sample may still take (Scene::maxrays)
     double lost;  // the most the rays left out of the current sample could have added
@@ -7466,8 +7483,8 @@ void shade_at(const Prim &q, R3 x, Shade *sh, double *ts, double *tt, R3 *ds, R3
     }
 }
 
-// Rays back to the side a ray came from, reflected or towards a light, start inside the solid
-// where the ray was inside before hit h.
+// A ray reflected back to the side a ray came from starts inside the solid where the ray was
+// inside before hit h.
 inline int inside_before(const Hit &h) { return !h.root_enter || h.from >= 0; }
 
 // The ratio of the refractive indices across hit h at x (m: the model that shades it): the
@@ -7494,7 +7511,7 @@ inline bool worth_tracing(Tracer &tr, int level, double weight) {
 
 // The colour a ray brings back; `seen`, when given, receives what it saw; `weight`: how much of
 // it reaches the sample, at most, in any channel.
-// `inside`: whether the ray starts inside the solid (1, 0, -1 unknown; drive), for rays other
+// `inside`: whether the ray starts inside the solid (1, 0, -1 unknown; across), for rays other
 // than primary ones.
 pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *seen = NULL, double weight = 1,
                int inside = -1) {
@@ -7556,9 +7573,10 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
             sh.ray = &sr;
             sh.f = cmake(1, 1, 1);
             tr.w->k.rays[RAY_SHADOW] += 1;
-            if (s->iface == 2 || (s->iface && inside_before(h)))  // (it may go on into a solid)
-                across(s, tr.w, sr, dist, h.prim, sh, inside_before(h), i);
-            else shadow_hits(s, tr.w, sr, dist, h.prim, i, sh);
+            // (a shadow ray is filtered at the faces of the solid it crosses; a face between two
+            // materials inside the solid lets the light through as it is, ShadowHit: so that a
+            // shadow ray never needs the reference sweep, whatever materials meet)
+            shadow_hits(s, tr.w, sr, dist, h.prim, i, sh);
             li = cmul(li, sh.f);
         }
         if (record) {
@@ -7908,7 +7926,7 @@ void put_first_hit(Worker &k, int i, int j) {
     ray.d = unit(ray.d);
     FirstHit fh;
     fh.found = false;
-    if (job->s->iface) across(job->s, &k.w, ray, REAL_INF, -1, fh, -1, 0);
+    if (job->s->iface) across(job->s, &k.w, ray, REAL_INF, -1, fh, -1, false);
     else find_hits(job->s, &k.w, ray, REAL_INF, -1, fh);
     pray_hit h;
     h.primitive = -1;
@@ -10344,7 +10362,7 @@ int pray_intersect(pray_ctx *c, pray_scene *q, pray_vec origin, pray_vec dir, do
     ch.max = max_hits;
     ch.n = 0;
     real t = tmax >= HUGE_VAL ? REAL_INF : (real)tmax;
-    if (q->s.iface) across(&q->s, &q->w, ch.ray, t, -1, ch, -1, 0);
+    if (q->s.iface) across(&q->s, &q->w, ch.ray, t, -1, ch, -1, false);
     else find_hits(&q->s, &q->w, ch.ray, t, -1, ch);
     return ch.n;
 }

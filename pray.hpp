@@ -389,7 +389,8 @@ void pray_stats_get(const pray_ctx *ctx, pray_stats *out);
 
 /* Ray queries, for picking and for checking the renderer: prepare a solid once with the
    context's options (grid, freeze, merge, bounds, brute), then ask for the surfaces a ray
-   crosses. The surfaces are those of the whole solid, in order along the ray. */
+   crosses. The surfaces are those of the whole solid, and the faces between two different
+   materials inside it (the language's section 12), in order along the ray. */
 typedef struct pray_scene pray_scene;
 typedef struct pray_hit {
     double t;          /* the ray parameter: origin + t * unit(direction) */
