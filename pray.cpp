@@ -3295,7 +3295,6 @@ struct Counters {
     double ebuf;  // primary rays answered by the eye's buffer
     double cache; // shadow rays answered by the shadow cache
     double notes, cells;  // image sequences: rays and region cells noted in records (10b)
-    double seen[2];  // surfaces met by primary rays that take light: no light reaches them, some does
 };
 enum { RAY_PRIMARY, RAY_SHADOW, RAY_REFLECT, RAY_REFRACT };
 
@@ -7222,6 +7221,8 @@ struct Tracer {
     const Scene *s;
     Scratch *w;
     int eye_in;   // primary rays start inside the solid: 1, outside: 0, unknown: -1 (across)
+    int seen;     // of the surfaces primary rays met that take light: bit 0 one that no light
+                  // reaches, bit 1 one that some light reaches (the warning of language 12)
     pray_rgb bg;  // background of the current pixel's row
     long left;    // rays the current sample may still take (Scene::maxrays)
     double lost;  // the most the rays left out of the current sample could have added
@@ -7585,7 +7586,7 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
         }
         if (!czero(li)) phong_light(&col, m, li, n, l, ndl, ray.d), lights_in = 1;
     }
-    if (kind == RAY_PRIMARY && lit) tr.w->k.seen[lights_in] += 1;  // (the warning of section 12)
+    if (kind == RAY_PRIMARY && lit) tr.seen |= 1 << lights_in;
     pray_rgb refl = m->reflect;
     if (!czero(m->transmit) && level < s->depth) {
         double wt = weight * rgb_maxabs(m->transmit);
@@ -8302,8 +8303,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         else st = c->status;
         scratch_release(c, &w);
     }
-    int made = 0;
-    double seen[2] = {0, 0};  // primary rays' surfaces that take light: dark, lit
+    int made = 0, seen = 0;  // (Tracer::seen of all threads)
     for (; st == PRAY_OK && made < nt; made++) {
         Worker &k = worker_at(wbuf, stride, made);
         k.job = &job;
@@ -8341,8 +8341,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         c->stats.rays_lightbuf += k.lbuf;
         c->stats.rays_eyebuf += k.ebuf;
         c->stats.rays_shadowcache += k.cache;
-        seen[0] += k.seen[0];
-        seen[1] += k.seen[1];
+        seen |= worker_at(wbuf, stride, i).tr.seen;
         if (job.redo) {
             c->stats.pixels_reused += worker_at(wbuf, stride, i).kept;
             c->stats.pixels_retraced += worker_at(wbuf, stride, i).traced;
@@ -8361,7 +8360,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
     // no light reaches anything the eye sees (a frame that takes pixels over from the frame
     // before, which had the same lights and camera, keeps that frame's answer for them)
     if (st == PRAY_OK)
-        c->no_light = c->dark = s->lights.n > 0 && !seen[1] && (seen[0] || job.redo) && (!job.redo || c->dark);
+        c->no_light = c->dark = s->lights.n > 0 && !(seen & 2) && ((seen & 1) || job.redo) && (!job.redo || c->dark);
     c->stats.threads = nt;
     mem_free(c, wbuf);
     mem_free(c, args);
