@@ -2806,8 +2806,8 @@ bool solids_apart(const Prim &a, const Prim &b) {
 
 // Scene::iface: may two primitives of different models (as values) overlap or touch? Only then
 // can a ray meet a face between two materials inside the solid. The boxes in n buckets of their
-// lower x (a counting sort), each against those after it that start in a bucket up to the one of
-// its upper x; the answer at the first such pair.
+// lower ends along one axis (a counting sort), each against those after it that start in a
+// bucket up to the one of its upper end; the answer at the first such pair.
 pray_status scene_interfaces(pray_ctx *c, Scene *s) {
     int n = s->prims.n, k = 1;
     s->iface = 0;
@@ -2819,13 +2819,16 @@ pray_status scene_interfaces(pray_ctx *c, Scene *s) {
         mem_free(c, at);
         return c->status;
     }
-    int *order = key + n;
-    double x0 = HUGE_VAL, x1 = -HUGE_VAL;  // the finite lower ends
-    for (int i = 0; i < n; i++) {
-        double x = (double)s->prims[i].box.lo[0];
-        if (x > -REAL_BIG) x0 = x < x0 ? x : x0, x1 = x > x1 ? x : x1;
-    }
-    double scale = x1 > x0 ? (n - 1) / (x1 - x0) : 0;
+    int *order = key + n, l = 0;
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};  // finite lower ends
+    for (int i = 0; i < n; i++)
+        for (int a = 0; a < 3; a++) {
+            double x = (double)s->prims[i].box.lo[a];
+            if (x > -REAL_BIG) lo[a] = x < lo[a] ? x : lo[a], hi[a] = x > hi[a] ? x : hi[a];
+        }
+    for (int a = 1; a < 3; a++)  // (along the axis where they spread most)
+        if (hi[a] - lo[a] > hi[l] - lo[l]) l = a;
+    double x0 = lo[l], x1 = hi[l], scale = x1 > x0 ? (n - 1) / (x1 - x0) : 0;
     struct Bucket {  // (of x, clamped: 0 below x0, n - 1 above x1)
         double x0, scale;
         int last;
@@ -2834,12 +2837,12 @@ pray_status scene_interfaces(pray_ctx *c, Scene *s) {
             return !(f > 0) ? 0 : f >= last ? last : (int)f;
         }
     } bucket = {x0, scale, n - 1};
-    for (int i = 0; i < n; i++) at[(key[i] = bucket(s->prims[i].box.lo[0])) + 1]++;
+    for (int i = 0; i < n; i++) at[(key[i] = bucket(s->prims[i].box.lo[l])) + 1]++;
     for (int j = 0; j < n; j++) at[j + 1] += at[j];
     for (int i = 0; i < n; i++) order[at[key[i]]++] = i;
     for (int a = 0; a < n && !s->iface; a++) {
         const Prim &p = s->prims[order[a]];
-        for (int b = a + 1, end = bucket(p.box.hi[0]); b < n && key[order[b]] <= end; b++) {
+        for (int b = a + 1, end = bucket(p.box.hi[l]); b < n && key[order[b]] <= end; b++) {
             const Prim &q = s->prims[order[b]];
             if (p.mat == q.mat || !box_overlap(p.box, q.box) || model_same(p.mat, q.mat) || solids_apart(p, q)) continue;
             s->iface = 1;
