@@ -7225,7 +7225,7 @@ struct Tracer {
     Scratch *w;
     int eye_in;   // primary rays start inside the solid: 1, outside: 0, unknown: -1 (across)
     int seen;     // of the surfaces primary rays met that take light: bit 0 one that no light
-                  // reaches, bit 1 one that some light reaches (the warning of language 12)
+                  // reaches, bit 1 one that a light adds to (the warning of language 12)
     pray_rgb bg;  // background of the current pixel's row
     long left;    // rays the current sample may still take (Scene::maxrays)
     double lost;  // the most the rays left out of the current sample could have added
@@ -7548,7 +7548,6 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
     bool outward = h.prim_enter == h.root_enter;
     R3 n = shading_normal(q, x, sh, ds, dt, outward, ray.d);
     bool record = seen && qm.mat->kind != M_FLAT && s->lights.n <= SEEN_LIGHTS && model_lit_only(qm.mat);
-    int lights_in = 0;
     if (seen) {
         seen->hit = h.prim;
         seen->enter = h.prim_enter;
@@ -7587,9 +7586,12 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
             seen->lights |= 1u << i;
             seen->light[i] = li;
         }
-        if (!czero(li)) phong_light(&col, m, li, n, l, ndl, ray.d), lights_in = 1;
+        if (!czero(li)) phong_light(&col, m, li, n, l, ndl, ray.d);
     }
-    if (kind == RAY_PRIMARY && lit) tr.seen |= 1 << lights_in;
+    if (kind == RAY_PRIMARY && lit && !(tr.seen & 2)) {  // (once a thread has seen light, no more)
+        pray_rgb own = cadd(m->emit, m->ambient);
+        tr.seen |= col.r != own.r || col.g != own.g || col.b != own.b ? 2 : 1;
+    }
     pray_rgb refl = m->reflect;
     if (!czero(m->transmit) && level < s->depth) {
         double wt = weight * rgb_maxabs(m->transmit);
