@@ -584,6 +584,8 @@ struct pray_ctx {
     double written;          // bytes of image files written by this run (option maxoutput)
     pray_object *drop;       // given up by a program's rendertiff: released once flattened (scene_build)
     int eye_inside;          // the camera's eye is inside the solid last rendered (render_scene)
+    int no_light, dark;      // no light reaches any surface the eye saw in it (render_scene);
+                             // dark: the same of the last frame rendered, kept
     volatile sig_atomic_t cancel;  // CANCEL_*: the running call stops at its next check
     int calls;               // cancellable public calls running (a run renders and writes)
     double started;          // when the outermost of them started (option maxtime)
@@ -1944,6 +1946,7 @@ struct Scene {
     int prune;        // drop parts that bounds show cannot matter
     int leaves;       // primitives met so far while flattening
     int tori;         // tori among the primitives (each may cross a ray four times)
+    int iface;        // two different materials may meet inside the solid (scene_interfaces)
     Accel *accel;     // NULL: the brute-force reference
     Array<Light> lights;
     int parallel;
@@ -2854,6 +2857,77 @@ pray_status scene_compact(pray_ctx *c, Scene *s) {
     return st;
 }
 
+// ---- where materials meet (language 12) ----
+bool model_same(const pray_model *a, const pray_model *b);
+
+// The solids of two primitives neither overlap nor touch but at a point, for certain: spheres,
+// and a sphere or a box against a half-space whose normal is along an axis (so that balls
+// resting on a floor or on one another, and boxes above it, are apart). False: perhaps not.
+bool solids_apart(const Prim &a, const Prim &b) {
+    if (b.kind == O_PLANE && a.kind != O_PLANE) return solids_apart(b, a);
+    if (a.kind == O_SPHERE && b.kind == O_SPHERE && !a.fr && !b.fr) {
+        R3 v = a.p - b.p;
+        real r = a.r + b.r;
+        return dot(v, v) >= r * r;
+    }
+    if (a.kind != O_PLANE) return false;
+    if (b.kind == O_SPHERE && !b.fr) return dot(a.n, b.p) - a.d >= b.r;
+    if (!a.axis) return false;
+    int l = a.axis == &R3::x ? 0 : a.axis == &R3::y ? 1 : 2;
+    real n = a.n.*a.axis;  // (the half-space is n x_l <= d; the box's nearest point to it)
+    return (n > 0 ? n * b.box.lo[l] : n * b.box.hi[l]) >= a.d;
+}
+
+// Scene::iface: may two primitives of different models (as values) overlap or touch? Only then
+// can a ray meet a face between two materials inside the solid. The boxes in n buckets of their
+// lower ends along one axis (a counting sort), each against those after it that start in a
+// bucket up to the one of its upper end; the answer at the first such pair.
+pray_status scene_interfaces(pray_ctx *c, Scene *s) {
+    int n = s->prims.n, k = 1;
+    s->iface = 0;
+    while (k < n && (s->prims[k].mat == s->prims[0].mat || model_same(s->prims[k].mat, s->prims[0].mat))) k++;
+    if (k >= n) return PRAY_OK;  // one material
+    int *key = (int *)mem_alloc(c, sizeof(int) * 2 * (size_t)n), *at = (int *)mem_zalloc(c, sizeof(int) * ((size_t)n + 1));
+    if (!key || !at) {
+        mem_free(c, key);
+        mem_free(c, at);
+        return c->status;
+    }
+    int *order = key + n, l = 0;
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};  // finite lower ends
+    for (int i = 0; i < n; i++)
+        for (int a = 0; a < 3; a++) {
+            double x = (double)s->prims[i].box.lo[a];
+            if (x > -REAL_BIG) lo[a] = x < lo[a] ? x : lo[a], hi[a] = x > hi[a] ? x : hi[a];
+        }
+    for (int a = 1; a < 3; a++)  // (along the axis where they spread most)
+        if (hi[a] - lo[a] > hi[l] - lo[l]) l = a;
+    double x0 = lo[l], x1 = hi[l], scale = x1 > x0 ? (n - 1) / (x1 - x0) : 0;
+    struct Bucket {  // (of x, clamped: 0 below x0, n - 1 above x1)
+        double x0, scale;
+        int last;
+        int operator()(real x) const {
+            double f = ((double)x - x0) * scale;
+            return !(f > 0) ? 0 : f >= last ? last : (int)f;
+        }
+    } bucket = {x0, scale, n - 1};
+    for (int i = 0; i < n; i++) at[(key[i] = bucket(s->prims[i].box.lo[l])) + 1]++;
+    for (int j = 0; j < n; j++) at[j + 1] += at[j];
+    for (int i = 0; i < n; i++) order[at[key[i]]++] = i;
+    for (int a = 0; a < n && !s->iface; a++) {
+        const Prim &p = s->prims[order[a]];
+        for (int b = a + 1, end = bucket(p.box.hi[l]); b < n && key[order[b]] <= end; b++) {
+            const Prim &q = s->prims[order[b]];
+            if (p.mat == q.mat || !box_overlap(p.box, q.box) || model_same(p.mat, q.mat) || solids_apart(p, q)) continue;
+            s->iface = 1;
+            break;
+        }
+    }
+    mem_free(c, key);
+    mem_free(c, at);
+    return PRAY_OK;
+}
+
 // =============================================================================================
 // [SECTION] 8 Ray/primitive intersection; primitives in a frame (box, rod, cone, torus, stretched)
 // =============================================================================================
@@ -3328,6 +3402,7 @@ struct Scratch {
     Cross *cross;
     Hull *hull;  // per solid of a list with a plan (at most one per node)
     unsigned char *pstat, *nstat, *nfirst;
+    unsigned char *away;  // per node: a ray of across misses its box (sweep_start)
     int *cnt;
     Counters k;
     // per ray, stamped with the ray number (thesis 3.5: no explicit unfreezing)
@@ -3365,6 +3440,7 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->pstat = (unsigned char *)thread_alloc(c, np);
     w->nstat = (unsigned char *)thread_alloc(c, nn);
     w->nfirst = (unsigned char *)thread_alloc(c, nn);
+    w->away = (unsigned char *)thread_alloc(c, nn);
     w->cnt = (int *)thread_alloc(c, sizeof(int) * nn);
     w->span = (Span *)thread_alloc(c, sizeof(Span) * np);
     w->nfrozen = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
@@ -3372,7 +3448,7 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->nfixval = (unsigned char *)thread_alloc(c, nn);
     w->blocker = (Blocker *)thread_alloc(c, sizeof(Blocker) * (size_t)(s->lights.n + 1));
     if (w->blocker) shadow_cache_clear(s, w);
-    return w->blocker && w->cross && (w->span2 || !s->tori) && w->hull && w->pstat && w->nstat && w->nfirst && w->cnt && w->span &&
+    return w->blocker && w->cross && (w->span2 || !s->tori) && w->hull && w->pstat && w->nstat && w->nfirst && w->away && w->cnt && w->span &&
            w->nfrozen && w->nfixed && w->nfixval;
 }
 
@@ -3388,6 +3464,7 @@ void scratch_release(pray_ctx *c, Scratch *w) {
     mem_free(c, w->pstat);
     mem_free(c, w->nstat);
     mem_free(c, w->nfirst);
+    mem_free(c, w->away);
     mem_free(c, w->cnt);
 }
 
@@ -3452,9 +3529,49 @@ void sort_crossings(Cross *x, int n) {
 struct Hit {
     real t;
     int prim;
-    int prim_enter;  // the ray enters the primitive there
-    int root_enter;  // the ray enters the whole solid there
+    int mat;   // the primitive whose model shades the surface: prim, or on a face between two
+               // materials inside the solid (language 12) the one whose material is entered
+    int from;  // on such a face, the primitive whose material the ray leaves; else -1
+    unsigned char prim_enter;  // the ray enters the primitive there
+    unsigned char root_enter;  // the ray enters the whole solid there (1 too on a face between materials)
 };
+
+// A hit where the whole solid is entered or left: shaded with the primitive's own model.
+inline Hit solid_hit(real t, int prim, int prim_enter, bool root_enter) {
+    Hit h;
+    h.t = t;
+    h.prim = h.mat = prim;
+    h.prim_enter = (unsigned char)prim_enter;
+    h.root_enter = root_enter;
+    h.from = -1;
+    return h;
+}
+
+// Two primitives of different materials (language 12: models that differ as values).
+inline bool other_material(const Scene *s, int p, int q) {
+    return s->prims[p].mat != s->prims[q].mat && !model_same(s->prims[p].mat, s->prims[q].mat);
+}
+
+// The primitive whose material fills the solid where the ray is, the root being inside
+// (language 12): in a union the last child the ray is in, in an intersection its last child
+// that is not a complement, in a difference its first; -1 in a complement (no primitive puts
+// the point there). Reads the statuses of a full sweep (section 9).
+int owner(const Scene *s, const Scratch *w) {
+    int e = s->root;
+    while (e_is_node(e)) {
+        const Node &nd = s->nodes[e_index(e)];
+        const int *k = &s->kids[nd.k0];
+        int i = nd.op == O_DIFF ? 0 : nd.n - 1;
+        if (nd.op == O_UNION)
+            for (; i >= 0; i--)
+                if (e_is_node(k[i]) ? w->nstat[e_index(k[i])] : w->pstat[e_index(k[i])]) break;
+        if (nd.op == O_INTER)
+            while (i > 0 && e_is_node(k[i]) && s->nodes[e_index(k[i])].op == O_COMPL) i--;
+        if (nd.op == O_COMPL || i < 0) return -1;
+        e = k[i];
+    }
+    return e_index(e);
+}
 
 // A crossing of a primitive at t, when t is in (a, b] and before tmax: noted for a sweep
 // (`prim`: the primitive, or its place in a list with a plan, 9b).
@@ -3466,18 +3583,37 @@ inline void add_cross(Scratch *w, int *nc, real t, int prim, int enter, real a, 
     x.enter = enter;
 }
 
+bool ray_box(const Ray &r, const real *inv, const real *lo, const real *hi, real *t0, real *t1);
+inline void ray_inverse(const Ray &ray, real *inv);
+
+// Does the part (0, tmax) of the ray miss the box (whose solid is then outside all along it)?
+inline bool misses(const Ray &ray, const real *inv, real tmax, const Box &b) {
+    real t0, t1;
+    return box_finite(b) && !(ray_box(ray, inv, b.lo, b.hi, &t0, &t1) && t1 > 0 && t0 < tmax);
+}
+
 // The start of a sweep: the status of every primitive and node at the start of the ray (just
 // after it, for a start on a surface) into w, and the crossings in (0, tmax) into w->cross
-// (*ncross of them, unsorted). Returns the root's status. The root must be an element.
-bool sweep_start(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int *ncross) {
+// (*ncross of them, unsorted). Returns the root's status. The root must be an element. `cull`
+// (across, not the reference): the primitives and nodes whose boxes the ray misses are outside
+// without a test.
+bool sweep_start(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int *ncross, bool cull = false) {
     int nc = 0;
     int np = s->prims.n;
-    for (int j = 0; j < s->nodes.n; j++) {
+    real inv[3];
+    if (cull) ray_inverse(ray, inv);
+    for (int j = s->nodes.n - 1; j >= 0; j--) {  // (parents first)
+        const Node &nd = s->nodes[j];
         w->cnt[j] = 0;
         w->nfirst[j] = 0;
+        w->away[j] = cull && ((nd.parent >= 0 && w->away[nd.parent]) || misses(ray, inv, tmax, nd.box));
     }
     for (int i = 0; i < np; i++) {
         const Prim &q = s->prims[i];
+        if (cull && ((q.parent >= 0 && w->away[q.parent]) || misses(ray, inv, tmax, q.box))) {
+            w->pstat[i] = 0;
+            continue;
+        }
         real t[4] = {0, 0, 0, 0};
         w->k.tests += 1;
         int k = prim_span(q, ray, twin(s, i, self), &t[0], &t[1], &t[2]);
@@ -3497,7 +3633,7 @@ bool sweep_start(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
     }
     for (int j = 0; j < s->nodes.n; j++) {
         const Node &nd = s->nodes[j];
-        bool st = node_status(nd, w->cnt[j], w->nfirst[j]);
+        bool st = !w->away[j] && node_status(nd, w->cnt[j], w->nfirst[j]);
         w->nstat[j] = st;
         if (st && nd.parent >= 0) {
             if (nd.first && s->nodes[nd.parent].op == O_DIFF) w->nfirst[nd.parent] = 1;
@@ -3514,35 +3650,60 @@ bool starts_inside(const Scene *s, Scratch *w, const Ray &ray) {
     return s->root < 0 ? s->root == E_ALL : sweep_start(s, w, ray, 0, -1, &nc);
 }
 
+// The face where materials meet at the crossings [g0, g1) of a sweep, all at one t: the last of
+// them that its primitive's status took, of a primitive within every box above it (so that a
+// sweep which leaves out the parts whose boxes the ray misses, across, takes the same one).
+int face_of(const Scene *s, const Scratch *w, const Ray &ray, real tmax, int g0, int g1) {
+    real inv[3];
+    ray_inverse(ray, inv);
+    for (int k = g1 - 1; k > g0; k--) {
+        const Cross &x = w->cross[k];
+        int p = s->prims[x.prim].parent;
+        while (p >= 0 && !misses(ray, inv, tmax, s->nodes[p].box)) p = s->nodes[p].parent;
+        if (p < 0 && (w->pstat[x.prim] != 0) == (x.enter != 0)) return k;
+    }
+    return g0;
+}
+
 // Visit the visible surfaces along the ray in (0, tmax) in order; `visit` returns false to stop.
 // Returns the number of hits visited.
 template <class Visit>
-int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
+int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, bool cull = false) {
     if (s->root < 0) return 0;
     int nc = 0;
-    bool root = sweep_start(s, w, ray, tmax, self, &nc);
+    bool root = sweep_start(s, w, ray, tmax, self, &nc, cull);
     if (nc > 1) sort_crossings(w->cross, nc);
     int hits = 0;
+    // where materials meet (Scene::iface): the material the ray is in while inside (owner)
+    int mat = s->iface && root ? owner(s, w) : -1;
     for (int i = 0; i < nc;) {
         real t = w->cross[i].t;
         bool before = root;
-        int last = -1;
+        int last = -1, moved = -1, g0 = i;
         for (; i < nc && w->cross[i].t == t; i++) {
             const Cross &x = w->cross[i];
             bool st = x.enter != 0;
             if ((w->pstat[x.prim] != 0) == st) continue;
             w->pstat[x.prim] = st;
+            moved = i;
             if (propagate(s, w, 2 * x.prim, st)) {
                 root = !root;
                 last = i;
             }
         }
         if (root != before && last >= 0) {
-            Hit h;
-            h.t = t;
-            h.prim = w->cross[last].prim;
-            h.prim_enter = w->cross[last].enter;
-            h.root_enter = root;
+            hits++;
+            if (!visit(solid_hit(t, w->cross[last].prim, w->cross[last].enter, root))) break;
+        }
+        if (!s->iface || moved < 0) continue;
+        int was = mat;
+        mat = root ? owner(s, w) : -1;
+        if (root && before && was >= 0 && mat >= 0 && other_material(s, was, mat)) {
+            // a face between two materials inside the solid: a surface of the one entered
+            const Cross &x = w->cross[face_of(s, w, ray, tmax, g0, i)];
+            Hit h = solid_hit(t, x.prim, x.enter, true);
+            h.mat = mat;
+            h.from = was;
             hits++;
             if (!visit(h)) break;
         }
@@ -3570,6 +3731,7 @@ struct ShadowHit {
     pray_rgb f;
     real t;
     bool operator()(const Hit &x) {
+        if (x.from >= 0) return true;  // (a face between materials inside the solid: trace)
         const Prim &q = s->prims[x.prim];
         f = cmul(f, q.mat->kind == M_FLAT ? q.mat->transmit : transmit_at(q, ray->o + ray->d * x.t));
         if (!czero(f)) return true;
@@ -5537,14 +5699,8 @@ bool eval_flat(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
                 fixed = true;
             }
         }
-        if (root != before && last >= 0) {
-            Hit h;
-            h.t = t;
-            h.prim = prims[w->cross[last].prim];
-            h.prim_enter = w->cross[last].enter;
-            h.root_enter = root;
-            if (!visit(h)) return true;
-        }
+        if (root != before && last >= 0 && !visit(solid_hit(t, prims[w->cross[last].prim], w->cross[last].enter, root)))
+            return true;
         if (w->root_fixed) return true;
     }
     return false;
@@ -5635,12 +5791,7 @@ int eval_plain(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
         tf = t0;
     }
     if (first < 0) return 0;
-    Hit h;
-    h.t = tf;
-    h.prim = first;
-    h.prim_enter = first_enter;
-    h.root_enter = 1;
-    if (!visit(h)) return 1;
+    if (!visit(solid_hit(tf, first, first_enter, true))) return 1;
     *pa = tf;  // the visitor goes on through the solid: the rest by the flat sweep
     return -1;
 }
@@ -5720,14 +5871,8 @@ bool eval_full(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
                 (!st ? sp.kind != SPAN2 || x.t >= w->span2[2 * x.prim + 1] : sp.t1 >= REAL_INF))
                 settle(s, w, 2 * x.prim, st);
         }
-        if (root != before && last >= 0) {
-            Hit h;
-            h.t = t;
-            h.prim = w->cross[last].prim;
-            h.prim_enter = w->cross[last].enter;
-            h.root_enter = root;
-            if (!visit(h)) return true;
-        }
+        if (root != before && last >= 0 && !visit(solid_hit(t, w->cross[last].prim, w->cross[last].enter, root)))
+            return true;
         if (w->root_fixed) return true;
     }
     return false;
@@ -6139,7 +6284,38 @@ bool drive(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visi
     return done;
 }
 
-// All hits along the ray in (0, tmax), by the reference or the accelerated path.
+// Where materials meet inside the solid (Scene::iface), the lists leave out the faces between
+// them: they trace a ray while it is outside the solid only. This visitor passes their hits on
+// until the ray is inside: it started there (its first hit leaves the solid), or the visitor goes
+// on into the solid; then `inside` is set, and the reference sweep (section 9) takes the rest of
+// the ray, after `done`.
+template <class Visit>
+struct Outside {
+    Visit &v;
+    real done;
+    int hits, inside;
+    explicit Outside(Visit &v_) : v(v_), done(-REAL_INF), hits(0), inside(0) {}
+    bool operator()(const Hit &h) {
+        hits++;
+        if (!h.root_enter) inside = 1;          // it was inside from its start
+        else if (v(h)) inside = 1, done = h.t;  // the visitor goes on into the solid
+        return false;
+    }
+};
+template <class Visit>
+inline real visit_end(const Outside<Visit> &o) { return o.inside ? REAL_INF : visit_end(o.v); }
+
+// The hits of the reference sweep after t = done.
+template <class Visit>
+struct After {
+    Visit &v;
+    real done;
+    After(Visit &v_, real done_) : v(v_), done(done_) {}
+    bool operator()(const Hit &h) { return h.t <= done || v(h); }
+};
+
+// All hits along the ray in (0, tmax), by the reference or the accelerated path. (Where
+// materials meet, a ray that may be inside the solid goes through across.)
 template <class Visit>
 void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
     if (!s->accel) {
@@ -6255,6 +6431,28 @@ void primary_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, Visit &
     }
     w->k.ebuf += 1;
     drive(s, w, ray, tmax, -1, visit, eye.run ? &eye : NULL);
+}
+
+// A ray of a scene where materials meet (Scene::iface), instead of find_hits or primary_hits
+// (`primary`): the lists while the ray is outside the solid, then the reference sweep (Outside).
+// `inside`: whether the ray starts inside the solid (1), outside (0), or unknown (-1).
+template <class Visit>
+PRAY_NOINLINE void across(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, int inside,
+                          bool primary) {
+    real done = -REAL_INF;
+    if (s->accel && inside != 1) {
+        Outside<Visit> o(visit);
+        if (primary) primary_hits(s, w, ray, tmax, o);
+        else find_hits(s, w, ray, tmax, self, o);
+        if (!o.inside && (o.hits || inside == 0 || !starts_inside(s, w, ray))) return;
+        done = o.done;
+    }
+    After<Visit> rest(visit, done);
+    sweep(s, w, ray, tmax, self, rest, s->accel != NULL);  // (the reference's way, with boxes)
+    if (w->rbits && s->accel) {
+        real e = visit_end(visit);
+        region_note(w, ray, e < tmax ? e : tmax);
+    }
 }
 
 // =============================================================================================
@@ -7160,6 +7358,9 @@ static const unsigned char FONT6X9[95][9] = {
 struct Tracer {
     const Scene *s;
     Scratch *w;
+    int eye_in;   // primary rays start inside the solid: 1, outside: 0, unknown: -1 (across)
+    int seen;     // of the surfaces primary rays met that take light: bit 0 one that no light
+                  // reaches, bit 1 one that a light adds to (the warning of language 12)
     pray_rgb bg;  // background of the current pixel's row
     long left;    // rays the current sample may still take (Scene::maxrays)
     double lost;  // the most the rays left out of the current sample could have added
@@ -7399,6 +7600,43 @@ R3 shading_normal(const Prim &q, R3 x, const Shade &sh, R3 ds, R3 dt, bool outwa
     return n;
 }
 
+// The direction a ray along d takes on through a surface whose unit normal n faces it, for the
+// ratio eta of the indices (the side it comes from over the side it enters), by Snell's law;
+// false at total internal reflection.
+inline bool refract_dir(R3 d, R3 n, double eta, R3 *out) {
+    real ci = -dot(n, d);
+    double k = 1.0 - eta * eta * (1.0 - (double)ci * ci);
+    if (k < 0) return false;
+    *out = unit(d * (real)eta + n * (real)(eta * ci - sqrt(k)));
+    return true;
+}
+
+// The model of primitive q at x, and the texture coordinates and their directions there.
+void shade_at(const Prim &q, R3 x, Shade *sh, double *ts, double *tt, R3 *ds, R3 *dt) {
+    *ts = *tt = 0;
+    *ds = *dt = r3(0, 0, 0);
+    if (q.mat->kind == M_FLAT) shade_of(q.mat, 0, 0, sh);
+    else {
+        tex_coords(q, x, ts, tt, ds, dt);
+        shade_of(q.mat, *ts, *tt, sh);
+    }
+}
+
+// A ray reflected back to the side a ray came from starts inside the solid where the ray was
+// inside before hit h.
+inline int inside_before(const Hit &h) { return !h.root_enter || h.from >= 0; }
+
+// The ratio of the refractive indices across hit h at x (m: the model that shades it): the
+// material the ray leaves over the one it enters; empty space counts 1.
+double hit_eta(const Scene *s, const Hit &h, R3 x, const Shade &m) {
+    if (h.from < 0) return h.root_enter ? 1.0 / m.index : m.index;
+    Shade f;
+    double ts, tt;
+    R3 ds, dt;
+    shade_at(s->prims[h.from], x, &f, &ts, &tt, &ds, &dt);
+    return f.index / m.index;
+}
+
 // Whether a ray spawned by a ray of the given level, which passes on `weight` of what it brings
 // back to the sample, is traced: unless what it could add (Scene::most) fits in what is left of
 // the sample's allowance for rays left out (Scene::cut), which it then takes.
@@ -7412,7 +7650,10 @@ inline bool worth_tracing(Tracer &tr, int level, double weight) {
 
 // The colour a ray brings back; `seen`, when given, receives what it saw; `weight`: how much of
 // it reaches the sample, at most, in any channel.
-pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *seen = NULL, double weight = 1) {
+// `inside`: whether the ray starts inside the solid (1, 0, -1 unknown; across), for rays other
+// than primary ones.
+pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *seen = NULL, double weight = 1,
+               int inside = -1) {
     const Scene *s = tr.s;
     if (seen) seen->hit = -1, seen->lit_only = 0, seen->st[0] = seen->st[1] = 0;
     if (level > s->depth) return cmake(0, 0, 0);
@@ -7424,24 +7665,24 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
     tr.w->k.rays[kind] += 1;
     FirstHit fh;
     fh.found = false;
-    if (kind == RAY_PRIMARY) primary_hits(s, tr.w, ray, REAL_INF, fh);
+    // where materials meet, a ray that starts inside the solid is traced across them (a first hit
+    // from outside is where the solid is entered, as before)
+    if (kind == RAY_PRIMARY) inside = tr.eye_in;
+    if (s->iface && inside) across(s, tr.w, ray, REAL_INF, self, fh, inside, kind == RAY_PRIMARY);
+    else if (kind == RAY_PRIMARY) primary_hits(s, tr.w, ray, REAL_INF, fh);
     else find_hits(s, tr.w, ray, REAL_INF, self, fh);
     if (!fh.found) return tr.bg;
     const Hit &h = fh.h;
-    const Prim &q = s->prims[h.prim];
+    const Prim &q = s->prims[h.prim], &qm = s->prims[h.mat];  // the face, and its material
     R3 x = ray.o + ray.d * h.t;
     Shade sh;
     const Shade *m = &sh;
-    double ts = 0, tt = 0;
-    R3 ds = r3(0, 0, 0), dt = ds;
-    if (q.mat->kind == M_FLAT) shade_of(q.mat, 0, 0, &sh);
-    else {
-        tex_coords(q, x, &ts, &tt, &ds, &dt);
-        shade_of(q.mat, ts, tt, &sh);
-    }
+    double ts, tt;
+    R3 ds, dt;
+    shade_at(qm, x, &sh, &ts, &tt, &ds, &dt);
     bool outward = h.prim_enter == h.root_enter;
     R3 n = shading_normal(q, x, sh, ds, dt, outward, ray.d);
-    bool record = seen && q.mat->kind != M_FLAT && s->lights.n <= SEEN_LIGHTS && model_lit_only(q.mat);
+    bool record = seen && qm.mat->kind != M_FLAT && s->lights.n <= SEEN_LIGHTS && model_lit_only(qm.mat);
     if (seen) {
         seen->hit = h.prim;
         seen->enter = h.prim_enter;
@@ -7470,6 +7711,9 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
             sh.ray = &sr;
             sh.f = cmake(1, 1, 1);
             tr.w->k.rays[RAY_SHADOW] += 1;
+            // (a shadow ray is filtered at the faces of the solid it crosses; a face between two
+            // materials inside the solid lets the light through as it is, ShadowHit: so that a
+            // shadow ray never needs the reference sweep, whatever materials meet)
             shadow_hits(s, tr.w, sr, dist, h.prim, i, sh);
             li = cmul(li, sh.f);
         }
@@ -7479,19 +7723,19 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
         }
         if (!czero(li)) phong_light(&col, m, li, n, l, ndl, ray.d);
     }
+    if (kind == RAY_PRIMARY && lit && !(tr.seen & 2)) {  // (once a thread has seen light, no more)
+        pray_rgb own = cadd(m->emit, m->ambient);
+        tr.seen |= col.r != own.r || col.g != own.g || col.b != own.b ? 2 : 1;
+    }
     pray_rgb refl = m->reflect;
     if (!czero(m->transmit) && level < s->depth) {
-        double eta = h.root_enter ? 1.0 / m->index : m->index;
-        real ci = -dot(n, ray.d);
-        double k = 1.0 - eta * eta * (1.0 - (double)ci * ci);
         double wt = weight * rgb_maxabs(m->transmit);
-        if (k < 0) {
+        Ray rr;
+        if (!refract_dir(ray.d, n, h.from < 0 ? (h.root_enter ? 1.0 / m->index : m->index) : hit_eta(s, h, x, sh), &rr.d)) {
             refl = cadd(refl, m->transmit);  // total internal reflection
         } else if (worth_tracing(tr, level, wt)) {
-            Ray rr;
             rr.o = x;
-            rr.d = unit(ray.d * (real)eta + n * (real)(eta * ci - sqrt(k)));
-            col = cadd(col, cmul(m->transmit, trace(tr, rr, level + 1, h.prim, RAY_REFRACT, NULL, wt)));
+            col = cadd(col, cmul(m->transmit, trace(tr, rr, level + 1, h.prim, RAY_REFRACT, NULL, wt, h.root_enter)));
         }
     }
     double wr = weight * rgb_maxabs(refl);
@@ -7499,7 +7743,7 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
         Ray rr;
         rr.o = x;
         rr.d = unit(ray.d - n * (2 * dot(n, ray.d)));
-        col = cadd(col, cmul(refl, trace(tr, rr, level + 1, h.prim, RAY_REFLECT, NULL, wr)));
+        col = cadd(col, cmul(refl, trace(tr, rr, level + 1, h.prim, RAY_REFLECT, NULL, wr, inside_before(h))));
     }
     return col;
 }
@@ -7612,7 +7856,8 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     }
     // snapped before compaction, over every primitive flattened, so that the reference and the
     // simplified scene give the same surviving primitives the same numbers
-    if (s->root == -3 || snap_coincident(c, s) || merge_chains(c, s) || scene_compact(c, s)) return c->status;
+    if (s->root == -3 || snap_coincident(c, s) || merge_chains(c, s) || scene_compact(c, s) || scene_interfaces(c, s))
+        return c->status;
     if (over_time(c)) return fail_cancelled(c);
     for (int i = 0; lights && i < lights->n; i++) {
         const LightSrc &src = lights->src[i];
@@ -7780,10 +8025,20 @@ void public_hit(const Scene *s, const Ray &ray, const Hit &h, pray_hit *o) {
     const Prim &q = s->prims[h.prim];
     o->t = (double)h.t;
     o->primitive = q.id;
-    o->entering = h.root_enter;
-    R3 ng = prim_normal(q, ray.o + ray.d * h.t);
+    o->entering = h.from >= 0 ? 2 : h.root_enter;
+    R3 x = ray.o + ray.d * h.t, ng = prim_normal(q, x);
     R3 nn = h.prim_enter == h.root_enter ? ng : ng * (real)-1;
     o->normal = vmake((double)nn.x, (double)nn.y, (double)nn.z);
+    // the refracted ray, as trace spawns it
+    Shade sh;
+    double ts, tt;
+    R3 ds, dt, rd = r3(0, 0, 0);
+    shade_at(s->prims[h.mat], x, &sh, &ts, &tt, &ds, &dt);
+    if (!czero(sh.transmit)) {
+        R3 n = shading_normal(q, x, sh, ds, dt, h.prim_enter == h.root_enter, ray.d);
+        if (!refract_dir(ray.d, n, hit_eta(s, h, x, sh), &rd)) rd = r3(0, 0, 0);
+    }
+    o->refracted = vmake((double)rd.x, (double)rd.y, (double)rd.z);
 }
 
 // Where pixel (i, j) of the image is kept in the caller's buffers, in pixels.
@@ -7812,7 +8067,8 @@ void put_first_hit(Worker &k, int i, int j) {
     ray.d = unit(ray.d);
     FirstHit fh;
     fh.found = false;
-    find_hits(job->s, &k.w, ray, REAL_INF, -1, fh);
+    if (job->s->iface) across(job->s, &k.w, ray, REAL_INF, -1, fh, -1, false);
+    else find_hits(job->s, &k.w, ray, REAL_INF, -1, fh);
     pray_hit h;
     h.primitive = -1;
     h.t = HUGE_VAL;
@@ -8187,7 +8443,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         else st = c->status;
         scratch_release(c, &w);
     }
-    int made = 0;
+    int made = 0, seen = 0;  // (Tracer::seen of all threads)
     for (; st == PRAY_OK && made < nt; made++) {
         Worker &k = worker_at(wbuf, stride, made);
         k.job = &job;
@@ -8196,6 +8452,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         else if (job.adaptive > 0 && !k.cache.reserve(c, (job.tile + 1) * (job.tile + 1))) st = c->status;
         k.tr.s = s;
         k.tr.w = &k.w;
+        k.tr.eye_in = s->parallel ? -1 : c->eye_inside;  // (a parallel camera's rays start apart)
         k.w.rg = job.rg;
         args[made] = &k;
     }
@@ -8225,6 +8482,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         c->stats.rays_lightbuf += k.lbuf;
         c->stats.rays_eyebuf += k.ebuf;
         c->stats.rays_shadowcache += k.cache;
+        seen |= worker_at(wbuf, stride, i).tr.seen;
         if (job.redo) {
             c->stats.pixels_reused += worker_at(wbuf, stride, i).kept;
             c->stats.pixels_retraced += worker_at(wbuf, stride, i).traced;
@@ -8240,6 +8498,10 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
     }
     if (out.rgb) c->stats.rays_primary_full += (double)r.width * r.height * s->antialias * s->antialias;
     if (job.redo && st == PRAY_OK) c->stats.frames_coherent += 1;
+    // no light reaches anything the eye sees (a frame that takes pixels over from the frame
+    // before, which had the same lights and camera, keeps that frame's answer for them)
+    if (st == PRAY_OK)
+        c->no_light = c->dark = s->lights.n > 0 && !(seen & 2) && ((seen & 1) || job.redo) && (!job.redo || c->dark);
     c->stats.threads = nt;
     mem_free(c, wbuf);
     mem_free(c, args);
@@ -10269,7 +10531,9 @@ int pray_intersect(pray_ctx *c, pray_scene *q, pray_vec origin, pray_vec dir, do
     ch.out = hits;
     ch.max = max_hits;
     ch.n = 0;
-    find_hits(&q->s, &q->w, ch.ray, tmax >= HUGE_VAL ? REAL_INF : (real)tmax, -1, ch);
+    real t = tmax >= HUGE_VAL ? REAL_INF : (real)tmax;
+    if (q->s.iface) across(&q->s, &q->w, ch.ray, t, -1, ch, -1, false);
+    else find_hits(&q->s, &q->w, ch.ray, t, -1, ch);
     return ch.n;
 }
 
@@ -12624,9 +12888,10 @@ PRAY_NOINLINE pray_status exec_render(Interp &I, const Stmt *s, Value *a) {
     // holds it any more, its tree is freed before the rest of the scene is built (not when the
     // host renders the frame: it may render the tree more than once, a band at a time)
     c->drop = c->render_fn ? NULL : (pray_object *)a[0].ref;
-    c->eye_inside = 0;
+    c->eye_inside = c->no_light = 0;
     pray_status st = pray_render(c, (pray_object *)a[0].ref, all, &img);
     if (st == PRAY_OK && c->eye_inside) warn(I, s, "the eye is inside the rendered solid");
+    if (st == PRAY_OK && c->no_light) warn(I, s, "no light reaches anything the eye sees");
     if (c->drop == NULL && !c->render_fn) a[0].ref = NULL, a[0].t = V_NONE;
     c->drop = NULL;
     release_handle(c, all);

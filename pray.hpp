@@ -411,14 +411,21 @@ void pray_stats_get(const pray_ctx *ctx, pray_stats *out);
 
 /* Ray queries, for picking and for checking the renderer: prepare a solid once with the
    context's options (grid, freeze, merge, bounds, brute), then ask for the surfaces a ray
-   crosses. The surfaces are those of the whole solid, in order along the ray. */
+   crosses. The surfaces are those of the whole solid, and the faces between two different
+   materials inside it (the language's section 12), in order along the ray. */
 typedef struct pray_scene pray_scene;
 typedef struct pray_hit {
     double t;          /* the ray parameter: origin + t * unit(direction) */
     int primitive;     /* which primitive: its position among the primitives of the object as
                           declared, left to right, from 0 (the same whatever is simplified) */
-    int entering;      /* 1 where the ray enters the solid, 0 where it leaves */
-    pray_vec normal;   /* unit normal facing out of the solid */
+    int entering;      /* 1 where the ray enters the solid, 0 where it leaves, 2 where it crosses
+                          a face between two materials inside it (the language's section 12) */
+    pray_vec normal;   /* unit normal facing out of the solid; on a face between two materials,
+                          towards the one the ray leaves */
+    pray_vec refracted; /* the unit direction the ray takes on through the surface by Snell's
+                          law, as the renderer traces it: the ratio of the indices of the
+                          material left and the one entered (empty space: 1); zero where the
+                          surface lets no light through or reflects it all */
 } pray_hit;
 /* A prepared scene, or NULL. It keeps no reference to root: release root when you like. It
    belongs to the context (pray_scene_free frees it early). */

@@ -232,22 +232,22 @@ public:
         sc.spheres.push_back(q);
         sc.nprims++;
         if (rng.chance(0.1) && sc.scale == 1) {  // built at the origin and moved there by '.'
-            pray_object *o = pray_sphere(c_, m_, V(0, 0, 0), r);
+            pray_object *o = pray_sphere(c_, m(), V(0, 0, 0), r);
             return pray_translate(c_, o, c);
         }
-        return pray_sphere(c_, m_, q.c, q.r);
+        return pray_sphere(c_, m(), q.c, q.r);
     }
     pray_object *plane(pray_vec p, pray_vec n) {
         Plane q = {P(p), unit(n)};
         sc.planes.push_back(q);
         sc.nprims++;
-        return pray_plane(c_, m_, q.p, n);
+        return pray_plane(c_, m(), q.p, n);
     }
     pray_object *cylinder(pray_vec p, pray_vec a, double r) {
         Cylinder q = {P(p), unit(a), L(r)};
         sc.cylinders.push_back(q);
         sc.nprims++;
-        return pray_cylinder(c_, m_, q.p, a, q.r);
+        return pray_cylinder(c_, m(), q.p, a, q.r);
     }
     // A box of six half-spaces: centre c, unit edge directions u (orthonormal), half sizes h.
     pray_object *box(pray_vec c, const pray_vec u[3], const double h[3]) {
@@ -351,7 +351,7 @@ public:
         auto axis = [&]() { return rng.chance(0.5) ? axis_vec(rng.below(3), rng.sign()) : rng.dir(); };
         if (k == 0) {  // box, its corners in any order
             pray_vec p2 = add(p1, V(rng.sign() * radius(0.1, 0.8), rng.sign() * radius(0.1, 0.8), rng.sign() * radius(0.1, 0.8)));
-            o = pray_box(c_, m_, p1, p2);
+            o = pray_box(c_, m(), p1, p2);
             for (int i = 0; i < 4; i++) {
                 pray_vec c = V(rng.chance(0.5) ? p1.x : p2.x, rng.chance(0.5) ? p1.y : p2.y, rng.chance(0.5) ? p1.z : p2.z);
                 pray_vec d = axis_vec(rng.below(3), rng.sign());
@@ -363,7 +363,7 @@ public:
             double h = radius(0.2, 1.2), r1 = radius(0.05, 0.5), r2 = k == 1 ? r1 : radius(0.05, 0.5);
             if (k == 2 && rng.chance(0.3)) (rng.chance(0.5) ? r1 : r2) = 0;
             pray_vec p2 = add(p1, mul(a, h));
-            o = k == 1 ? pray_rod(c_, m_, p1, p2, r1) : pray_cone(c_, m_, p1, r1, p2, r2);
+            o = k == 1 ? pray_rod(c_, m(), p1, p2, r1) : pray_cone(c_, m(), p1, r1, p2, r2);
             for (int i = 0; i < 4; i++) {
                 pray_vec u = side(a), w = cross(a, u);
                 pray_vec e1 = add(p1, mul(u, r1)), e2 = add(p2, mul(u, r2));
@@ -374,7 +374,7 @@ public:
             }
         } else if (k == 3) {  // a sphere, stretched below into an ellipsoid
             double r = radius(0.1, 0.6);
-            o = pray_sphere(c_, m_, p1, r);
+            o = pray_sphere(c_, m(), p1, r);
             for (int i = 0; i < 3; i++) {
                 pray_vec u = rng.dir();
                 loc.push_back(Graze{add(p1, mul(u, r)), side(u)});
@@ -382,9 +382,9 @@ public:
         } else if (k == 4) {  // a capped cylinder, stretched below
             pray_vec a = axis();
             double r = radius(0.08, 0.5), h = radius(0.1, 0.6);
-            o = pray_csg(c_, PRAY_INTERSECTION, pray_cylinder(c_, m_, p1, a, r),
-                         pray_csg(c_, PRAY_INTERSECTION, pray_plane(c_, m_, add(p1, mul(a, h)), a),
-                                  pray_plane(c_, m_, sub(p1, mul(a, h)), mul(a, -1))));
+            o = pray_csg(c_, PRAY_INTERSECTION, pray_cylinder(c_, m(), p1, a, r),
+                         pray_csg(c_, PRAY_INTERSECTION, pray_plane(c_, m(), add(p1, mul(a, h)), a),
+                                  pray_plane(c_, m(), sub(p1, mul(a, h)), mul(a, -1))));
             sc.nprims += 2;
             pray_vec u = side(a);
             loc.push_back(Graze{add(p1, mul(u, r)), a});
@@ -392,7 +392,7 @@ public:
         } else {  // torus
             pray_vec a = axis();
             double R = radius(0.2, 0.6), r = R * rng.range(0.1, 0.9);
-            o = pray_torus(c_, m_, p1, a, R, r);
+            o = pray_torus(c_, m(), p1, a, R, r);
             pray_vec u = side(a), w = cross(a, u);
             loc.push_back(Graze{add(p1, mul(u, R + r)), w});                   // the outline
             loc.push_back(Graze{add(p1, mul(u, R - r)), w});                   // the hole's rim
@@ -463,12 +463,17 @@ public:
             }
         }
         if (rng.chance(0.04)) acc = pray_csg(c_, PRAY_UNION, acc, pray_nothing(c_));
-        if (rng.chance(0.04)) acc = pray_csg(c_, PRAY_INTERSECTION, acc, pray_one(c_, m_));
+        if (rng.chance(0.04)) acc = pray_csg(c_, PRAY_INTERSECTION, acc, pray_one(c_, m()));
         if (rng.chance(0.12)) acc = pray_complement(c_, acc);
         focus = f0;
         spread = s0;
         return acc;
     }
+
+    // The primitives' models: one for all, or each picked at random among `mats` when given
+    // (scenes where different materials touch and overlap).
+    std::vector<pray_model *> mats;
+    pray_model *m() { return mats.empty() ? m_ : mats[rng.below((int)mats.size())]; }
 
     pray_ctx *c_;
     pray_model *m_;
@@ -517,8 +522,9 @@ inline const char *kind_name(int k) {
 }
 
 // Build scene `seed` of kind `kind` in context c.
-inline Scene make_scene(pray_ctx *c, int kind, uint64_t seed) {
+inline Scene make_scene(pray_ctx *c, int kind, uint64_t seed, const std::vector<pray_model *> *mats = nullptr) {
     Gen g(c, seed * 7919 + (uint64_t)kind);
+    if (mats) g.mats = *mats;
     Rng &r = g.rng;
     pray_object *root = nullptr;
     switch (kind) {

@@ -487,6 +487,7 @@ std::string fmt_hits(const Hits &a) {
 struct Report {
     long scenes = 0, rays = 0, rays_hitting = 0, hits = 0, comparisons = 0, mismatches = 0, failed_prepares = 0;
     long nested = 0;  // preparations that nested grids (so that the scenes test them)
+    long faces = 0;   // the reference's hits on faces between two materials
     struct Case {
         std::string where, want, got, options;
         int count = 0;
@@ -539,11 +540,20 @@ struct Report {
     }
 };
 
+// Opaque, glass, water, a clear solid of index 1 and a mirror, for the primitives of a mixed scene.
+std::vector<pray_model *> mixed_models(pray_ctx *c) {
+    pray_rgb d = {0.7, 0.5, 0.3}, s = {0.2, 0.2, 0.2}, z = {0, 0, 0}, t = {0.8, 0.85, 0.9}, one = {1, 1, 1};
+    pray_rgb m = {0.6, 0.6, 0.6};
+    return {pray_phong(c, d, s, z, 10), pray_model_add(c, pray_transparent(c, t, 1.5), pray_phong(c, z, s, z, 40)),
+            pray_transparent(c, t, 1.33), pray_transparent(c, one, 1), pray_model_add(c, pray_mirror(c, m), pray_phong(c, z, s, z, 20))};
+}
+
 // Compare every switch combination with the reference on one scene.
-void check_scene(int kind, uint64_t seed, Report &rep) {
+void check_scene(int kind, uint64_t seed, Report &rep, bool mixed) {
     pray_ctx *c = pray_new();
     REQUIRE(c);
-    Scene s = make_scene(c, kind, seed);
+    std::vector<pray_model *> mats = mixed_models(c);
+    Scene s = make_scene(c, kind, seed, mixed ? &mats : nullptr);
     INFO(s.label);
     CHECK_MESSAGE(s.root != nullptr, std::string(pray_error(c)));
     if (!s.root) {
@@ -583,6 +593,7 @@ void check_scene(int kind, uint64_t seed, Report &rep) {
     for (const Hits &h : want) {
         rep.rays_hitting += h.n > 0;
         rep.hits += h.n;
+        for (const pray_hit &x : h.h) rep.faces += x.entering == 2;
     }
     rep.scenes++;
     rep.rays += (long)rays.size();
@@ -615,16 +626,18 @@ int scale_from_env() {
     return k < 1 ? 1 : k;
 }
 
-void run_kind(int kind, int first_seed, int count, Report &total) {
+void run_kind(int kind, int first_seed, int count, Report &total, bool mixed = false) {
     count *= scale_from_env();
     Report rep;
     auto t0 = std::chrono::steady_clock::now();
-    for (int i = 0; i < count; i++) check_scene(kind, (uint64_t)(first_seed + i), rep);
+    for (int i = 0; i < count; i++) check_scene(kind, (uint64_t)(first_seed + i), rep, mixed);
     double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    MESSAGE(std::string(kind_name(kind)) << " scenes (" << secs << " s): " << rep.summary() << ", " << rep.nested << " with nested grids");
+    MESSAGE(std::string(kind_name(kind)) << std::string(mixed ? " scenes of mixed materials (" : " scenes (") << secs << " s): " << rep.summary() << ", " << rep.nested << " with nested grids"
+                                     << (mixed ? ", " + std::to_string(rep.faces) + " hits on faces between materials" : std::string()));
     CHECK_MESSAGE(rep.mismatches == 0, rep.text());
     CHECK(rep.failed_prepares == 0);
     if (kind == K_CLUSTER) CHECK_MESSAGE(rep.nested > 0, "no scene nested a grid: the test would not test them");
+    if (mixed) CHECK_MESSAGE(rep.faces > 10, rep.faces << " hits on faces between materials: too few to test them");
     total.scenes += rep.scenes;
     total.rays += rep.rays;
     total.rays_hitting += rep.rays_hitting;
@@ -655,6 +668,13 @@ TEST_CASE("accel hits: dense clusters of small solids with a few far away, a flo
 }
 TEST_CASE("accel hits: boxes, rods, cones, tori, stretched and mirrored solids with the others, grazed (60 seeds)") {
     run_kind(K_SHAPES, 1, 60, g_total);
+}
+TEST_CASE("accel hits: primitives of several materials touching and overlapping, with the faces between them "
+          "(random 40, blocks 20, floor 15, shapes 20 seeds)") {
+    run_kind(K_RANDOM, 1, 40, g_total, true);
+    run_kind(K_BLOCKS, 1, 20, g_total, true);
+    run_kind(K_FLOOR, 1, 15, g_total, true);
+    run_kind(K_SHAPES, 1, 20, g_total, true);
 }
 TEST_CASE("accel hits: scenes scaled from 1e-3 to 1e6 and moved far from the origin (20 seeds)") {
     run_kind(K_SCALED, 1, 20, g_total);
@@ -896,10 +916,13 @@ Render render(pray_ctx *c, pray_object *root, pray_light *lights, const Opts &o,
     return r;
 }
 
-// A generated scene of the image tests: its kind and seed.
+// A generated scene of the image tests: its kind and seed; mixed: its primitives of several
+// materials (mixed_models), so that different materials touch and overlap.
 struct Pick {
     int kind, seed;
+    int mixed = 0;
 };
+
 
 pray_light *some_lights(pray_ctx *c) {
     pray_rgb w = {0.7, 0.7, 0.7}, w2 = {0.4, 0.4, 0.4};
@@ -912,7 +935,9 @@ template <size_t N, class Fn> void each_pick(const Pick (&picks)[N], Fn fn) {
     for (const Pick &pk : picks) {
         pray_ctx *c = pray_new();
         REQUIRE(c);
-        Scene s = make_scene(c, pk.kind, (uint64_t)pk.seed);
+        std::vector<pray_model *> mats = mixed_models(c);
+        Scene s = make_scene(c, pk.kind, (uint64_t)pk.seed, pk.mixed ? &mats : nullptr);
+        if (pk.mixed) s.label += ", mixed materials";
         CAPTURE(s.label);
         REQUIRE_MESSAGE(s.root, std::string(pray_error(c)));
         fn(c, s);
@@ -927,7 +952,9 @@ TEST_CASE("accel images: random scenes at 40 x 40, every grid x freeze x merge x
           "--brute; freezing never adds intersection tests") {
     const Pick picks[] = {{K_RANDOM, 3}, {K_RANDOM, 17}, {K_RANDOM, 42}, {K_RANDOM, 77}, {K_RANDOM, 101},
                           {K_MANY, 2},   {K_MANY, 5},    {K_LATTICE, 1}, {K_LATTICE, 4}, {K_BLOCKS, 3},
-                          {K_BLOCKS, 12}, {K_FLOOR, 2},  {K_FLOOR, 9},   {K_SHAPES, 3},  {K_SHAPES, 8}};
+                          {K_BLOCKS, 12}, {K_FLOOR, 2},  {K_FLOOR, 9},   {K_SHAPES, 3},  {K_SHAPES, 8},
+                          {K_RANDOM, 3, 1}, {K_RANDOM, 42, 1}, {K_RANDOM, 77, 1}, {K_MANY, 2, 1}, {K_LATTICE, 4, 1},
+                          {K_BLOCKS, 3, 1}, {K_BLOCKS, 12, 1}, {K_FLOOR, 2, 1}, {K_FLOOR, 9, 1}, {K_SHAPES, 8, 1}};
     auto t0 = std::chrono::steady_clock::now();
     long renders = 0, image_mismatches = 0, freeze_violations = 0;
     std::vector<std::string> problems;
@@ -1327,7 +1354,8 @@ TEST_CASE("accel shadow cache: shadowcache=0 and 1 give the reference's image, t
           "the objects; a table and a pane of glass over a field of spheres; a cluster in nested grids") {
     const Pick picks[] = {{K_RANDOM, 30}, {K_RANDOM, 41}, {K_RANDOM, 64}, {K_RANDOM, 66}, {K_MANY, 4},  {K_LATTICE, 3},
                           {K_BLOCKS, 7},  {K_FLOOR, 5},   {K_FLOOR, 12},  {K_SCALED, 2},  {K_SCALED, 6},
-                          {K_SHAPES, 11}, {K_CLUSTER, 2}, {K_CLUSTER, 5}};
+                          {K_SHAPES, 11}, {K_CLUSTER, 2}, {K_CLUSTER, 5}, {K_RANDOM, 30, 1}, {K_BLOCKS, 7, 1},
+                          {K_FLOOR, 5, 1}, {K_CLUSTER, 2, 1}};
     SwitchTally t;
     // (the lamps amid the objects end their shadow rays in voxels that hold surfaces beyond them)
     shadow_switch_picks(picks, &Opts::shadowcache, "shadowcache", &pray_stats::rays_shadowcache, nullptr, {3, 8}, 64, t);
@@ -1417,7 +1445,8 @@ TEST_CASE("accel threads: the counts of a render are the same for 1, 2, 3 and 8 
 TEST_CASE("accel eye buffer: eyebuffer=0 and 1 give the reference's image from eyes outside, inside, on the edge of "
           "and far from the grid's box; a field of spheres; none for a parallel camera") {
     const Pick picks[] = {{K_RANDOM, 4},  {K_RANDOM, 31}, {K_MANY, 3},   {K_MANY, 8},   {K_LATTICE, 5},
-                          {K_BLOCKS, 6},  {K_FLOOR, 4},   {K_FLOOR, 13}, {K_SCALED, 3}, {K_SCALED, 9}, {K_SHAPES, 6}};
+                          {K_BLOCKS, 6},  {K_FLOOR, 4},   {K_FLOOR, 13}, {K_SCALED, 3}, {K_SCALED, 9}, {K_SHAPES, 6},
+                          {K_RANDOM, 31, 1}, {K_BLOCKS, 6, 1}, {K_FLOOR, 13, 1}};
     SwitchTally t;
     each_pick(picks, [&](pray_ctx *c, const Scene &s) {
         pray_light *lights = some_lights(c);
@@ -1618,7 +1647,8 @@ TEST_CASE("accel buffers: examples at 384 and 512 pixels square with the automat
 TEST_CASE("accel buffers: random scenes at 128 x 128 under the sun and lamps outside, inside the grid's box and amid "
           "the objects, every lightbuffer x eyebuffer x shadowcache x freeze x merge x bounds: the same floats as --brute") {
     const Pick picks[] = {{K_RANDOM, 5},  {K_RANDOM, 42}, {K_RANDOM, 77}, {K_MANY, 2},  {K_MANY, 7},   {K_LATTICE, 4},
-                          {K_BLOCKS, 7},  {K_BLOCKS, 12}, {K_FLOOR, 3},   {K_FLOOR, 9}, {K_SCALED, 2}, {K_SCALED, 6}};
+                          {K_BLOCKS, 7},  {K_BLOCKS, 12}, {K_FLOOR, 3},   {K_FLOOR, 9}, {K_SCALED, 2}, {K_SCALED, 6},
+                          {K_RANDOM, 42, 1}, {K_BLOCKS, 12, 1}, {K_FLOOR, 9, 1}, {K_SCALED, 2, 1}};
     auto t0 = std::chrono::steady_clock::now();
     NetTally t;
     pray_rgb w = {0.6, 0.6, 0.6}, w2 = {0.5, 0.4, 0.3};

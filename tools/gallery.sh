@@ -94,6 +94,7 @@ examples/roomball.ray|A ball rolling through the Room (image-sequence coherence)
 examples/machine.ray|A turning flywheel (image-sequence coherence)
 examples/redsph.ray|The red sphere
 examples/chess.ray|Chess
+examples/water.ray|A glass of water on a table
 examples/redsphx.ray|The red sphere as printed|The red sphere of the thesis' appendix A exactly as printed, slips included.
 EOF
 # every example must be in the list
