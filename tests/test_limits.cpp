@@ -254,6 +254,8 @@ TEST_CASE("limit maxtime: a run that takes longer stops with an error naming the
     CHECK_MESSAGE((err == "t.ray:3:3: error: the run was stopped after 1 second (option maxtime)" ||
                    err == "t.ray:2:1: error: the run was stopped after 1 second (option maxtime)"), err);
     // a render: many nested transparent shells on a large image, with one thread and with two
+    std::vector<testkit::Frame> frames;
+    pray_set_frame(c, testkit::frame_sink, &frames);
     for (int threads : {1, 2}) {
         CAPTURE(threads);
         pray_option(c, "threads", threads);
@@ -263,8 +265,7 @@ TEST_CASE("limit maxtime: a run that takes longer stops with an error naming the
         const char *shells = "M = transparent({0.99}, 1)\nO = nothing\nK = 1\nwhile K < 400\n"
                              "  O = O | (sphere(M, [0, 0, 0], 0.001 * K) - sphere(M, [0, 0, 0], 0.001 * K - 0.0004))\n"
                              "  K = K + 1\nendwhile\nrendertiff O, dirlight({1}, <1, 1, 1>)\n";
-        std::vector<testkit::Frame> frames;
-        pray_set_frame(c, testkit::frame_sink, &frames);
+        frames.clear();
         t0 = std::chrono::steady_clock::now();
         CHECK(pray_run_string(c, "s.ray", shells, strlen(shells)) == PRAY_ERR_LIMIT);
         took = seconds_since(t0);
@@ -279,6 +280,7 @@ TEST_CASE("limit maxtime: a run that takes longer stops with an error naming the
     CHECK(pray_run_string(c, "q.ray", quick, strlen(quick)) == PRAY_OK);
     pray_option(c, "maxtime", 0);
     CHECK(pray_run_string(c, "q.ray", quick, strlen(quick)) == PRAY_OK);
+    CHECK(frames.size() == 2);
     pray_free(c);
 }
 
