@@ -2034,8 +2034,8 @@ real comp(R3 v, int i) { return i == 0 ? v.x : i == 1 ? v.y : v.z; }
 // in the last place of the largest coordinate involved.
 void box_pad(Box *b, double scale) {
     for (int i = 0; i < 3; i++) {
-        double m = fabs((double)b->lo[i]) > fabs((double)b->hi[i]) ? fabs((double)b->lo[i]) : fabs((double)b->hi[i]);
-        double pad = SNAP_ULPS * REAL_EPS * (m + scale);
+        double lo = b->lo[i] > -REAL_BIG ? fabs((double)b->lo[i]) : 0, hi = b->hi[i] < REAL_BIG ? fabs((double)b->hi[i]) : 0;
+        double pad = SNAP_ULPS * REAL_EPS * ((lo > hi ? lo : hi) + scale);  // (of the finite ends)
         if (b->lo[i] > -REAL_BIG) b->lo[i] = (real)((double)b->lo[i] - pad);
         if (b->hi[i] < REAL_BIG) b->hi[i] = (real)((double)b->hi[i] + pad);
     }
