@@ -1694,7 +1694,9 @@ struct OptDef {
     double untrusted;  // the highest value allowed in untrusted mode (0: no ceiling)
 };
 // Alphabetical, in the order of the OPT_ enumeration. grid -1 means "automatic". The max* options
-// and depth, gridmem and texmem are the limits of a run (pray.hpp, "Limits").
+// and depth, gridmem and texmem are the limits of a run (pray.hpp, "Limits"). brute, grid, nest,
+// freeze, merge, bounds, lightbuffer, eyebuffer, shadowcache, plans and coherence are diagnostic
+// (pray.hpp, "Options"; --help): they change how fast an image is made, never the image.
 const OptDef OPTS[OPT_COUNT] = {
     {"adaptive", 0, 0, 1e9, 0, 0},
     {"antialias", 1, 1, 64, 1, 0},
@@ -13628,7 +13630,6 @@ const char *const USAGE =
     "  -s WxH           image size in pixels; same as -D width=W -D height=H\n"
     "  -D name=value    set an option of the language; wins over `option` in the program\n"
     "  --stats          print statistics of the rendering to standard error\n"
-    "  --brute          the brute-force reference renderer (no acceleration)\n"
     "  --threads N      threads to render with (0 = automatic)\n"
     "  --untrusted      tighter limits; the program reads files beside it only\n"
     "  --rows A:B       render only rows A to B-1 of every image (a row part, .tif or .ppm)\n"
@@ -13638,6 +13639,27 @@ const char *const USAGE =
     "  --version        print the version and the features compiled in\n"
     "  --help           print this text\n"
     "A program of '-' is read from standard input.\n"
+    "\n"
+    "Options of the language, for -D name=value or `option` in the program:\n"
+    "  the image        width height output bits antialias adaptive depth cutoff shadows\n"
+    "  the machine      threads\n"
+    "  limits           maxsteps maxnest maxline maxstring maxprims maxpixels maxrays\n"
+    "                   maxmem maxframes maxoutput maxtime gridmem texmem\n"
+    "\n"
+    "Diagnostic options, to measure the acceleration or compare it with the reference;\n"
+    "an image never needs them, and it stays the same byte for byte whatever they are:\n"
+    "  --brute          the brute-force reference renderer; same as -D brute=1\n"
+    "  -D grid=N        N voxels along the longest side (0: no grid; -1: automatic)\n"
+    "  -D nest=N        levels of finer grids in crowded voxels (0 to 4; 2)\n"
+    "  -D freeze=0      no freezing of CSG nodes whose status can no longer change\n"
+    "  -D merge=0       no areas of neighbouring voxels with the same action lists\n"
+    "  -D bounds=0      no bounding boxes around the parts of the CSG tree\n"
+    "  -D lightbuffer=0 shadow rays walk the grid, not the lists around each light\n"
+    "  -D eyebuffer=0   primary rays walk the grid, not the lists around the eye\n"
+    "  -D shadowcache=0 shadow rays do not first try the voxel that stopped the last one\n"
+    "  -D plans=0       every action list is evaluated in full, without shortcuts\n"
+    "  -D coherence=0   every frame of a sequence is traced in full\n"
+    "\n"
     "Exit status: 0 ok, 1 error in the program, 2 usage, 3 input/output error.\n";
 
 int usage_error(const char *fmt, const char *arg) {
