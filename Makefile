@@ -4,6 +4,7 @@
 #   make textures   the examples' TIFF textures, rendered by examples/maketex.ray into examples/tex/
 #   make gallery    render every example into docs/gallery/ and write docs/gallery.md (tools/gallery.sh)
 #   make check      build and run all tests (installs the test packages if missing)
+#   make sections   the line budget of each [SECTION] of pray.cpp (tests/sections.sh)
 #   make matrix     compile pray.cpp under every configuration macro and language level, g++ and clang++
 #   make bench      the acceleration benchmarks (bench/run.sh), results in docs/benchmarks.md
 #   make pov        pray against POV-Ray 3.7 (bench/pov.sh; installs povray)
@@ -41,7 +42,7 @@ TESTS = tests/pray_tests$(EXE)
 TESTS_FLOAT = tests/pray_tests_float$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
-.PHONY: FORCE all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff fuzz-join fuzz-long textures gallery ports pov suite charts mpi mpi-deps check-mpi
+.PHONY: FORCE all examples sections check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff fuzz-join fuzz-long textures gallery ports pov suite charts mpi mpi-deps check-mpi
 
 all: $(PRAY)
 
@@ -107,7 +108,7 @@ tests/embed$(EXE): examples/embed.c pray.cpp pray.hpp build/png
 	$(CC) tests/embed.o tests/pray.o -o $@ $(LDLIBS)
 embed: tests/embed$(EXE)
 
-check: deps $(PRAY) textures $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embed$(EXE)
+check: sections deps $(PRAY) textures $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embed$(EXE)
 	$(RUN) ./tests/embed$(EXE) tests/embed.ppm
 	CC="$(CC)" CXX="$(CXX)" RUN="$(RUN)" sh tests/manual_examples.sh
 	@echo "== tests of rendering into buffers, without file access (PRAY_NO_STDIO)"
@@ -117,6 +118,10 @@ check: deps $(PRAY) textures $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embe
 	@echo "== tests, PRAY_REAL=double"
 	$(RUN) ./$(TESTS)
 	@$(MAKE) --no-print-directory check-bad
+
+# The line budgets of pray.cpp's sections, given in its index comment (docs/testing.md).
+sections:
+	@sh tests/sections.sh -q
 
 # Bad inputs: exact messages and exit statuses, nothing left behind (docs/testing.md).
 check-bad: $(PRAY)
@@ -256,4 +261,5 @@ ports:
 	sh ports/check
 
 clean:
-	rm -rf $(PRAY) $(PRAY_MPI) build/mpi build/tests build/tests-float build/sanitize $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embed$(EXE) tests/*.o tests/*.ppm out
+	rm -rf $(PRAY) $(PRAY_MPI) build/mpi build/tests build/tests-float build/sanitize $(TESTS) $(TESTS_FLOAT) \
+	  $(TESTS_NOSTDIO) tests/embed$(EXE) tests/*.o tests/*.ppm out

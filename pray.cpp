@@ -1,29 +1,35 @@
 /* pray.cpp — the whole implementation of pray. MIT License, see LICENSE.
 
-   Index (grep '\[SECTION\]'):
-   [SECTION] 1  Portability shims: configuration, real type, clock, terminal, files, threads
-   [SECTION] 2  Context: allocator with a cap, status and messages
-   [SECTION] 3  Tiny containers on the context allocator
-   [SECTION] 4  Vector math and the `.` transformations
-   [SECTION] 5  Scene values: models, lights, solids (reference counted handles)
-   [SECTION] 6  Options
-   [SECTION] 7  Prepared scene: flattened n-ary CSG tree, boxes, simplification, snapping
-   [SECTION] 8  Ray/primitive intersection; primitives in a frame (box, rod, cone, torus, stretched)
-   [SECTION] 9  CSG status-tree sweep (the brute-force reference, thesis 3.4)
-   [SECTION] 9b Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
-                [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas and
-                jumps, [9b.4] light and eye buffers, [9b.5] accel_build; per ray: [9b.6] list
-                evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver
-   [SECTION] 9c Reading files (programs, textures, fonts), TIFF reader and textures, the built-in font
-   [SECTION] 10 Whitted shading, textured surfaces, the render driver (threads, undersampling)
-   [SECTION] 10b Image sequences (3.7): the regions a ray crosses, comparing a frame's scene with
-                the one before, records
-   [SECTION] 11 Image writers: TIFF, PPM, PNG; writing files safely; public functions
-   [SECTION] 12 PRAY lexer
-   [SECTION] 13 PRAY parser
-   [SECTION] 14 PRAY interpreter: values, operators, builtins, statements
-   [SECTION] 15 One-call helpers and the running of programs
-   [SECTION] 16 Command-line program (PRAY_MAIN)
+   Index (grep '\[SECTION\]'). Each section has a budget of lines, from its banner to the next
+   one; tests/sections.sh checks them (docs/testing.md). A budget is lowered when a section
+   shrinks, and raised only as a decision.
+   section      budget  contents
+   [SECTION] 1     500  Portability shims: configuration, real type, clock, terminal, files, threads
+   [SECTION] 2     300  Context: allocator with a cap, status and messages
+   [SECTION] 3     100  Tiny containers on the context allocator
+   [SECTION] 4     200  Vector math and the `.` transformations
+   [SECTION] 5     650  Scene values: models, lights, solids (reference counted handles)
+   [SECTION] 6     150  Options
+   [SECTION] 7    1100  Prepared scene: flattened n-ary CSG tree, boxes, simplification, snapping
+   [SECTION] 8     450  Ray/primitive intersection; primitives in a frame (box, rod, cone, torus,
+                          stretched)
+   [SECTION] 9     450  CSG status-tree sweep (the brute-force reference, thesis 3.4)
+   [SECTION] 9b   2750  Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
+                          [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas
+                          and jumps, [9b.4] light and eye buffers, [9b.5] accel_build; per ray: [9b.6]
+                          list evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver
+   [SECTION] 9c    900  Reading files (programs, textures, fonts), TIFF reader and textures, the
+                          built-in font
+   [SECTION] 10   1200  Whitted shading, textured surfaces, the render driver (threads, undersampling)
+   [SECTION] 10b   600  Image sequences (3.7): the regions a ray crosses, comparing a frame's scene
+                          with the one before, records
+   [SECTION] 11   1650  Image writers: TIFF, PPM, PNG; writing files safely; public functions
+   [SECTION] 12    500  PRAY lexer
+   [SECTION] 13    800  PRAY parser
+   [SECTION] 14   1500  PRAY interpreter: values, operators, builtins, statements
+   [SECTION] 15    200  One-call helpers and the running of programs
+   [SECTION] 16    750  Command-line program (PRAY_MAIN)
+   The whole file: at most 14400 lines.
 */
 
 // =============================================================================================
