@@ -112,6 +112,7 @@ embed: tests/embed$(EXE)
 check: sections deps $(PRAY) textures $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embed$(EXE)
 	$(RUN) ./tests/embed$(EXE) tests/embed.ppm
 	CC="$(CC)" CXX="$(CXX)" RUN="$(RUN)" sh tests/manual_examples.sh
+	RUN="$(RUN)" sh tests/options.sh ./$(PRAY)
 	@echo "== tests of rendering into buffers, without file access (PRAY_NO_STDIO)"
 	$(RUN) ./$(TESTS_NOSTDIO)
 	@echo "== tests, PRAY_REAL=float"
@@ -127,7 +128,8 @@ sections:
 # The quick tier (docs/testing.md): every layer of check, lightly. The line budgets; ./pray as for
 # check; the test files built without optimisation (compiling dominates): most of them in double
 # precision, three in float, test_buffers.cpp without file access, each run as tests/quick.sh
-# chooses; the C example; the programs of the manual; every fifth case of the bad inputs.
+# chooses; the C example; the programs of the manual; the options as --help and the manual
+# present them; every fifth case of the bad inputs.
 QUICK_TESTS = test_main test_internal test_smoke test_lang test_lang2 test_render test_sampling \
               test_accel test_coherence test_gallery test_docs test_buffers test_image test_texture \
               test_api test_limits test_interfaces
@@ -160,6 +162,7 @@ build/quick/pray_tests_nostdio$(EXE): build/quick/test_main.o build/quick/nostdi
 test: sections deps $(PRAY) textures $(QUICK) tests/embed$(EXE)
 	$(RUN) ./tests/embed$(EXE) tests/embed.ppm
 	CC="$(CC)" CXX="$(CXX)" RUN="$(RUN)" sh tests/manual_examples.sh
+	RUN="$(RUN)" sh tests/options.sh ./$(PRAY)
 	RUN="$(RUN)" sh tests/quick.sh build/quick
 	@echo "== bad inputs, every fifth case (tests/bad: the numbers ending in 0 or 5)"
 	PRAY=./$(PRAY) tests/bad/run.sh 0- 5-
