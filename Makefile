@@ -3,7 +3,9 @@
 #   make examples   render every examples/*.ray into out/
 #   make textures   the examples' TIFF textures, rendered by examples/maketex.ray into examples/tex/
 #   make gallery    render every example into docs/gallery/ and write docs/gallery.md (tools/gallery.sh)
+#   make test       the quick tier: a little of every layer of check, in a couple of minutes
 #   make check      build and run all tests (installs the test packages if missing)
+#   make sections   the line budget of each [SECTION] of pray.cpp (tests/sections.sh)
 #   make matrix     compile pray.cpp under every configuration macro and language level, g++ and clang++
 #   make bench      the acceleration benchmarks (bench/run.sh), results in docs/benchmarks.md
 #   make pov        pray against POV-Ray 3.7 (bench/pov.sh; installs povray)
@@ -41,7 +43,7 @@ TESTS = tests/pray_tests$(EXE)
 TESTS_FLOAT = tests/pray_tests_float$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
-.PHONY: FORCE all examples check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff fuzz-join fuzz-long textures gallery ports pov suite charts mpi mpi-deps check-mpi
+.PHONY: FORCE all examples test sections check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff fuzz-join fuzz-long textures gallery ports pov suite charts mpi mpi-deps check-mpi
 
 all: $(PRAY)
 
@@ -107,9 +109,10 @@ tests/embed$(EXE): examples/embed.c pray.cpp pray.hpp build/png
 	$(CC) tests/embed.o tests/pray.o -o $@ $(LDLIBS)
 embed: tests/embed$(EXE)
 
-check: deps $(PRAY) textures $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embed$(EXE)
+check: sections deps $(PRAY) textures $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embed$(EXE)
 	$(RUN) ./tests/embed$(EXE) tests/embed.ppm
 	CC="$(CC)" CXX="$(CXX)" RUN="$(RUN)" sh tests/manual_examples.sh
+	RUN="$(RUN)" sh tests/options.sh ./$(PRAY)
 	@echo "== tests of rendering into buffers, without file access (PRAY_NO_STDIO)"
 	$(RUN) ./$(TESTS_NOSTDIO)
 	@echo "== tests, PRAY_REAL=float"
@@ -117,6 +120,52 @@ check: deps $(PRAY) textures $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embe
 	@echo "== tests, PRAY_REAL=double"
 	$(RUN) ./$(TESTS)
 	@$(MAKE) --no-print-directory check-bad
+
+# The line budgets of pray.cpp's sections, given in its index comment (docs/testing.md).
+sections:
+	@sh tests/sections.sh -q
+
+# The quick tier (docs/testing.md): every layer of check, lightly. The line budgets; ./pray as for
+# check; the test files built without optimisation (compiling dominates): most of them in double
+# precision, three in float, test_buffers.cpp without file access, each run as tests/quick.sh
+# chooses; the C example; the programs of the manual; the options as --help and the manual
+# present them; every fifth case of the bad inputs.
+QUICK_TESTS = test_main test_internal test_smoke test_lang test_lang2 test_render test_sampling \
+              test_accel test_coherence test_gallery test_docs test_buffers test_image test_texture \
+              test_api test_limits test_interfaces
+QUICK_FLOAT = test_main test_smoke test_render test_gallery
+QUICKFLAGS = -std=c++17 -O0 -Wall -Wextra -DPRAY_CHECKS
+QUICK = build/quick/pray_tests$(EXE) build/quick/pray_tests_float$(EXE) build/quick/pray_tests_nostdio$(EXE)
+build/quick/%.o: tests/%.cpp $(TEST_HDR) | deps
+	@mkdir -p build/quick
+	$(CXX) $(QUICKFLAGS) -c $< -o $@
+build/quick/test_internal.o: pray.cpp
+build/quick/pray_tests$(EXE): $(QUICK_TESTS:%=build/quick/%.o)
+	$(CXX) $(QUICKFLAGS) $^ -o $@ $(LDLIBS) -lpthread
+build/quick/float/%.o: tests/%.cpp $(TEST_HDR) | deps
+	@mkdir -p build/quick/float
+	$(CXX) $(QUICKFLAGS) -DPRAY_REAL=float -c $< -o $@
+build/quick/float/pray.o: pray.cpp pray.hpp build/png
+	@mkdir -p build/quick/float
+	$(CXX) $(QUICKFLAGS) -DPRAY_REAL=float -c pray.cpp -o $@
+build/quick/pray_tests_float$(EXE): $(QUICK_FLOAT:%=build/quick/float/%.o) build/quick/float/pray.o
+	$(CXX) $(QUICKFLAGS) $^ -o $@ $(LDLIBS) -lpthread
+build/quick/nostdio/%.o: tests/%.cpp $(TEST_HDR) | deps
+	@mkdir -p build/quick/nostdio
+	$(CXX) $(QUICKFLAGS) -DPRAY_NO_STDIO -c $< -o $@
+build/quick/nostdio/pray.o: pray.cpp pray.hpp
+	@mkdir -p build/quick/nostdio
+	$(CXX) $(QUICKFLAGS) -DPRAY_NO_STDIO -c pray.cpp -o $@
+build/quick/pray_tests_nostdio$(EXE): build/quick/test_main.o build/quick/nostdio/test_buffers.o build/quick/nostdio/pray.o
+	$(CXX) $(QUICKFLAGS) $^ -o $@ $(LDLIBS) -lpthread
+
+test: sections deps $(PRAY) textures $(QUICK) tests/embed$(EXE)
+	$(RUN) ./tests/embed$(EXE) tests/embed.ppm
+	CC="$(CC)" CXX="$(CXX)" RUN="$(RUN)" sh tests/manual_examples.sh
+	RUN="$(RUN)" sh tests/options.sh ./$(PRAY)
+	RUN="$(RUN)" sh tests/quick.sh build/quick
+	@echo "== bad inputs, every fifth case (tests/bad: the numbers ending in 0 or 5)"
+	PRAY=./$(PRAY) tests/bad/run.sh 0- 5-
 
 # Bad inputs: exact messages and exit statuses, nothing left behind (docs/testing.md).
 check-bad: $(PRAY)
@@ -256,4 +305,5 @@ ports:
 	sh ports/check
 
 clean:
-	rm -rf $(PRAY) $(PRAY_MPI) build/mpi build/tests build/tests-float build/sanitize $(TESTS) $(TESTS_FLOAT) $(TESTS_NOSTDIO) tests/embed$(EXE) tests/*.o tests/*.ppm out
+	rm -rf $(PRAY) $(PRAY_MPI) build/mpi build/tests build/tests-float build/sanitize build/quick $(TESTS) $(TESTS_FLOAT) \
+	  $(TESTS_NOSTDIO) tests/embed$(EXE) tests/*.o tests/*.ppm out

@@ -1,29 +1,35 @@
 /* pray.cpp — the whole implementation of pray. MIT License, see LICENSE.
 
-   Index (grep '\[SECTION\]'):
-   [SECTION] 1  Portability shims: configuration, real type, clock, terminal, files, threads
-   [SECTION] 2  Context: allocator with a cap, status and messages
-   [SECTION] 3  Tiny containers on the context allocator
-   [SECTION] 4  Vector math and the `.` transformations
-   [SECTION] 5  Scene values: models, lights, solids (reference counted handles)
-   [SECTION] 6  Options
-   [SECTION] 7  Prepared scene: flattened n-ary CSG tree, boxes, simplification, snapping
-   [SECTION] 8  Ray/primitive intersection; primitives in a frame (box, rod, cone, torus, stretched)
-   [SECTION] 9  CSG status-tree sweep (the brute-force reference, thesis 3.4)
-   [SECTION] 9b Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
-                [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas and
-                jumps, [9b.4] light and eye buffers, [9b.5] accel_build; per ray: [9b.6] list
-                evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver
-   [SECTION] 9c Reading files (programs, textures, fonts), TIFF reader and textures, the built-in font
-   [SECTION] 10 Whitted shading, textured surfaces, the render driver (threads, undersampling)
-   [SECTION] 10b Image sequences (3.7): the regions a ray crosses, comparing a frame's scene with
-                the one before, records
-   [SECTION] 11 Image writers: TIFF, PPM, PNG; writing files safely; public functions
-   [SECTION] 12 PRAY lexer
-   [SECTION] 13 PRAY parser
-   [SECTION] 14 PRAY interpreter: values, operators, builtins, statements
-   [SECTION] 15 One-call helpers and the running of programs
-   [SECTION] 16 Command-line program (PRAY_MAIN)
+   Index (grep '\[SECTION\]'). Each section has a budget of lines, from its banner to the next
+   one; tests/sections.sh checks them (docs/testing.md). A budget is lowered when a section
+   shrinks, and raised only as a decision.
+   section      budget  contents
+   [SECTION] 1     500  Portability shims: configuration, real type, clock, terminal, files, threads
+   [SECTION] 2     300  Context: allocator with a cap, status and messages
+   [SECTION] 3     100  Tiny containers on the context allocator
+   [SECTION] 4     200  Vector math and the `.` transformations
+   [SECTION] 5     650  Scene values: models, lights, solids (reference counted handles)
+   [SECTION] 6     150  Options
+   [SECTION] 7    1100  Prepared scene: flattened n-ary CSG tree, boxes, simplification, snapping
+   [SECTION] 8     450  Ray/primitive intersection; primitives in a frame (box, rod, cone, torus,
+                          stretched)
+   [SECTION] 9     450  CSG status-tree sweep (the brute-force reference, thesis 3.4)
+   [SECTION] 9b   2750  Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
+                          [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas
+                          and jumps, [9b.4] light and eye buffers, [9b.5] accel_build; per ray: [9b.6]
+                          list evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver
+   [SECTION] 9c    900  Reading files (programs, textures, fonts), TIFF reader and textures, the
+                          built-in font
+   [SECTION] 10   1200  Whitted shading, textured surfaces, the render driver (threads, undersampling)
+   [SECTION] 10b   600  Image sequences (3.7): the regions a ray crosses, comparing a frame's scene
+                          with the one before, records
+   [SECTION] 11   1650  Image writers: TIFF, PPM, PNG; writing files safely; public functions
+   [SECTION] 12    500  PRAY lexer
+   [SECTION] 13    800  PRAY parser
+   [SECTION] 14   1500  PRAY interpreter: values, operators, builtins, statements
+   [SECTION] 15    200  One-call helpers and the running of programs
+   [SECTION] 16    750  Command-line program (PRAY_MAIN)
+   The whole file: at most 14400 lines.
 */
 
 // =============================================================================================
@@ -1694,7 +1700,9 @@ struct OptDef {
     double untrusted;  // the highest value allowed in untrusted mode (0: no ceiling)
 };
 // Alphabetical, in the order of the OPT_ enumeration. grid -1 means "automatic". The max* options
-// and depth, gridmem and texmem are the limits of a run (pray.hpp, "Limits").
+// and depth, gridmem and texmem are the limits of a run (pray.hpp, "Limits"). brute, grid, nest,
+// freeze, merge, bounds, lightbuffer, eyebuffer, shadowcache, plans and coherence are diagnostic
+// (pray.hpp, "Options"; --help): they change how fast an image is made, never the image.
 const OptDef OPTS[OPT_COUNT] = {
     {"adaptive", 0, 0, 1e9, 0, 0},
     {"antialias", 1, 1, 64, 1, 0},
@@ -13628,7 +13636,6 @@ const char *const USAGE =
     "  -s WxH           image size in pixels; same as -D width=W -D height=H\n"
     "  -D name=value    set an option of the language; wins over `option` in the program\n"
     "  --stats          print statistics of the rendering to standard error\n"
-    "  --brute          the brute-force reference renderer (no acceleration)\n"
     "  --threads N      threads to render with (0 = automatic)\n"
     "  --untrusted      tighter limits; the program reads files beside it only\n"
     "  --rows A:B       render only rows A to B-1 of every image (a row part, .tif or .ppm)\n"
@@ -13638,6 +13645,27 @@ const char *const USAGE =
     "  --version        print the version and the features compiled in\n"
     "  --help           print this text\n"
     "A program of '-' is read from standard input.\n"
+    "\n"
+    "Options of the language, for -D name=value or `option` in the program:\n"
+    "  the image        width height output bits antialias adaptive depth cutoff shadows\n"
+    "  the machine      threads\n"
+    "  limits           maxsteps maxnest maxline maxstring maxprims maxpixels maxrays\n"
+    "                   maxmem maxframes maxoutput maxtime gridmem texmem\n"
+    "\n"
+    "Diagnostic options, to measure the acceleration or compare it with the reference;\n"
+    "an image never needs them, and it stays the same byte for byte whatever they are:\n"
+    "  --brute          the brute-force reference renderer; same as -D brute=1\n"
+    "  -D grid=N        N voxels along the longest side (0: no grid; -1: automatic)\n"
+    "  -D nest=N        levels of finer grids in crowded voxels (0 to 4; 2)\n"
+    "  -D freeze=0      no freezing of CSG nodes whose status can no longer change\n"
+    "  -D merge=0       no areas of neighbouring voxels with the same action lists\n"
+    "  -D bounds=0      no bounding boxes around the parts of the CSG tree\n"
+    "  -D lightbuffer=0 shadow rays walk the grid, not the lists around each light\n"
+    "  -D eyebuffer=0   primary rays walk the grid, not the lists around the eye\n"
+    "  -D shadowcache=0 shadow rays do not first try the voxel that stopped the last one\n"
+    "  -D plans=0       every action list is evaluated in full, without shortcuts\n"
+    "  -D coherence=0   every frame of a sequence is traced in full\n"
+    "\n"
     "Exit status: 0 ok, 1 error in the program, 2 usage, 3 input/output error.\n";
 
 int usage_error(const char *fmt, const char *arg) {

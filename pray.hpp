@@ -188,27 +188,33 @@ const char *pray_temp_file(const pray_ctx *ctx);
 void pray_cancel(pray_ctx *ctx);
 
 /* ---------------------------------------------------------------------------------------------
-   Options: the same names as the PRAY `option` statement: width, height (pixels, default 256),
-   depth (ray depth, 5), cutoff (1: leave out rays that, all together, could move no sample by
-   half a step of the output; 0: the whole ray tree), antialias (samples per pixel side, 1), adaptive (0), grid (-1 =
-   automatic), gridmem (MiB for the grid, 64), freeze, merge, bounds, lightbuffer, eyebuffer,
-   shadowcache, plans, shadows (1/0, default 1), brute (1 = the brute-force reference renderer, 0),
-   coherence (1: a program's frame with the camera, lights and options of the frame before
-   re-traces only the pixels whose rays could have met what changed; 0: every pixel), threads (0 = automatic), maxsteps (statements a program may execute, 10000000; 0 = no
-   limit), texmem (MiB for textures, 256),
-   bits (8 or 16 per sample in TIFF/PPM files), and the string option output (file name of
-   `rendertiff`; its extension picks the format).
+   Options: the same names as the PRAY `option` statement. Those of the image: width, height
+   (pixels, default 256), depth (ray depth, 5), cutoff (1: leave out rays that, all together,
+   could move no sample by half a step of the output; 0: the whole ray tree), antialias (samples
+   per pixel side, 1), adaptive (0), shadows (1/0, default 1), bits (8 or 16 per sample in
+   TIFF/PPM files), and the string option output (file name of `rendertiff`; its extension picks
+   the format). Of the machine: threads (0 = automatic).
 
-   Limits (each refuses with a message naming the option; see "Limits" in the manual below):
-   maxsteps, depth, gridmem, texmem as above; maxline (characters on one line of a program,
-   65536), maxnest (nesting of blocks, includes and expressions together, 256, at most 1024), maxstring (bytes
-   of a string, literal or built, 65536), maxprims (primitives one object stands for, 16777216),
-   maxpixels (samples of one image: width x height x antialias^2, 1073741824), maxrays (rays one
-   sample may take, primary, reflected and refracted, 65536), maxmem (MiB a context may hold,
-   0 = no cap), maxframes (frames of a run, 0 = no limit), maxoutput (MiB of image files a run
-   writes, 0 = no limit), maxtime (seconds a run may take, 0 = no limit). maxline and maxnest
-   apply when a program is read, so only the host or
-   the command line can change them for that program.
+   Diagnostic options, for measuring the acceleration and comparing it with the reference; an
+   image never needs them, and every value gives the image of brute=1, byte for byte (manual,
+   section 6): brute (1 = the brute-force reference renderer, 0), grid (voxels along the longest
+   side; -1 = automatic, 0 = no grid), nest (levels of nested grids, 2), and the switches of one
+   part each, 1 = on (the default) and 0 = off: freeze, merge, bounds, lightbuffer, eyebuffer,
+   shadowcache, plans, coherence (1: a program's frame with the camera, lights and options of
+   the frame before re-traces only the pixels whose rays could have met what changed; 0: every
+   pixel).
+
+   Limits (each refuses with a message naming the option; see "Limits" in the manual below): depth
+   as above; maxsteps (statements a program may execute, 10000000; 0 = no limit), gridmem (MiB for
+   the grid, 64), texmem (MiB for textures, 256); maxline (characters on one line of a program,
+   65536), maxnest (nesting of blocks, includes and expressions together, 256, at most 1024),
+   maxstring (bytes of a string, literal or built, 65536), maxprims (primitives one object stands
+   for, 16777216), maxpixels (samples of one image: width x height x antialias^2, 1073741824),
+   maxrays (rays one sample may take, primary, reflected and refracted, 65536), maxmem (MiB a
+   context may hold, 0 = no cap), maxframes (frames of a run, 0 = no limit), maxoutput (MiB of
+   image files a run writes, 0 = no limit), maxtime (seconds a run may take, 0 = no limit). maxline
+   and maxnest apply when a program is read, so only the host or the command line can change them
+   for that program.
 
    What the host sets here (options, camera, background) is where every program run starts;
    what a program sets lasts until the end of its run.
