@@ -160,6 +160,9 @@ static void *png_alloc(void *p, size_t n);
 #undef far
 #elif defined(__unix__) || defined(__APPLE__) || defined(__DJGPP__)
 #include <fcntl.h>
+#if defined(__DJGPP__)
+#include <io.h>  // setmode
+#endif
 #include <sys/stat.h>
 #include <unistd.h>
 #define PRAY_HAS_UNISTD 1
@@ -13632,7 +13635,8 @@ const char *const USAGE =
     "       pray --join OUT PART...\n"
     "Render a PRAY program, or stack the row parts that --rows or --part wrote into the\n"
     "image OUT. Options:\n"
-    "  -o FILE          output file (" PRAY_FORMATS "); same as -D output=FILE\n"
+    "  -o FILE          output file (" PRAY_FORMATS "); same as -D output=FILE;\n"
+    "                   -o - writes PPM to standard output (`print` then goes to standard error)\n"
     "  -s WxH           image size in pixels; same as -D width=W -D height=H\n"
     "  -D name=value    set an option of the language; wins over `option` in the program\n"
     "  --stats          print statistics of the rendering to standard error\n"
@@ -13641,7 +13645,7 @@ const char *const USAGE =
     "  --rows A:B       render only rows A to B-1 of every image (a row part, .tif or .ppm)\n"
     "  --part K/N       render only the K-th of N bands of rows of equal height (K from 1)\n"
     "  --frames A:B     write only frames A to B-1 of the program (from 0)\n"
-    "  --quiet          no progress bar\n"
+    "  --quiet          no progress bar, no warnings\n"
     "  --version        print the version and the features compiled in\n"
     "  --help           print this text\n"
     "A program of '-' is read from standard input.\n"
@@ -13822,6 +13826,16 @@ pray_status write_part(void *ud, const pray_image *img, const char *name) {
     }
     snprintf(note, sizeof note, PART_NOTE, sp->y0, sp->y1, sp->height, sp->frame, sp->id);
     return pray_write_image_note(c, img, name, (int)pray_option_get(c, "bits"), note);
+}
+
+// -o -: each frame to standard output as PPM, one after another (a stream netpbm tools read).
+void to_stdout(void *, const void *p, size_t n) { fwrite(p, 1, n, stdout); }
+pray_status write_stdout(void *ud, const pray_image *img, const char *) {
+    pray_ctx *c = (pray_ctx *)ud;
+    pray_status st = pray_write_ppm(c, img, (int)pray_option_get(c, "bits"), to_stdout, NULL);
+    if (st == PRAY_OK && (fflush(stdout) != 0 || ferror(stdout)))
+        st = pray_set_error(c, PRAY_ERR_IO, "cannot write the image to standard output");
+    return st;
 }
 
 // FNV-1a, twice with different starts: 16 hexadecimal digits for the part's id.
@@ -14241,7 +14255,7 @@ int main(int argc, char **argv) {
             }
             i++;
             if (a[1] == 'o') {
-                st = pray_option_fix(c, "output", next);
+                if (strcmp(next, "-") != 0) st = pray_option_fix(c, "output", next);
                 output = next;
             }
             else if (a[1] == '-') st = pray_option_fix(c, "threads", next);
@@ -14298,8 +14312,22 @@ int main(int argc, char **argv) {
         pray_free(c);
         return rc;
     }
+    bool piped = output && strcmp(output, "-") == 0;
+    if (piped && (sp.row1 || sp.n)) {
+        pray_free(c);
+        return usage_error("-o - writes whole images: not with --rows or --part%s", "");
+    }
+    if (piped) {  // (and `print` goes to standard error, out of the images' way)
+#if defined(_WIN32)
+        _setmode(_fileno(stdout), _O_BINARY);
+#elif defined(__DJGPP__)
+        setmode(fileno(stdout), O_BINARY);
+#endif
+        pray_set_frame(c, write_stdout, c);
+        pray_set_print(c, to_stderr, NULL);
+    }
     if (!quiet && stderr_is_terminal()) pray_set_progress(c, progress_bar, NULL);
-    pray_set_warning(c, to_stderr, NULL);
+    if (!quiet) pray_set_warning(c, to_stderr, NULL);
     if (sp.row1 || sp.n || sp.frame1) pray_set_render(c, render_part, &sp);
     if (sp.row1 || sp.n) {
         render_id(c, sp.id, program, argc, argv);

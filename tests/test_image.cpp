@@ -603,12 +603,36 @@ TEST_CASE("a camera whose |X| : |Y| is not width : height: one warning a run, on
     REQUIRE_MESSAGE(have_pray(), NO_PRAY);
     TempDir d;
     std::string err;
-    CHECK(run_cmd(testkit::pray_shell() + " --quiet -s 64x32 -o " + sq(d / "x.ppm") + " examples/redsph.ray 2>&1 >/dev/null", &err, false) == 0);
+    CHECK(run_cmd(testkit::pray_shell() + " -s 64x32 -o " + sq(d / "x.ppm") + " examples/redsph.ray 2>&1 >/dev/null", &err, false) == 0);
     CHECK(err == "examples/redsph.ray:9:1: warning: the image is 64 x 32 pixels but the camera's |X| : |Y| is 1 : 1, "
                  "so the picture is stretched sideways (make |X| / |Y| equal to width / height)\n");
     CHECK(d.listing() == "x.ppm");
-    CHECK(run_cmd(testkit::pray_shell() + " --quiet -s 64x64 -o " + sq(d / "y.ppm") + " examples/redsph.ray 2>&1 >/dev/null", &err, false) == 0);
+    CHECK(run_cmd(testkit::pray_shell() + " -s 64x64 -o " + sq(d / "y.ppm") + " examples/redsph.ray 2>&1 >/dev/null", &err, false) == 0);
     CHECK(err == "");
+    // --quiet: no warnings (N copies from N processes of a parallel run), the image the same
+    CHECK(run_cmd(testkit::pray_shell() + " --quiet -s 64x32 -o " + sq(d / "z.ppm") + " examples/redsph.ray 2>&1 >/dev/null", &err, false) == 0);
+    CHECK(err == "");
+    CHECK(slurp(d / "z.ppm") == slurp(d / "x.ppm"));
+}
+
+TEST_CASE("command line: -o - writes PPM to standard output, and print goes to standard error") {
+    REQUIRE_MESSAGE(have_pray(), NO_PRAY);
+    TempDir d;
+    spit(d / "p.ray", "print \"hello\"\nrendertiff sphere(color({1, 0.5, 0}), [0, 0, 0], 0.5)\n"
+                      "rendertiff sphere(color({0, 0, 1}), [0, 0, 0], 0.5)\n");
+    std::string out, err;
+    CHECK(run_cmd("(" + testkit::pray_shell() + " -s 8x8 -o - " + sq(d / "p.ray") + " 2>" + sq(d / "err.txt") + " >" +
+                      sq(d / "out.ppm") + ")", &out) == 0);
+    CHECK(slurp(d / "err.txt") == "hello\n");
+    CHECK(run_cmd(testkit::pray_shell() + " -s 8x8 -o " + sq(d / "f.ppm") + " " + sq(d / "p.ray"), &out) == 0);
+    // the two frames, one after the other: the files the run writes, f.ppm and f_0001.ppm
+    std::string s = slurp(d / "out.ppm"), f = slurp(d / "f.ppm"), g = slurp(d / "f_0001.ppm");
+    CHECK(s == f + g);
+    CHECK(f != g);
+    CHECK(s.compare(0, 11, "P6\n8 8\n255\n") == 0);
+    // not with row parts
+    CHECK(run_cmd(testkit::pray_shell() + " -o - --rows 0:4 " + sq(d / "p.ray"), &out) == 2);
+    CHECK(out.find("-o - writes whole images") != std::string::npos);
 }
 
 TEST_CASE("command line: -D and -s win over the program's options") {

@@ -41,7 +41,7 @@ const char *const USAGE =
     "  --untrusted      tighter limits; the program reads files beside it only\n"
     "  --split rows|frames  hand out rows or frames (default: rows for one image, frames\n"
     "                   for a sequence)\n"
-    "  --quiet          accepted, as pray's (pray-mpi draws no progress bar)\n"
+    "  --quiet          no warnings (pray-mpi draws no progress bar)\n"
     "  --help           print this text\n"
     "Exit status: 0 ok, 1 error in the program, 2 usage, 3 input/output error.\n";
 
@@ -318,6 +318,7 @@ int run(int argc, char **argv) {
     }
     const char *program = NULL;
     int split = 0;  // 0 automatic, 1 rows, 2 frames
+    int quiet = 0;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         pray_status st = PRAY_OK;
@@ -325,7 +326,7 @@ int run(int argc, char **argv) {
             if (rank == 0) fputs(USAGE, stdout);
             pray_free(c);
             return 0;
-        } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) continue;
+        } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) quiet = 1;
         else if (strcmp(a, "--brute") == 0) st = pray_option_fix(c, "brute", "1");
         else if (strcmp(a, "--untrusted") == 0) pray_set_untrusted(c);
         else if (!strcmp(a, "-o") || !strcmp(a, "-s") || !strcmp(a, "-D") || !strcmp(a, "--threads") ||
@@ -406,7 +407,7 @@ int run(int argc, char **argv) {
     memset(&w, 0, sizeof w);
     if (rank == 0) {
         pray_set_print(c, to_stdout, NULL);  // rank 0 prints what the program prints, as pray
-        pray_set_warning(c, to_stderr, NULL);
+        if (!quiet) pray_set_warning(c, to_stderr, NULL);
     }
     if (nranks == 1) {
         pray_set_render(c, NULL, NULL);  // one process: pray alone
