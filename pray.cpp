@@ -10,7 +10,7 @@
    [SECTION] 4     200  Vector math and the `.` transformations
    [SECTION] 5     650  Scene values: models, lights, solids (reference counted handles)
    [SECTION] 6     150  Options
-   [SECTION] 7    1100  Prepared scene: flattened n-ary CSG tree, boxes, simplification, snapping
+   [SECTION] 7    1150  Prepared scene: flattened n-ary CSG tree, boxes, simplification, snapping
    [SECTION] 8     450  Ray/primitive intersection; primitives in a frame (box, rod, cone, torus,
                           stretched)
    [SECTION] 9     450  CSG status-tree sweep (the brute-force reference, thesis 3.4)
@@ -2869,7 +2869,31 @@ pray_status scene_compact(pray_ctx *c, Scene *s) {
 }
 
 // ---- where materials meet (language 12) ----
-bool model_same(const pray_model *a, const pray_model *b);
+// Values compared by their bits (here, and between the frames of a sequence, 10b).
+inline bool same_bytes(const void *a, const void *b, size_t n) { return memcmp(a, b, n) == 0; }
+inline bool same_real(real a, real b) { return same_bytes(&a, &b, sizeof a); }
+inline bool same_r3(R3 a, R3 b) { return same_real(a.x, b.x) && same_real(a.y, b.y) && same_real(a.z, b.z); }
+inline bool same_rgb_bits(pray_rgb a, pray_rgb b) { return same_bytes(&a, &b, sizeof a); }
+
+bool tex_same(const pray_texture *a, const pray_texture *b) {
+    if (a == b) return true;
+    return a && b && a->w == b->w && a->hgt == b->hgt &&
+           same_bytes(a->rgb, b->rgb, sizeof(float) * 3 * (size_t)a->w * (size_t)a->hgt);
+}
+
+// Two models alike in every coefficient, texture (its texels) and part.
+bool model_same(const pray_model *a, const pray_model *b) {
+    if (a == b) return true;
+    if (!a || !b || a->kind != b->kind || a->has_exponent != b->has_exponent || a->has_index != b->has_index)
+        return false;
+    const pray_rgb *x[7] = {&a->diffuse, &a->specular, &a->ambient, &a->emit, &a->reflect, &a->transmit, &a->factor};
+    const pray_rgb *y[7] = {&b->diffuse, &b->specular, &b->ambient, &b->emit, &b->reflect, &b->transmit, &b->factor};
+    for (int i = 0; i < 7; i++)
+        if (!same_rgb_bits(*x[i], *y[i])) return false;
+    double u[5] = {a->exponent, a->index, a->amount, a->dx, a->dy}, v[5] = {b->exponent, b->index, b->amount, b->dx, b->dy};
+    return same_bytes(u, v, sizeof u) && tex_same(a->tex, b->tex) && model_same(a->a, b->a) && model_same(a->b, b->b);
+}
+
 
 // The solids of two primitives neither overlap nor touch but at a point, for certain: spheres,
 // and a sphere or a box against a half-space whose normal is along an axis (so that balls
@@ -4716,6 +4740,7 @@ bool grid_areas(pray_ctx *c, const Grid &G, long *areas) {
 // of the cell between the voxel and the light, which holds every shadow ray that starts in the
 // voxel. Such a ray evaluates that one list instead of walking the grid. The zones are classed
 // like the grid's voxels, with a margin for rounding.
+#ifndef PRAY_NO_BUFFERS  // (a build without them: their options change nothing)
 
 // The squared distance from point p to box bx (0 inside it).
 inline real box_dist2(const Box &bx, R3 p) {
@@ -5187,6 +5212,7 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
     foot.release(c);
     return ok;
 }
+#endif  // PRAY_NO_BUFFERS
 
 // ---- [9b.5] Building: the whole structure ----
 // The measure of a box that sizes a grid (auto_grid): the cube of its longest side times its
@@ -5456,10 +5482,14 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         a->outer = st == PRAY_OK && lb_region(b, cand.p, cand.n, out) ? lb_list(b, b.rprims.p, b.rcls.p, b.rprims.n) : -1;
         if (a->outer < 0) st = c->status;
     }
+#ifndef PRAY_NO_BUFFERS
     bool lights = opt_int(c, OPT_SHADOWS) && opt_int(c, OPT_LIGHTBUFFER) && s->lights.n > 0;
     bool eye = render && opt_int(c, OPT_EYEBUFFER) && !s->parallel;
     if (st == PRAY_OK && a->g.n[0] > 0 && (lights || eye) && !lightbuf_build(b, eff, a->g.h, (real)margin, lights, eye, rays))
         st = c->status;
+#else
+    (void)render;
+#endif
     cand.release(c);
     start.release(c);
     mem_free(c, eff);
@@ -8533,6 +8563,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
 // same colour; the others are traced again. With undersampling the unit is the band of rows
 // the render driver samples alone. The records of a frame are at most COH_BYTES; a frame that
 // cannot have them is traced in full (docs/acceleration.md, "Image sequences").
+#ifndef PRAY_NO_SEQUENCES  // (a build without them: option coherence changes nothing)
 const double COH_BYTES = 64.0 * 1048576;  // the records of a frame at most
 const int COH_CELLS = 12;                 // cells along an axis at most (4 at least)
 
@@ -8632,30 +8663,6 @@ void region_note(Scratch *w, const Ray &ray, real end) {
 }
 
 // ---- comparing two prepared scenes by value ----
-inline bool same_bytes(const void *a, const void *b, size_t n) { return memcmp(a, b, n) == 0; }
-inline bool same_real(real a, real b) { return same_bytes(&a, &b, sizeof a); }
-inline bool same_r3(R3 a, R3 b) { return same_real(a.x, b.x) && same_real(a.y, b.y) && same_real(a.z, b.z); }
-inline bool same_rgb_bits(pray_rgb a, pray_rgb b) { return same_bytes(&a, &b, sizeof a); }
-
-bool tex_same(const pray_texture *a, const pray_texture *b) {
-    if (a == b) return true;
-    return a && b && a->w == b->w && a->hgt == b->hgt &&
-           same_bytes(a->rgb, b->rgb, sizeof(float) * 3 * (size_t)a->w * (size_t)a->hgt);
-}
-
-// Two models alike in every coefficient, texture (its texels) and part.
-bool model_same(const pray_model *a, const pray_model *b) {
-    if (a == b) return true;
-    if (!a || !b || a->kind != b->kind || a->has_exponent != b->has_exponent || a->has_index != b->has_index)
-        return false;
-    const pray_rgb *x[7] = {&a->diffuse, &a->specular, &a->ambient, &a->emit, &a->reflect, &a->transmit, &a->factor};
-    const pray_rgb *y[7] = {&b->diffuse, &b->specular, &b->ambient, &b->emit, &b->reflect, &b->transmit, &b->factor};
-    for (int i = 0; i < 7; i++)
-        if (!same_rgb_bits(*x[i], *y[i])) return false;
-    double u[5] = {a->exponent, a->index, a->amount, a->dx, a->dy}, v[5] = {b->exponent, b->index, b->amount, b->dx, b->dy};
-    return same_bytes(u, v, sizeof u) && tex_same(a->tex, b->tex) && model_same(a->a, b->a) && model_same(a->b, b->b);
-}
-
 // A primitive's surface, its texture coordinates and its model (not its number, nor its twins).
 bool prim_same(const Prim &a, const Prim &b) {
     if (a.kind != b.kind || a.axis != b.axis || a.map != b.map || !a.tm != !b.tm) return false;
@@ -9118,6 +9125,10 @@ pray_status coh_keep(pray_ctx *c, Scene *s, const float *img, const CohPlan *pla
     h->recorded = recorded;
     return PRAY_OK;
 }
+#else
+inline void coh_release(pray_ctx *) {}
+void region_note(Scratch *, const Ray &, real) {}
+#endif  // PRAY_NO_SEQUENCES
 } // namespace
 
 // =============================================================================================
@@ -9472,6 +9483,12 @@ const char *pray_features(void) {
 #endif
 #if PRAY_HAS_THREADS
            "threads "
+#endif
+#ifndef PRAY_NO_BUFFERS
+           "buffers "
+#endif
+#ifndef PRAY_NO_SEQUENCES
+           "sequences "
 #endif
            "real=" PRAY_STRINGIFY(PRAY_REAL);
 }
@@ -10350,17 +10367,21 @@ pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, cons
         c->stats.primitives = s.prims.n;
         c->stats.nodes = s.nodes.n;
         // a program's frame of the whole image, in colour only, may take over from the one before
+        CohPlan plan;
+        memset(&plan, 0, sizeof plan);
+#ifndef PRAY_NO_SEQUENCES
         bool coh = opt_int(c, OPT_COHERENCE) && c->running && s.accel && out.rgb && !out.primitive && !out.depth &&
                    !out.normal && r.x == 0 && r.y == 0 && r.width == s.width && r.height == s.height &&
                    out.stride == (size_t)s.width;
-        CohPlan plan;
-        memset(&plan, 0, sizeof plan);
         if (coh) st = coh_plan(c, &s, &plan);
         else coh_release(c);
         if (st == PRAY_OK) st = render_scene(c, &s, r, out, &plan);
         mem_free(c, plan.redo);
         if (st == PRAY_OK && coh) st = coh_keep(c, &s, out.rgb, &plan);
         if (st != PRAY_OK || !coh) coh_release(c);
+#else
+        st = render_scene(c, &s, r, out, &plan);
+#endif
     }
     c->stats.time_prepare += t1 - t0;
     c->stats.time_render += clock_seconds() - t1;

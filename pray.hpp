@@ -23,6 +23,10 @@
    @@ PRAY_NO_STDIO               no file access: write images through callbacks only
    @@ PRAY_NO_PNG                 no PNG output even when <stb/stb_image_write.h> is present
    @@ PRAY_NO_THREADS             no threads (DOS, bare targets)
+   @@ PRAY_NO_BUFFERS             no light or eye buffers (options lightbuffer and eyebuffer then
+                                  change nothing); the images stay the same, byte for byte
+   @@ PRAY_NO_SEQUENCES           no image-sequence coherence (option coherence then changes
+                                  nothing): every frame is traced in full, to the same bytes
    @@ PRAY_NO_DEFAULT_ALLOC       no malloc-based allocator: pray_new_with must be given one
    @@ PRAY_MAX_ALLOC bytes        default memory cap of a context (0 = none)
    @@ PRAY_TEMP_SUFFIX ".tmp"     ends the temporary name a file is written under
