@@ -23,13 +23,13 @@
    [SECTION] 10   1200  Whitted shading, textured surfaces, the render driver (threads, undersampling)
    [SECTION] 10b   600  Image sequences (3.7): the regions a ray crosses, comparing a frame's scene
                           with the one before, records
-   [SECTION] 11   1650  Image writers: TIFF, PPM, PNG; writing files safely; public functions
+   [SECTION] 11   1700  Image writers: TIFF, PPM, PNG; writing files safely; public functions
    [SECTION] 12    500  PRAY lexer
    [SECTION] 13    800  PRAY parser
    [SECTION] 14   1500  PRAY interpreter: values, operators, builtins, statements
    [SECTION] 15    200  One-call helpers and the running of programs
    [SECTION] 16    750  Command-line program (PRAY_MAIN)
-   The whole file: at most 14400 lines.
+   The whole file: at most 14450 lines.
 */
 
 // =============================================================================================
@@ -599,6 +599,7 @@ struct pray_ctx {
     int calls;               // cancellable public calls running (a run renders and writes)
     double started;          // when the outermost of them started (option maxtime)
     Coherence *coh;          // image sequences (option coherence): the frame before, or NULL
+    struct Prepared *prep;   // the scene pray_render_into prepared last, outside runs, or NULL
 };
 
 namespace {
@@ -10355,13 +10356,59 @@ pray_status image_limits(pray_ctx *c) {
     return PRAY_OK;
 }
 
-// The one way to render: rectangle r of the image into the buffers (stride set), both checked.
+} // namespace
+// The scene pray_render_into prepared last outside a program's run, for the next render of the
+// same root and lights with the same options, camera and background (a host's bands, tiles and
+// passes): it holds a reference to both, so that neither can be freed and its address taken by
+// another while it is kept. A render of another scene, a run, and pray_free drop it.
+struct Prepared {
+    pray_object *root;
+    pray_light *lights;
+    Setup setup;
+    Scene s;
+};
+namespace {
+
+void prepared_drop(pray_ctx *c) {
+    Prepared *p = c->prep;
+    if (!p) return;
+    c->prep = NULL;
+    scene_release(c, &p->s);
+    release_handle(c, p->root);
+    if (p->lights) release_handle(c, p->lights);
+    mem_free(c, p);
+}
+
+// The one way to render: rectangle r of the image into the buffers (stride set), both checked;
+// with the scene kept from the render before when it is the same (Prepared).
 pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, const pray_rect &r,
                         const pray_buffers &out) {
     double t0 = clock_seconds();
     mem_phase(c, MEM_RUN);
-    Scene s;
-    pray_status st = scene_build(c, &s, root, lights, true);
+    Prepared *p = c->prep;
+    bool keep = !c->running && c->drop != root;
+    if (p && !(keep && p->root == root && p->lights == lights && memcmp(&p->setup, &c->cur, sizeof(Setup)) == 0)) {
+        prepared_drop(c);  // (before another is built: the two need not fit at once)
+        p = NULL;
+    }
+    Scene own;
+    memset(&own, 0, sizeof own);
+    pray_status st = p ? PRAY_OK : scene_build(c, &own, root, lights, true);
+    if (!p && st == PRAY_OK && keep) {
+        p = (Prepared *)mem_alloc(c, sizeof(Prepared));
+        if (!p) st = c->status;
+        else {
+            p->root = root;
+            p->lights = lights;
+            memcpy(&p->setup, &c->cur, sizeof(Setup));
+            p->s = own;  // (moved)
+            memset(&own, 0, sizeof own);
+            retain(root);
+            if (lights) retain(lights);
+            c->prep = p;
+        }
+    }
+    Scene &s = p ? p->s : own;
     double t1 = clock_seconds();
     if (st == PRAY_OK) {
         c->stats.primitives = s.prims.n;
@@ -10385,7 +10432,7 @@ pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, cons
     }
     c->stats.time_prepare += t1 - t0;
     c->stats.time_render += clock_seconds() - t1;
-    scene_release(c, &s);
+    scene_release(c, &own);
     mem_phase(c, st == PRAY_OK ? MEM_RENDER : MEM_PREPARE);  // (what the scene held is counted)
     return st;
 }
@@ -13508,6 +13555,7 @@ static pray_status run_string_call(pray_ctx *c, const char *name, const char *te
     c->run_dir_len = 0;
     for (size_t i = 0; nm[i]; i++)
         if (nm[i] == '/' || nm[i] == '\\' || nm[i] == ':') c->run_dir_len = i + 1;
+    prepared_drop(c);  // (a run prepares its own frames)
     c->running = 1;
     pray_status st = run_program(c, nm, text, len);
     coh_release(c);

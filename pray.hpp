@@ -544,7 +544,13 @@ typedef struct pray_buffers {
    any number of threads. Memory besides the buffers comes from the context. Errors:
    PRAY_ERR_ARG (no context or buffers, all buffers NULL, a rectangle not inside the image, a
    stride less than its width), and those of pray_render; on error the buffers hold partial
-   results. */
+   results.
+   Prepared once, rendered many times: outside a program's run, the context keeps the scene
+   pray_render_into and pray_render prepared (flattened, simplified, with its grid), and the next
+   render of the same root and lights with the same options, camera and background uses it
+   again, so that bands, tiles and passes cost what the whole image costs. It holds a reference
+   to root and lights meanwhile (releasing yours is safe). Rendering another scene or lights,
+   changing an option, the camera or the background, running a program, or pray_free drops it. */
 pray_status pray_render_into(pray_ctx *ctx, pray_object *root, pray_light *lights, const pray_rect *rect,
                              const pray_buffers *out);
 /* The primary ray through image point (px, py), in pixels from the image's top left corner

@@ -823,3 +823,94 @@ TEST_CASE("api: pray_retain keeps a program's scene past its run, to render agai
     pray_free(d);
     pray_free(c);
 }
+
+namespace {
+// A scene of the test below on context c: 0 a ball and a box, 1 two balls; lights 0 and 1.
+pray_object *scene_of(pray_ctx *c, int which) {
+    pray_rgb red = {0.8, 0.2, 0.1};
+    pray_model *m = pray_phong(c, red, GREY, GREY, 8);
+    pray_vec p = {0.3, -0.2, 0.1}, q = {-0.6, 0.1, -0.3}, lo = {-0.9, -0.9, -0.9}, hi = {-0.2, -0.3, 0.4};
+    pray_object *o = pray_csg(c, PRAY_UNION, pray_sphere(c, m, p, 0.5),
+                              which == 0 ? pray_box(c, m, lo, hi) : pray_sphere(c, m, q, 0.35));
+    pray_release(c, m);
+    return o;
+}
+pray_light *light_of(pray_ctx *c, int which) {
+    pray_vec d = {1, 1, 1}, at = {2, -1, 3};
+    return which == 0 ? pray_dirlight(c, WHITE, d) : pray_pointlight(c, GREY, at);
+}
+// The settings of step k of the test below, and those of the steps before it.
+void settings_of(pray_ctx *c, int k) {
+    pray_option(c, "width", 40);
+    pray_option(c, "height", 30);
+    if (k >= 2) pray_option(c, "shadows", 0);
+    if (k >= 3) {
+        pray_vec eye = {3, -2, 1}, up = {0, 0, 1};
+        pray_lookat(c, eye, ORIGIN, up, 40);
+    }
+    if (k >= 4) {
+        pray_rgb top = {0.2, 0.3, 0.9}, bottom = {0.9, 0.8, 0.2};
+        pray_background(c, top, bottom);
+    }
+}
+std::vector<float> render_rect(pray_ctx *c, pray_object *o, pray_light *l, int bands) {
+    std::vector<float> px((size_t)40 * 30 * 3);
+    for (int b = 0; b < bands; b++) {
+        pray_rect r = {0, 30 * b / bands, 40, 30 * (b + 1) / bands - 30 * b / bands};
+        pray_buffers out = {px.data() + (size_t)3 * 40 * r.y, nullptr, nullptr, nullptr, 40};
+        REQUIRE(pray_render_into(c, o, l, &r, &out) == PRAY_OK);
+    }
+    return px;
+}
+} // namespace
+
+TEST_CASE("api: pray_render_into reuses the scene it prepared only for the same scene, lights, options, camera and background") {
+    // each step on one context, in bands (the second band on reuses the first's preparation),
+    // against a fresh context with the same settings rendering the whole image
+    pray_ctx *c = pray_new();
+    pray_object *o = scene_of(c, 0);
+    pray_light *l = light_of(c, 0);
+    std::vector<std::vector<float>> seen;
+    for (int k = 0; k < 8; k++) {
+        CAPTURE(k);
+        settings_of(c, k);
+        int which = k >= 6 ? 1 : 0, lit = k >= 5 ? 1 : 0;
+        if (k == 5) {  // other lights
+            pray_light_release(c, l);
+            l = light_of(c, 1);
+        }
+        if (k == 6) {  // another scene, made right after the kept one is let go (it may take its address)
+            pray_object_release(c, o);
+            o = scene_of(c, 1);
+        }
+        std::vector<float> got = render_rect(c, o, l, k == 0 ? 1 : 6);
+        pray_ctx *d = pray_new();
+        settings_of(d, k);
+        pray_object *od = scene_of(d, which);
+        pray_light *ld = light_of(d, lit);
+        CHECK(got == render_rect(d, od, ld, 1));
+        pray_free(d);
+        seen.push_back(got);
+    }
+    CHECK(seen[1] == seen[0]);  // (steps 1 and 7 change nothing: the kept scene is used)
+    for (int k = 2; k < 7; k++) CHECK(seen[k] != seen[k - 1]);  // (every other step changes the picture)
+    CHECK(seen[7] == seen[6]);
+    // a program run on the context after: as on a fresh one
+    const char *prog = "rendertiff sphere(phong({0.2, 0.7, 0.3}, {0.3}, 5), [0, 0, 0], 0.6), dirlight({1}, <0, 0, 1>)\n";
+    std::vector<testkit::Frame> a, b;
+    pray_set_frame(c, testkit::frame_sink, &a);
+    REQUIRE(pray_run_string(c, "p.ray", prog, strlen(prog)) == PRAY_OK);
+    pray_ctx *d = pray_new();
+    settings_of(d, 7);
+    pray_set_frame(d, testkit::frame_sink, &b);
+    REQUIRE(pray_run_string(d, "p.ray", prog, strlen(prog)) == PRAY_OK);
+    REQUIRE(a.size() == 1);
+    REQUIRE(b.size() == 1);
+    CHECK(a[0].pixels == b[0].pixels);
+    pray_free(d);
+    // and the scene kept from before is rendered again as it was
+    CHECK(render_rect(c, o, l, 3) == seen[7]);
+    pray_object_release(c, o);
+    pray_light_release(c, l);
+    pray_free(c);
+}
