@@ -226,11 +226,12 @@ sanitize: deps $(PRAY) textures
 # render on two threads cancelled from a third, and two contexts rendering at once; a race makes
 # the program exit non-zero.
 .PHONY: tsan
-build/tsan/cancel: tests/tsan/cancel.cpp pray.cpp pray.hpp
+build/tsan/%: tests/tsan/%.cpp pray.cpp pray.hpp
 	@mkdir -p build/tsan
-	g++ -std=c++11 -g -O1 -fsanitize=thread -I. tests/tsan/cancel.cpp pray.cpp -o $@ -lpthread
-tsan: build/tsan/cancel
+	g++ -std=c++11 -g -O1 -fsanitize=thread -I. $< pray.cpp -o $@ -lpthread
+tsan: build/tsan/cancel build/tsan/shared
 	TSAN_OPTIONS=halt_on_error=1 ./build/tsan/cancel
+	TSAN_OPTIONS=halt_on_error=1 ./build/tsan/shared
 
 # libFuzzer (clang; on Debian the runtime is in libclang-rt-14-dev): the harness runs fuzz inputs
 # as PRAY programs. New inputs go to build/fuzz/corpus, crashes to build/fuzz/artifacts/; the seeds

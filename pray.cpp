@@ -23,13 +23,13 @@
    [SECTION] 10   1200  Whitted shading, textured surfaces, the render driver (threads, undersampling)
    [SECTION] 10b   600  Image sequences (3.7): the regions a ray crosses, comparing a frame's scene
                           with the one before, records
-   [SECTION] 11   1700  Image writers: TIFF, PPM, PNG; writing files safely; public functions
+   [SECTION] 11   1750  Image writers: TIFF, PPM, PNG; writing files safely; public functions
    [SECTION] 12    500  PRAY lexer
    [SECTION] 13    800  PRAY parser
    [SECTION] 14   1500  PRAY interpreter: values, operators, builtins, statements
    [SECTION] 15    200  One-call helpers and the running of programs
    [SECTION] 16    750  Command-line program (PRAY_MAIN)
-   The whole file: at most 14450 lines.
+   The whole file: at most 14500 lines.
 */
 
 // =============================================================================================
@@ -1965,6 +1965,7 @@ struct Scene {
     R3 eye, point, cx, cy, dir;
     R3 keye, kpoint, kcx, kcy;  // the perspective camera scaled by a power of two near 1/size
     int width, height, depth, shadows, antialias;
+    double adaptive;  // the undersampling threshold (option adaptive)
     pray_rgb bg_top, bg_bottom;
     // The ray tree's cut-off (ray_most): the most a ray with k levels left can bring back, for
     // k = 0 .. depth, and the least a ray must be able to add to its sample to be traced (0:
@@ -7916,6 +7917,7 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     s->depth = opt_int(c, OPT_DEPTH);
     s->shadows = opt_int(c, OPT_SHADOWS);
     s->antialias = opt_int(c, OPT_ANTIALIAS);
+    s->adaptive = c->cur.opt.v[OPT_ADAPTIVE];
     s->bg_top = c->cur.bg_top;
     s->bg_bottom = c->cur.bg_bottom;
     ray_most(c, s);
@@ -8431,10 +8433,10 @@ struct CohPlan {
 };
 
 // The rows of a band of the render driver: a band of tiles with undersampling.
-int band_rows_of(const pray_ctx *c, const Scene *s, bool rgb) {
+int band_rows_of(const Scene *s, bool rgb) {
     int step = s->antialias * (s->antialias > 1 ? ADAPT_PIXELS_AA : ADAPT_PIXELS);
     int tile = step * (ADAPT_TILE > step ? ADAPT_TILE / step : 1);
-    return rgb && c->cur.opt.v[OPT_ADAPTIVE] > 0 ? tile / s->antialias : 4;
+    return rgb && s->adaptive > 0 ? tile / s->antialias : 4;
 }
 
 // Render the rectangle r of the image into the buffers (stride set); `plan`: what an image
@@ -8451,10 +8453,10 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
     job.s = s;
     job.r = r;
     job.out = out;
-    job.adaptive = out.rgb ? c->cur.opt.v[OPT_ADAPTIVE] : 0;
+    job.adaptive = out.rgb ? s->adaptive : 0;
     job.step = s->antialias * (s->antialias > 1 ? ADAPT_PIXELS_AA : ADAPT_PIXELS);
     job.tile = job.step * (ADAPT_TILE > job.step ? ADAPT_TILE / job.step : 1);
-    job.band_rows = band_rows_of(c, s, out.rgb != NULL);
+    job.band_rows = band_rows_of(s, out.rgb != NULL);
     if (plan) {
         job.redo = plan->redo;
         job.rec = plan->rec;
@@ -8991,10 +8993,10 @@ pray_status coh_plan(pray_ctx *c, const Scene *s, CohPlan *plan) {
     Coherence *h = c->coh;
     if (!h) h = c->coh = (Coherence *)mem_zalloc(c, sizeof(Coherence));
     if (!h) return c->status;
-    bool bands = c->cur.opt.v[OPT_ADAPTIVE] > 0;
+    bool bands = s->adaptive > 0;
     size_t units = (size_t)s->width * s->height;
     if (bands) {
-        int rows = band_rows_of(c, s, true);
+        int rows = band_rows_of(s, true);
         units = (size_t)((s->height + rows - 1) / rows);
     }
     Options o = c->cur.opt;
@@ -10357,10 +10359,11 @@ pray_status image_limits(pray_ctx *c) {
 }
 
 } // namespace
-// The scene pray_render_into prepared last outside a program's run, for the next render of the
-// same root and lights with the same options, camera and background (a host's bands, tiles and
-// passes): it holds a reference to both, so that neither can be freed and its address taken by
-// another while it is kept. A render of another scene, a run, and pray_free drop it.
+// The scene pray_render_into prepared last outside a program's run (or in a render function),
+// for the next render of the same root and lights with the same options, camera and background
+// (a host's bands, tiles and passes): it holds a reference to both, so that neither can be freed
+// and its address taken by another while it is kept. A render of another scene, the start and
+// end of a run, and pray_free drop it.
 struct Prepared {
     pray_object *root;
     pray_light *lights;
@@ -10386,7 +10389,7 @@ pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, cons
     double t0 = clock_seconds();
     mem_phase(c, MEM_RUN);
     Prepared *p = c->prep;
-    bool keep = !c->running && c->drop != root;
+    bool keep = (!c->running || c->in_render_fn) && c->drop != root;
     if (p && !(keep && p->root == root && p->lights == lights && memcmp(&p->setup, &c->cur, sizeof(Setup)) == 0)) {
         prepared_drop(c);  // (before another is built: the two need not fit at once)
         p = NULL;
@@ -10417,7 +10420,7 @@ pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, cons
         CohPlan plan;
         memset(&plan, 0, sizeof plan);
 #ifndef PRAY_NO_SEQUENCES
-        bool coh = opt_int(c, OPT_COHERENCE) && c->running && s.accel && out.rgb && !out.primitive && !out.depth &&
+        bool coh = !p && opt_int(c, OPT_COHERENCE) && c->running && s.accel && out.rgb && !out.primitive && !out.depth &&
                    !out.normal && r.x == 0 && r.y == 0 && r.width == s.width && r.height == s.height &&
                    out.stride == (size_t)s.width;
         if (coh) st = coh_plan(c, &s, &plan);
@@ -10495,6 +10498,25 @@ pray_status pray_render(pray_ctx *c, pray_object *root, pray_light *lights, pray
     return r;
 }
 
+// The rectangle (NULL: the whole W x H image) and the buffers of pray_render_into and
+// pray_render_prepared (fn), checked, into *r and *b (the stride set).
+static pray_status render_target(pray_ctx *c, const char *fn, int W, int H, const pray_rect *rect,
+                                 const pray_buffers *out, pray_rect *r, pray_buffers *b) {
+    pray_rect all = {0, 0, W, H};
+    *r = rect ? *rect : all;
+    if (r->width < 1 || r->height < 1 || r->x < 0 || r->y < 0 || r->x > W - r->width || r->y > H - r->height)
+        return fail(c, PRAY_ERR_ARG, "%s: the rectangle of %d x %d pixels at (%d, %d) is not inside the image of %d x %d",
+                    fn, r->width, r->height, r->x, r->y, W, H);
+    *b = *out;
+    if (b->stride == 0) b->stride = (size_t)r->width;
+    if (b->stride < (size_t)r->width)
+        return fail(c, PRAY_ERR_ARG, "%s: the stride %lu is less than the rectangle's width %d", fn,
+                    (unsigned long)b->stride, r->width);
+    if (b->stride > (size_t)-1 / 3 / (size_t)r->height)
+        return fail(c, PRAY_ERR_ARG, "%s: the stride %lu is too large", fn, (unsigned long)b->stride);
+    return PRAY_OK;
+}
+
 // pray_render_into's work, between call_enter and call_leave
 static pray_status render_into_call(pray_ctx *c, pray_object *root, pray_light *lights, const pray_rect *rect,
                                     const pray_buffers *out) {
@@ -10502,19 +10524,10 @@ static pray_status render_into_call(pray_ctx *c, pray_object *root, pray_light *
     if (!out->rgb && !out->primitive && !out->depth && !out->normal)
         return fail(c, PRAY_ERR_ARG, "pray_render_into: every buffer is NULL");
     if (!scene_ok(c, root, lights, "pray_render_into") || image_limits(c)) return c->status;
-    int W = opt_int(c, OPT_WIDTH), H = opt_int(c, OPT_HEIGHT);
-    pray_rect r = {0, 0, W, H};
-    if (rect) r = *rect;
-    if (r.width < 1 || r.height < 1 || r.x < 0 || r.y < 0 || r.x > W - r.width || r.y > H - r.height)
-        return fail(c, PRAY_ERR_ARG, "pray_render_into: the rectangle of %d x %d pixels at (%d, %d) is not inside the "
-                    "image of %d x %d", r.width, r.height, r.x, r.y, W, H);
-    pray_buffers b = *out;
-    if (b.stride == 0) b.stride = (size_t)r.width;
-    if (b.stride < (size_t)r.width)
-        return fail(c, PRAY_ERR_ARG, "pray_render_into: the stride %lu is less than the rectangle's width %d",
-                    (unsigned long)b.stride, r.width);
-    if (b.stride > (size_t)-1 / 3 / (size_t)r.height)
-        return fail(c, PRAY_ERR_ARG, "pray_render_into: the stride %lu is too large", (unsigned long)b.stride);
+    pray_rect r;
+    pray_buffers b;
+    if (render_target(c, "pray_render_into", opt_int(c, OPT_WIDTH), opt_int(c, OPT_HEIGHT), rect, out, &r, &b))
+        return c->status;
     return render_into(c, root, lights, r, b);
 }
 
@@ -10548,24 +10561,64 @@ void pray_stats_get(const pray_ctx *c, pray_stats *out) {
 
 struct pray_scene {
     Scene s;
-    Scratch w;
+    Scratch w;    // pray_intersect's
+    int render;   // prepared for rendering (pray_prepare_render)
 };
 
-// pray_prepare's work, between call_enter and call_leave
-static pray_scene *prepare_call(pray_ctx *c, pray_object *root) {
+// pray_prepare's and pray_prepare_render's work, between call_enter and call_leave
+static pray_scene *prepare_call(pray_ctx *c, pray_object *root, pray_light *lights, bool render) {
     pray_scene *q = (pray_scene *)mem_zalloc(c, sizeof(pray_scene));
     if (!q) return NULL;
-    if (scene_build(c, &q->s, root, NULL, false) || !scratch_init(c, &q->w, &q->s)) {
+    q->render = render;
+    if (scene_build(c, &q->s, root, lights, render) || !scratch_init(c, &q->w, &q->s)) {
         pray_scene_free(c, q);
         return NULL;
     }
     return q;
 }
 
+pray_scene *pray_prepare_render(pray_ctx *c, pray_object *root, pray_light *lights) {
+    if (!c || !scene_ok(c, root, lights, "pray_prepare_render") || image_limits(c)) return NULL;
+    call_enter(c);
+    pray_scene *r = prepare_call(c, root, lights, true);
+    call_leave(c);
+    return r;
+}
+
+// pray_render_prepared's work, between call_enter and call_leave
+static pray_status render_prepared_call(pray_ctx *c, const pray_scene *q, const pray_rect *rect,
+                                        const pray_buffers *out) {
+    if (!q) return c->status != PRAY_OK ? c->status : fail(c, PRAY_ERR_ARG, "pray_render_prepared: no scene");
+    if (!q->render)
+        return fail(c, PRAY_ERR_ARG, "pray_render_prepared: the scene was prepared for ray queries (pray_prepare)");
+    if (!out || (!out->rgb && !out->primitive && !out->depth && !out->normal))
+        return fail(c, PRAY_ERR_ARG, "pray_render_prepared: no buffers");
+    pray_rect r;
+    pray_buffers b;
+    if (render_target(c, "pray_render_prepared", q->s.width, q->s.height, rect, out, &r, &b)) return c->status;
+    double t0 = clock_seconds();
+    CohPlan none;
+    memset(&none, 0, sizeof none);
+    c->stats.primitives = q->s.prims.n;
+    c->stats.nodes = q->s.nodes.n;
+    pray_status st = render_scene(c, &q->s, r, b, &none);
+    c->stats.time_render += clock_seconds() - t0;
+    return st;
+}
+
+pray_status pray_render_prepared(pray_ctx *c, const pray_scene *scene, const pray_rect *rect,
+                                 const pray_buffers *out) {
+    if (!c) return PRAY_ERR_ARG;
+    call_enter(c);
+    pray_status r = render_prepared_call(c, scene, rect, out);
+    call_leave(c);
+    return r;
+}
+
 pray_scene *pray_prepare(pray_ctx *c, pray_object *root) {
     if (!c || !object_ok(c, root, "pray_prepare")) return NULL;
     call_enter(c);
-    pray_scene *r = prepare_call(c, root);
+    pray_scene *r = prepare_call(c, root, NULL, false);
     call_leave(c);
     return r;
 }
@@ -13555,9 +13608,10 @@ static pray_status run_string_call(pray_ctx *c, const char *name, const char *te
     c->run_dir_len = 0;
     for (size_t i = 0; nm[i]; i++)
         if (nm[i] == '/' || nm[i] == '\\' || nm[i] == ':') c->run_dir_len = i + 1;
-    prepared_drop(c);  // (a run prepares its own frames)
+    prepared_drop(c);  // (a run prepares its own frames, kept only for a render function's parts)
     c->running = 1;
     pray_status st = run_program(c, nm, text, len);
+    prepared_drop(c);
     coh_release(c);
     c->running = 0;
     c->run_dir = NULL;

@@ -181,14 +181,15 @@ void pray_set_frame(pray_ctx *ctx, pray_frame_fn fn, void *ud);
    signal handler that removes it before the program dies: reading it is async-signal-safe. */
 const char *pray_temp_file(const pray_ctx *ctx);
 /* Stop the call running on the context: pray_run_string, pray_run_file, pray_render,
-   pray_render_into, pray_prepare, pray_write_image, pray_write_image_note, pray_write_tiff,
-   pray_write_ppm or pray_write_png. Safe from any thread and from a signal handler: it only sets a flag. The call stops at its next check (each statement
+   pray_render_into, pray_prepare, pray_prepare_render, pray_render_prepared, pray_write_image,
+   pray_write_image_note, pray_write_tiff, pray_write_ppm or pray_write_png. Safe from any thread
+   and from a signal handler: it only sets a flag. The call stops at its next check (each statement
    of a program; each row of voxels while a scene is prepared; each row of an image rendered or
-   written) with PRAY_ERR_CANCELLED, "error: cancelled" (with the place in a program). It leaves
-   no file behind and no image; a byte sink has got part of one, to be thrown away. One of those
-   calls starting clears the flag: a cancel made when none runs, or just before one starts, is
-   forgotten. A host that must not lose one keeps its own flag too and checks it between calls.
-   Other functions ignore the flag. */
+   written) with PRAY_ERR_CANCELLED, "error: cancelled" (with the place in a program). It leaves no
+   file behind and no image; a byte sink has got part of one, to be thrown away. One of those calls
+   starting clears the flag: a cancel made when none runs, or just before one starts, is forgotten.
+   A host that must not lose one keeps its own flag too and checks it between calls. Other
+   functions ignore the flag. */
 void pray_cancel(pray_ctx *ctx);
 
 /* ---------------------------------------------------------------------------------------------
@@ -545,14 +546,31 @@ typedef struct pray_buffers {
    PRAY_ERR_ARG (no context or buffers, all buffers NULL, a rectangle not inside the image, a
    stride less than its width), and those of pray_render; on error the buffers hold partial
    results.
-   Prepared once, rendered many times: outside a program's run, the context keeps the scene
-   pray_render_into and pray_render prepared (flattened, simplified, with its grid), and the next
-   render of the same root and lights with the same options, camera and background uses it
-   again, so that bands, tiles and passes cost what the whole image costs. It holds a reference
-   to root and lights meanwhile (releasing yours is safe). Rendering another scene or lights,
-   changing an option, the camera or the background, running a program, or pray_free drops it. */
+   Prepared once, rendered many times: outside a program's run (and in a render function), the
+   context keeps the scene pray_render_into and pray_render prepared (flattened, simplified, with
+   its grid), and the next render of the same root and lights with the same options, camera and
+   background uses it again, so that bands, tiles and passes cost what the whole image costs. It
+   holds a reference to root and lights meanwhile (releasing yours is safe). Rendering another
+   scene or lights, changing an option, the camera or the background, the start or the end of a
+   program's run, or pray_free drops it. To render one scene from several threads at once, see
+   pray_prepare_render. */
 pray_status pray_render_into(pray_ctx *ctx, pray_object *root, pray_light *lights, const pray_rect *rect,
                              const pray_buffers *out);
+/* A scene prepared for rendering, with the context's options, camera and background as they are
+   now, as pray_render_into prepares it; NULL on error (those of pray_render_into). pray_intersect
+   takes it too. It belongs to the context (pray_scene_free, pray_free), which must outlive every
+   render of it; it keeps no reference to root or lights. */
+pray_scene *pray_prepare_render(pray_ctx *ctx, pray_object *root, pray_light *lights);
+/* Render rectangle `rect` (NULL: the whole image) of a scene from pray_prepare_render into the
+   caller's buffers, as pray_render_into would with the options, camera and background the scene
+   was prepared with (this context's option threads excepted): the same bits. The scene is only
+   read, and may belong to another context: several contexts, each on a thread of its own, may
+   render one scene at once, with no preparing again and no locks. This context gives the memory
+   of the render, its statistics, progress and cancelling. Errors: PRAY_ERR_ARG (no scene, one
+   prepared by pray_prepare, buffers or a rectangle as for pray_render_into); those of
+   pray_render. */
+pray_status pray_render_prepared(pray_ctx *ctx, const pray_scene *scene, const pray_rect *rect,
+                                 const pray_buffers *out);
 /* The primary ray through image point (px, py), in pixels from the image's top left corner
    (a pixel's centre is at x + 0.5, y + 0.5), for the context's camera and width and height
    options: *origin (the eye; for a parallel camera the point on the image plane) and *dir (a

@@ -10,15 +10,16 @@ Right: the speed-up on P processes that the cost model of docs/distributed.md gi
 
     T(P) = T_run + T_prepare * b + T_render / P + T_gather + T_write
 
-with T_run and T_prepare from the table's `pray --stats` line, T_render the rest of the time
-of one thread, b = 5 bands per process (what pray-mpi hands a worker), the gather of 12 bytes a
-pixel over 10 Gbit/s without overlap and one writer at 500 MB/s (8-bit TIFF, 3 bytes a pixel),
-for the image measured and for the same scene 16 times wider and higher. Needs matplotlib.
+with T_run and T_prepare from the table's `pray --stats` line, T_render the rest of the time of
+one thread, b = 1 preparation per process (a pray-mpi worker's bands of a frame share one), the
+gather of 12 bytes a pixel over 10 Gbit/s without overlap and one writer at 500 MB/s (8-bit
+TIFF, 3 bytes a pixel), for the image measured and for the same scene 16 times wider and higher.
+Needs matplotlib.
 """
 import re
 import sys
 
-BANDS = 5            # bands a pray-mpi worker renders per image (docs/distributed.md)
+BANDS = 1            # preparations per process and image: a pray-mpi worker's bands share one
 NET = 10e9 / 8       # bytes a second into rank 0
 DISK = 500e6         # bytes a second written by the one writer
 

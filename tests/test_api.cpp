@@ -914,3 +914,62 @@ TEST_CASE("api: pray_render_into reuses the scene it prepared only for the same 
     pray_light_release(c, l);
     pray_free(c);
 }
+
+TEST_CASE("api: a scene prepared for rendering is rendered by other contexts on their threads, to the same bits") {
+    pray_ctx *c = pray_new();
+    settings_of(c, 4);
+    pray_option(c, "antialias", 2);
+    pray_option(c, "adaptive", 0.05);  // (undersampling: bands of tiles, from the scene's options)
+    pray_object *o = scene_of(c, 0);
+    pray_light *l = light_of(c, 1);
+    std::vector<float> whole = render_rect(c, o, l, 1);
+    pray_scene *q = pray_prepare_render(c, o, l);
+    REQUIRE(q);
+    pray_object_release(c, o);  // (the scene needs neither)
+    pray_light_release(c, l);
+    // four contexts at once, with other options of their own: the scene's are those it was made with
+    std::vector<float> bands(whole.size());
+    std::vector<std::thread> threads;
+    std::atomic<int> failed(0);
+    for (int k = 0; k < 4; k++)
+        threads.emplace_back([&, k] {
+            pray_ctx *d = pray_new();
+            pray_option(d, "width", 8);
+            pray_option(d, "antialias", 1);
+            pray_option(d, "threads", 1 + k % 2);
+            pray_rect r = {0, 30 * k / 4, 40, 30 * (k + 1) / 4 - 30 * k / 4};
+            pray_buffers out = {bands.data() + (size_t)3 * 40 * r.y, nullptr, nullptr, nullptr, 40};
+            if (pray_render_prepared(d, q, &r, &out) != PRAY_OK) failed++;
+            pray_free(d);
+        });
+    for (auto &t : threads) t.join();
+    CHECK(failed == 0);
+    CHECK(bands == whole);
+    // its own context queries it as any prepared scene
+    pray_hit h;
+    pray_vec from = {3, -2, 1}, towards = {-3, 2, -1};
+    CHECK(pray_intersect(c, q, from, towards, HUGE_VAL, &h, 1) >= 1);
+    // what it refuses
+    pray_ctx *d = pray_new();
+    pray_buffers none = {nullptr, nullptr, nullptr, nullptr, 0}, one = {bands.data(), nullptr, nullptr, nullptr, 0};
+    pray_rect outside = {0, 20, 40, 11};
+    CHECK(pray_render_prepared(d, nullptr, nullptr, &one) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(d)) == "error: pray_render_prepared: no scene");
+    pray_clear_error(d);
+    CHECK(pray_render_prepared(d, q, nullptr, &none) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(d)) == "error: pray_render_prepared: no buffers");
+    pray_clear_error(d);
+    CHECK(pray_render_prepared(d, q, &outside, &one) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(d)) == "error: pray_render_prepared: the rectangle of 40 x 11 pixels at (0, 20) is "
+                                        "not inside the image of 40 x 30");
+    pray_clear_error(d);
+    pray_object *b = ball(c);
+    pray_scene *queries = pray_prepare(c, b);
+    CHECK(pray_render_prepared(d, queries, nullptr, &one) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(d)) == "error: pray_render_prepared: the scene was prepared for ray queries (pray_prepare)");
+    CHECK(pray_render_prepared(nullptr, q, nullptr, &one) == PRAY_ERR_ARG);
+    CHECK(pray_prepare_render(c, nullptr, nullptr) == nullptr);
+    pray_free(d);
+    pray_object_release(c, b);
+    pray_free(c);
+}
