@@ -119,6 +119,11 @@
 // context writing the PNG (section 11: png_alloc); an allocation it cannot have ends the encoding
 // there, so its own checks (asserts) are not needed.
 #define PRAY_HAS_PNG 0
+#ifdef PRAY_NO_PNG
+#define PNG_MISSING "it was built with PRAY_NO_PNG"
+#else  // (why a build has no PNG, for the messages)
+#define PNG_MISSING "<stb/stb_image_write.h> was not found when it was built (Debian: libstb-dev)"
+#endif
 #if !defined(PRAY_NO_PNG) && defined(__has_include)
 #if __has_include(<stb/stb_image_write.h>)
 #undef PRAY_HAS_PNG
@@ -9628,7 +9633,9 @@ pray_status pray_option_string(pray_ctx *c, const char *name, const char *value)
     if (strlen(value) >= sizeof c->cur.opt.output)
         return fail(c, PRAY_ERR_ARG, "option 'output': file name too long");
     int fmt = image_format(value);
-    if (fmt == FMT_NONE || (fmt == FMT_PNG && !PRAY_HAS_PNG))
+    if (fmt == FMT_PNG && !PRAY_HAS_PNG)
+        return fail(c, PRAY_ERR_ARG, "option 'output': '%s': this pray writes no PNG: " PNG_MISSING "; use .tif or .ppm", value);
+    if (fmt == FMT_NONE)
         return fail(c, PRAY_ERR_ARG, "option 'output': cannot tell the image format of '%s' (use .tif, .ppm%s)", value,
                     PRAY_HAS_PNG ? " or .png" : "");
     if (c->untrusted && c->running && (untrusted_path_problem(value) || strchr(value, '/') || strchr(value, '\\')))
@@ -10735,7 +10742,7 @@ static pray_status write_png_call(pray_ctx *c, const pray_image *img, pray_write
 #else
     (void)fn;
     (void)ud;
-    return fail(c, PRAY_ERR_ARG, "this build cannot write PNG");
+    return fail(c, PRAY_ERR_ARG, "pray_write_png: this pray writes no PNG: " PNG_MISSING);
 #endif
 }
 
@@ -10754,7 +10761,9 @@ pray_status write_image_file(pray_ctx *c, const pray_image *img, const char *pat
     if (!path || !*path) return fail(c, PRAY_ERR_ARG, "no file name");
     if (bits != 8 && bits != 16) return fail(c, PRAY_ERR_ARG, "bits must be 8 or 16");
     int fmt = image_format(path);
-    if (fmt == FMT_NONE || (fmt == FMT_PNG && !PRAY_HAS_PNG))
+    if (fmt == FMT_PNG && !PRAY_HAS_PNG)
+        return fail(c, PRAY_ERR_ARG, "'%s': this pray writes no PNG: " PNG_MISSING "; use .tif or .ppm", path);
+    if (fmt == FMT_NONE)
         return fail(c, PRAY_ERR_ARG, "cannot tell the image format of '%s' (use .tif, .ppm%s)", path,
                     PRAY_HAS_PNG ? " or .png" : "");
     if (fmt == FMT_PNG && bits != 8) return fail(c, PRAY_ERR_ARG, "PNG output has 8 bits only");

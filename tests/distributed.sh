@@ -140,6 +140,15 @@ if PRAY=$PRAY sh tools/pray-slurm.sh examples/room.ray "$d/room.ppm" >/dev/null 
 else
     bad "Slurm script: rows"
 fi
+for k in 0 1 2 3 4; do  # (an array counted from 0)
+    SLURM_ARRAY_TASK_ID=$k SLURM_ARRAY_TASK_MIN=0 SLURM_ARRAY_TASK_COUNT=5 PRAY=$PRAY sh tools/pray-slurm.sh \
+        examples/room.ray "$d/zero.ppm" -s 128x96 -D adaptive=0.1 >/dev/null 2>&1
+done
+if PRAY=$PRAY sh tools/pray-slurm.sh examples/room.ray "$d/zero.ppm" >/dev/null && cmp -s "$d/whole.ppm" "$d/zero.ppm"; then
+    ok
+else
+    bad "Slurm script: rows of an array counted from 0"
+fi
 mkdir -p "$d/seq"
 for k in 0 1 2; do
     SLURM_ARRAY_TASK_ID=$k SPLIT=frames PRAY=$PRAY sh tools/pray-slurm.sh examples/anim.ray "$d/seq/x.tif" $OPTS >/dev/null 2>&1

@@ -81,6 +81,16 @@ for d in '' -DPRAY_NO_BUFFERS -DPRAY_NO_SEQUENCES; do
     printf '%-8s %-12s %-52s %s\n' "$cxx" "-std=c++98" "$d: csg.ray, anim.ray" "renders the same bytes: $r"
     [ "$r" = ok ] || st=1
 done
+# A build without PNG says why when asked for one.
+if $cxx -std=c++98 $OPT -DPRAY_NO_PNG -DPRAY_MAIN pray.cpp -o "$tmp/nopng" -lm -lpthread; then
+    msg=$("$tmp/nopng" -q -o "$tmp/x.png" examples/csg.ray 2>&1)
+    want="pray: error: option 'output': '$tmp/x.png': this pray writes no PNG: it was built with PRAY_NO_PNG; use .tif or .ppm"
+    if [ "$msg" = "$want" ] && [ ! -e "$tmp/x.png" ]; then r=ok; else r="FAILED ($msg)"; st=1; fi
+else
+    r=FAILED
+    st=1
+fi
+printf '%-8s %-12s %-52s %s\n' "$cxx" "-std=c++98" "-DPRAY_NO_PNG: -o x.png" "says why: $r"
 rm -rf "$tmp"
 [ $st = 0 ] && echo "matrix: all $n compiled without a warning" || echo "matrix: FAILED"
 exit $st

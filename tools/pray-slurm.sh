@@ -10,7 +10,8 @@
 #
 # Arguments: the program, the output file, then any options of pray (the same in every task).
 # An array task (SLURM_ARRAY_TASK_ID set) renders its part:
-#   SPLIT=rows (default): band K of N, K = SLURM_ARRAY_TASK_ID (from 1), N = PARTS or
+#   SPLIT=rows (default): band K of N, K = SLURM_ARRAY_TASK_ID counted from the array's first
+#     index (SLURM_ARRAY_TASK_MIN: --array=1-16 and --array=0-15 alike), N = PARTS or
 #     SLURM_ARRAY_TASK_COUNT; written to OUT.parts/partK.tif (.ppm when OUT is a .ppm);
 #   SPLIT=frames: frame K of the program (from 0), written where pray writes it.
 # Without SLURM_ARRAY_TASK_ID (the second job) it joins OUT.parts/* into OUT and removes them;
@@ -44,6 +45,7 @@ if [ -n "${SLURM_ARRAY_TASK_ID:-}" ]; then
     if [ "${SPLIT:-rows}" = frames ]; then
         exec "$PRAY" --quiet --threads "${SLURM_CPUS_PER_TASK:-0}" --frames "$k:$((k + 1))" -o "$out" "$@" "$prog"
     fi
+    k=$((k - ${SLURM_ARRAY_TASK_MIN:-1} + 1))
     n=${PARTS:-${SLURM_ARRAY_TASK_COUNT:-}}
     if [ -z "$n" ]; then
         echo "pray-slurm.sh: set PARTS to the number of bands (Slurm sets SLURM_ARRAY_TASK_COUNT)" >&2
