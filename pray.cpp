@@ -10483,7 +10483,7 @@ static pray_status render_call(pray_ctx *c, pray_object *root, pray_light *light
     int W = opt_int(c, OPT_WIDTH), H = opt_int(c, OPT_HEIGHT);
     pray_rect r = {0, 0, W, H};
     pray_buffers b = {NULL, NULL, NULL, NULL, (size_t)W};
-    b.rgb = (float *)mem_zalloc(c, sizeof(float) * 3 * (size_t)W * (size_t)H);
+    b.rgb = (float *)mem_alloc(c, sizeof(float) * 3 * (size_t)W * (size_t)H);  // (every pixel is written)
     if (!b.rgb) return c->status;
     out->pixels = b.rgb;
     out->width = W;
