@@ -566,6 +566,8 @@ struct pray_ctx {
     Block blocks;  // sentinel of the list of live blocks
     pray_status status;
     char msg[1024];
+    int err_line, err_col;   // where in a program the last error is (0: nowhere), and in which file:
+    char err_name[256];      // (pray_error_place)
     pray_write_fn print_fn;
     void *print_ud;
     int print_set;
@@ -628,6 +630,7 @@ pray_status fail(pray_ctx *c, pray_status s, const char *fmt, ...) {
     vsnprintf(tmp, sizeof tmp, fmt, ap);
     va_end(ap);
     c->status = s;
+    c->err_line = c->err_col = 0;
     snprintf(c->msg, sizeof c->msg, "error: %s", tmp);
     return s;
 }
@@ -9536,6 +9539,13 @@ void pray_clear_error(pray_ctx *c) {
     if (!c) return;
     c->status = PRAY_OK;
     c->msg[0] = 0;
+    c->err_line = c->err_col = 0;
+}
+const char *pray_error_place(const pray_ctx *c, int *line, int *col) {
+    bool at = c && c->status != PRAY_OK && c->err_line > 0;
+    if (line) *line = at ? c->err_line : 0;
+    if (col) *col = at ? c->err_col : 0;
+    return at ? c->err_name : NULL;
 }
 void pray_set_memory_limit(pray_ctx *c, size_t bytes) {
     if (!c) return;
@@ -10565,6 +10575,9 @@ void pray_stats_get(const pray_ctx *c, pray_stats *out) {
     if (c) *out = c->stats;
     else memset(out, 0, sizeof *out);
 }
+void pray_stats_reset(pray_ctx *c) {
+    if (c) memset(&c->stats, 0, sizeof c->stats);
+}
 
 struct pray_scene {
     Scene s;
@@ -10698,60 +10711,34 @@ void pray_image_free(pray_ctx *c, pray_image *img) {
     img->width = img->height = 0;
 }
 
-// pray_write_tiff's work, between call_enter and call_leave
-static pray_status write_tiff_call(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
-    if (!image_ok(c, img)) return c->status;
-    if (!fn) return fail(c, PRAY_ERR_ARG, "pray_write_tiff: no write function");
-    if (bits != 8 && bits != 16) return fail(c, PRAY_ERR_ARG, "bits must be 8 or 16");
-    Sink s = {fn, ud};
-    return write_tiff(c, img, bits, s);
-}
-
-pray_status pray_write_tiff(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
+// pray_write_tiff, pray_write_ppm and pray_write_png (fmt): an image into a byte sink.
+static pray_status write_sink(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud, int fmt) {
     if (!c) return PRAY_ERR_ARG;
+    const char *name = fmt == FMT_TIFF ? "pray_write_tiff" : fmt == FMT_PPM ? "pray_write_ppm" : "pray_write_png";
+    Sink sink = {fn, ud};
+    pray_status st;
     call_enter(c);
-    pray_status r = write_tiff_call(c, img, bits, fn, ud);
-    call_leave(c);
-    return r;
-}
-
-// pray_write_ppm's work, between call_enter and call_leave
-static pray_status write_ppm_call(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
-    if (!image_ok(c, img)) return c->status;
-    if (!fn) return fail(c, PRAY_ERR_ARG, "pray_write_ppm: no write function");
-    if (bits != 8 && bits != 16) return fail(c, PRAY_ERR_ARG, "bits must be 8 or 16");
-    Sink s = {fn, ud};
-    return write_ppm(c, img, bits, s);
-}
-
-pray_status pray_write_ppm(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
-    if (!c) return PRAY_ERR_ARG;
-    call_enter(c);
-    pray_status r = write_ppm_call(c, img, bits, fn, ud);
-    call_leave(c);
-    return r;
-}
-
-// pray_write_png's work, between call_enter and call_leave
-static pray_status write_png_call(pray_ctx *c, const pray_image *img, pray_write_fn fn, void *ud) {
-    if (!image_ok(c, img)) return c->status;
-    if (!fn) return fail(c, PRAY_ERR_ARG, "pray_write_png: no write function");
+    if (!image_ok(c, img)) st = c->status;
+    else if (!fn) st = fail(c, PRAY_ERR_ARG, "%s: no write function", name);
+    else if (bits != 8 && bits != 16) st = fail(c, PRAY_ERR_ARG, "bits must be 8 or 16");
+    else if (fmt == FMT_TIFF) st = write_tiff(c, img, bits, sink);
+    else if (fmt == FMT_PPM) st = write_ppm(c, img, bits, sink);
 #if PRAY_HAS_PNG
-    Sink s = {fn, ud};
-    return write_png(c, img, s);
+    else st = write_png(c, img, sink);
 #else
-    (void)fn;
-    (void)ud;
-    return fail(c, PRAY_ERR_ARG, "pray_write_png: this pray writes no PNG: " PNG_MISSING);
+    else st = fail(c, PRAY_ERR_ARG, "pray_write_png: this pray writes no PNG: " PNG_MISSING);
 #endif
-}
-
-pray_status pray_write_png(pray_ctx *c, const pray_image *img, pray_write_fn fn, void *ud) {
-    if (!c) return PRAY_ERR_ARG;
-    call_enter(c);
-    pray_status r = write_png_call(c, img, fn, ud);
     call_leave(c);
-    return r;
+    return st;
+}
+pray_status pray_write_tiff(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
+    return write_sink(c, img, bits, fn, ud, FMT_TIFF);
+}
+pray_status pray_write_ppm(pray_ctx *c, const pray_image *img, int bits, pray_write_fn fn, void *ud) {
+    return write_sink(c, img, bits, fn, ud, FMT_PPM);
+}
+pray_status pray_write_png(pray_ctx *c, const pray_image *img, pray_write_fn fn, void *ud) {
+    return write_sink(c, img, 8, fn, ud, FMT_PNG);
 }
 
 namespace {
@@ -10818,33 +10805,34 @@ pray_status write_image_file(pray_ctx *c, const pray_image *img, const char *pat
 }
 } // namespace
 
-// pray_write_image's work, between call_enter and call_leave
-static pray_status write_image_call(pray_ctx *c, const pray_image *img, const char *path, int bits) {
-    return write_image_file(c, img, path, bits, NULL);
+// pray_write_image (note NULL, `noted` false) and pray_write_image_note.
+static pray_status write_file(pray_ctx *c, const pray_image *img, const char *path, int bits, const char *note,
+                              bool noted) {
+    if (!c) return PRAY_ERR_ARG;
+    call_enter(c);
+    pray_status r = noted && !note ? fail(c, PRAY_ERR_ARG, "pray_write_image_note: no note")
+                                   : write_image_file(c, img, path, bits, note);
+    call_leave(c);
+    return r;
 }
-
 pray_status pray_write_image(pray_ctx *c, const pray_image *img, const char *path, int bits) {
-    if (!c) return PRAY_ERR_ARG;
-    call_enter(c);
-    pray_status r = write_image_call(c, img, path, bits);
-    call_leave(c);
-    return r;
+    return write_file(c, img, path, bits, NULL, false);
+}
+pray_status pray_write_image_note(pray_ctx *c, const pray_image *img, const char *path, int bits, const char *note) {
+    return write_file(c, img, path, bits, note, true);
 }
 
-// pray_write_image_note's work, between call_enter and call_leave
-static pray_status write_image_note_call(pray_ctx *c, const pray_image *img, const char *path, int bits,
-                                         const char *note) {
-    if (!note) return fail(c, PRAY_ERR_ARG, "pray_write_image_note: no note");
-    return write_image_file(c, img, path, bits, note);
-}
-
-pray_status pray_write_image_note(pray_ctx *c, const pray_image *img, const char *path, int bits,
-                                  const char *note) {
+pray_status pray_image_bytes(pray_ctx *c, const pray_image *img, int channels, unsigned char *out) {
     if (!c) return PRAY_ERR_ARG;
-    call_enter(c);
-    pray_status r = write_image_note_call(c, img, path, bits, note);
-    call_leave(c);
-    return r;
+    if (!image_ok(c, img)) return c->status;
+    if ((channels != 3 && channels != 4) || !out)
+        return fail(c, PRAY_ERR_ARG, "pray_image_bytes: %s", out ? "channels must be 3 or 4" : "no buffer");
+    size_t n = (size_t)img->width * (size_t)img->height;
+    for (size_t i = 0; i < n; i++, out += channels) {
+        for (int k = 0; k < 3; k++) out[k] = (unsigned char)quantize(img->pixels[3 * i + k], 255);
+        if (channels == 4) out[3] = 255;
+    }
+    return PRAY_OK;
 }
 
 pray_status pray_image_new(pray_ctx *c, int width, int height, pray_image *out) {
@@ -10964,6 +10952,9 @@ pray_status perr(pray_ctx *c, const char *name, int line, int col, pray_status s
     va_end(ap);
     c->status = s;
     snprintf(c->msg, sizeof c->msg, "%s:%d:%d: error: %s", *ShownPath(name), line, col, tmp);
+    snprintf(c->err_name, sizeof c->err_name, "%s", *ShownPath(name));
+    c->err_line = line;
+    c->err_col = col;
     return s;
 }
 

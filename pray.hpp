@@ -145,6 +145,10 @@ void pray_free(pray_ctx *ctx);
 /* The last error: "name:line:col: error: message" for program errors, "error: message" else.
    "" when there was none. Valid until the next call on the context. */
 const char *pray_error(const pray_ctx *ctx);
+/* Where in a program the last error is, as numbers: the name as the message shows it (valid
+   until the next call on the context), *line and *col from 1. NULL, 0 and 0 when the last error
+   has no place in a program (or there is none). line and col may be NULL. */
+const char *pray_error_place(const pray_ctx *ctx, int *line, int *col);
 /* The status of the last failing call (PRAY_OK if none failed since pray_clear_error). */
 pray_status pray_last_status(const pray_ctx *ctx);
 /* Forget the last error: status PRAY_OK, message "". */
@@ -419,6 +423,9 @@ typedef struct pray_stats {
 pray_status pray_render(pray_ctx *ctx, pray_object *root, pray_light *lights, pray_image *out);
 /* The statistics (all zero for a NULL context; nothing for a NULL out). */
 void pray_stats_get(const pray_ctx *ctx, pray_stats *out);
+/* Set every statistic to zero, so that the next pray_stats_get counts from here (a program's run
+   starts its own totals without it). */
+void pray_stats_reset(pray_ctx *ctx);
 
 /* Ray queries, for picking and for checking the renderer: prepare a solid once with the
    context's options (grid, freeze, merge, bounds, brute), then ask for the surfaces a ray
@@ -489,6 +496,11 @@ pray_status pray_write_image_note(pray_ctx *ctx, const pray_image *img, const ch
    PRAY_ERR_ARG for a size pray cannot render (sides 1 to 65536, at most 2^28 pixels);
    PRAY_ERR_NOMEM over the context's memory cap. */
 pray_status pray_image_new(pray_ctx *ctx, int width, int height, pray_image *out);
+/* The image as 8-bit samples into the caller's buffer, rows from the top, `channels` bytes a
+   pixel: 3 (R, G, B) or 4 (R, G, B and 255): exactly the samples an 8-bit file of it holds
+   (pray_write_image: PPM, TIFF and PNG alike). out must hold width x height x channels bytes.
+   PRAY_ERR_ARG for an image that is not valid, channels not 3 or 4, or a NULL out. */
+pray_status pray_image_bytes(pray_ctx *ctx, const pray_image *img, int channels, unsigned char *out);
 /* Record an error as pray's own calls do: status `status`, message "error: " + message (NULL:
    the status's text); returns status. For callbacks (render, frame) that fail with a message of
    their own. PRAY_OK clears the error (pray_clear_error); any other int that is not one of the

@@ -973,3 +973,87 @@ TEST_CASE("api: a scene prepared for rendering is rendered by other contexts on 
     pray_object_release(c, b);
     pray_free(c);
 }
+
+TEST_CASE("api: an image as 8-bit samples in the host's buffer holds the bytes of its 8-bit file") {
+    pray_ctx *c = pray_new();
+    pray_image img;
+    REQUIRE(pray_image_new(c, 7, 5, &img) == PRAY_OK);
+    for (int i = 0; i < 7 * 5 * 3; i++) img.pixels[i] = (float)((i * 37) % 101) / 97.0f - 0.02f;  // (below 0, over 1)
+    img.pixels[4] = 0.5f / 255;  // (a sample halfway between two steps)
+    std::string ppm;
+    pray_write_fn sink = [](void *ud, const void *p, size_t n) { static_cast<std::string *>(ud)->append((const char *)p, n); };
+    REQUIRE(pray_write_ppm(c, &img, 8, sink, &ppm) == PRAY_OK);
+    std::vector<unsigned char> rgb(7 * 5 * 3), rgba(7 * 5 * 4);
+    REQUIRE(pray_image_bytes(c, &img, 3, rgb.data()) == PRAY_OK);
+    REQUIRE(pray_image_bytes(c, &img, 4, rgba.data()) == PRAY_OK);
+    const std::string head = "P6\n7 5\n255\n";
+    REQUIRE(ppm.size() == head.size() + rgb.size());
+    CHECK(std::string(rgb.begin(), rgb.end()) == ppm.substr(head.size()));
+    for (int i = 0; i < 7 * 5; i++) {
+        CHECK(rgba[4 * i + 3] == 255);
+        for (int k = 0; k < 3; k++) CHECK(rgba[4 * i + k] == rgb[3 * i + k]);
+    }
+    CHECK(rgb[0] == 0);  // (-0.02: black)
+    CHECK(rgb[4] == 1);
+    CHECK(pray_image_bytes(c, &img, 2, rgb.data()) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: pray_image_bytes: channels must be 3 or 4");
+    CHECK(pray_image_bytes(c, &img, 3, nullptr) == PRAY_ERR_ARG);
+    CHECK(pray_image_bytes(c, nullptr, 3, rgb.data()) == PRAY_ERR_ARG);
+    CHECK(pray_image_bytes(nullptr, &img, 3, rgb.data()) == PRAY_ERR_ARG);
+    pray_image_free(c, &img);
+    pray_free(c);
+}
+
+TEST_CASE("api: the place of a program's error as numbers, and statistics counted again from zero") {
+    pray_ctx *c = pray_new();
+    int line = -1, col = -1;
+    CHECK(pray_error_place(c, &line, &col) == nullptr);
+    CHECK(line == 0);
+    CHECK(col == 0);
+    const char *prog = "A = 1\nB = 2\nC = A +  nothing_here\n";
+    REQUIRE(pray_run_string(c, "p.ray", prog, strlen(prog)) != PRAY_OK);
+    const char *name = pray_error_place(c, &line, &col);
+    REQUIRE(name);
+    CHECK(std::string(name) == "p.ray");
+    CHECK(line == 3);
+    CHECK(col == 10);
+    CHECK(std::string(pray_error(c)).compare(0, 12, "p.ray:3:10: ") == 0);
+    CHECK(pray_error_place(c, nullptr, nullptr) == std::string("p.ray"));
+    // an error with no place in a program, and none at all
+    pray_clear_error(c);
+    CHECK(pray_sphere(c, nullptr, ORIGIN, 1) == nullptr);
+    CHECK(pray_error_place(c, &line, &col) == nullptr);
+    CHECK(line == 0);
+    pray_clear_error(c);
+    REQUIRE(pray_run_string(c, "q.ray", "X = 1 +\n", 8) != PRAY_OK);
+    CHECK(pray_error_place(c, &line, &col) != nullptr);
+    pray_clear_error(c);
+    CHECK(pray_error_place(c, &line, &col) == nullptr);
+    // statistics: a render's, then zero, then the next render's alone (as a fresh context's)
+    pray_option(c, "width", 16);
+    pray_option(c, "height", 16);
+    pray_object *o = ball(c);
+    pray_light *l = pray_dirlight(c, WHITE, ONE);
+    pray_image img;
+    REQUIRE(pray_render(c, o, l, &img) == PRAY_OK);
+    pray_image_free(c, &img);
+    pray_stats s;
+    pray_stats_get(c, &s);
+    CHECK(s.rays_primary == 256);
+    pray_stats_reset(c);
+    pray_stats_get(c, &s);
+    CHECK(s.rays_primary == 0);
+    CHECK(s.primitives == 0);
+    CHECK(s.time_render == 0);
+    REQUIRE(pray_render(c, o, l, &img) == PRAY_OK);
+    pray_image_free(c, &img);
+    pray_stats_get(c, &s);
+    CHECK(s.rays_primary == 256);
+    CHECK(s.rays_shadow > 0);
+    pray_stats_reset(nullptr);
+    CHECK(pray_error_place(nullptr, &line, &col) == nullptr);
+    CHECK(pray_prepare_render(nullptr, o, l) == nullptr);
+    pray_object_release(c, o);
+    pray_light_release(c, l);
+    pray_free(c);
+}
