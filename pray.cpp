@@ -18,7 +18,7 @@
                           [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas
                           and jumps, [9b.4] light and eye buffers, [9b.5] accel_build; per ray: [9b.6]
                           list evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver
-   [SECTION] 9c    900  Reading files (programs, textures, fonts), TIFF reader and textures, the
+   [SECTION] 9c    950  Reading files (programs, textures, fonts), TIFF reader and textures, the
                           built-in font
    [SECTION] 10   1200  Whitted shading, textured surfaces, the render driver (threads, undersampling)
    [SECTION] 10b   600  Image sequences (3.7): the regions a ray crosses, comparing a frame's scene
@@ -28,8 +28,8 @@
    [SECTION] 13    800  PRAY parser
    [SECTION] 14   1500  PRAY interpreter: values, operators, builtins, statements
    [SECTION] 15    200  One-call helpers and the running of programs
-   [SECTION] 16    750  Command-line program (PRAY_MAIN)
-   The whole file: at most 14500 lines.
+   [SECTION] 16    800  Command-line program (PRAY_MAIN)
+   The whole file: at most 14600 lines.
 */
 
 // =============================================================================================
@@ -5019,6 +5019,88 @@ struct Footprint {
     }
 };
 
+// Each primitive's cells on face F (foot: the first and last along u, then v; none when first >
+// last) and its depths from the light (key: nearest and farthest), which decide its slabs. A
+// point light's primitives within r of it, and unbounded ones, reach every cell and depth; wid
+// widens the footprints (a point light's: eps, else the margin).
+void face_footprints(const LightBuf &B, const LightFace &F, const Box *eff, int np, real r, real wid, real *key,
+                     int *foot) {
+    for (int i = 0; i < np; i++) {
+        const Box &bx = eff[i];
+        int *ft = foot + 4 * i;
+        ft[0] = 0, ft[1] = F.n[0] - 1, ft[2] = 0, ft[3] = F.n[1] - 1;
+        key[2 * i] = -REAL_BIG;
+        key[2 * i + 1] = REAL_BIG;
+        if (box_empty(bx)) {
+            ft[0] = 1, ft[1] = 0;
+            continue;
+        }
+        if (!box_finite(bx)) continue;
+        if (B.point && box_dist2(bx, B.o) <= r * r) continue;
+        real lo[3], hi[3];
+        bool behind = face_extent(B, F, bx, lo, hi);
+        if (B.point && !(hi[2] > 0)) {  // behind the face: no zone reaches it
+            ft[0] = 1, ft[1] = 0;
+            continue;
+        }
+        key[2 * i + 1] = hi[2];
+        if (B.point && behind) continue;
+        key[2 * i] = lo[2];
+        for (int l = 0; l < 2; l++) {
+            double g0 = ((double)(lo[l] - wid) - (double)F.lo[l]) / (double)F.h[l];
+            double g1 = ((double)(hi[l] + wid) - (double)F.lo[l]) / (double)F.h[l];
+            ft[2 * l] = g0 < 0 ? 0 : g0 >= F.n[l] ? F.n[l] : (int)g0;
+            ft[2 * l + 1] = g1 < 0 ? -1 : g1 >= F.n[l] ? F.n[l] - 1 : (int)g1;
+        }
+    }
+}
+
+// Face F (number fi) of buffer B: its axes (across a directional light, towards it: `toward`),
+// the part of the grid's box it sees, and its cells and slabs of about `cell`; false when the box
+// is behind it.
+bool face_layout(LightBuf &B, LightFace &F, int fi, R3 toward, const Grid &g, real cell, real margin) {
+    if (!B.point) {
+        F.e[2] = toward;
+        real ax = (real)fabs((double)toward.x), ay = (real)fabs((double)toward.y), az = (real)fabs((double)toward.z);
+        R3 least = ax <= ay && ax <= az ? r3(1, 0, 0) : ay <= az ? r3(0, 1, 0) : r3(0, 0, 1);
+        F.e[0] = unit(cross(F.e[2], least));
+        F.e[1] = cross(F.e[2], F.e[0]);
+    } else point_face(fi, &F);
+    // the grid's box in the face's coordinates
+    Box grid;
+    for (int l = 0; l < 3; l++) grid.lo[l] = g.org[l], grid.hi[l] = g.top[l];
+    real lo[3], hi[3];
+    bool behind = face_extent(B, F, grid, lo, hi);
+    if (B.point) {
+        if (!(hi[2] > 0)) return false;  // the box is behind the face
+        if (behind) lo[0] = lo[1] = -1, hi[0] = hi[1] = 1, lo[2] = 0;
+        if (B.pieces) {  // the pieces hold the box whatever the rounding of a ray's depth
+            lo[2] = lo[2] - margin > 0 ? lo[2] - margin : 0;
+            hi[2] += margin;
+        }
+        for (int l = 0; l < 2; l++) {
+            lo[l] = lo[l] < -1 ? -1 : lo[l];
+            hi[l] = hi[l] > 1 ? 1 : hi[l];
+        }
+        real mid = (lo[2] + hi[2]) / 2;
+        F.h[0] = F.h[1] = cell / mid;
+        F.h[2] = cell;
+    } else {
+        for (int l = 0; l < 3; l++) lo[l] -= margin, hi[l] += margin;
+        F.h[0] = F.h[1] = F.h[2] = cell;
+        B.top = hi[2];
+    }
+    for (int l = 0; l < 3; l++) {
+        double n = ceil((double)(hi[l] - lo[l]) / (double)F.h[l]);
+        F.n[l] = n < 1 ? 1 : n > 256 ? 256 : (int)n;
+        F.h[l] = (hi[l] - lo[l]) / (real)F.n[l];
+        if (!(F.h[l] > 0)) F.h[l] = cell;
+        F.inv[l] = (real)1 / F.h[l];
+        F.lo[l] = lo[l];
+    }
+    return true;
+}
+
 // Build the light buffers: cells and slabs about `cell` wide where the grid's box is, and lists
 // for the space between each voxel and its light. `eff`: where
 // bounds place each primitive; `margin`: how far rounding may move a point (the grid's).
@@ -5053,46 +5135,7 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
         real eps = 0, r = 0;
         for (int fi = 0; fi < B.faces; fi++) {
             LightFace &F = B.f[fi];
-            if (!B.point) {
-                R3 toward = s->lights[li].v;
-                F.e[2] = toward;
-                real ax = (real)fabs((double)toward.x), ay = (real)fabs((double)toward.y), az = (real)fabs((double)toward.z);
-                R3 least = ax <= ay && ax <= az ? r3(1, 0, 0) : ay <= az ? r3(0, 1, 0) : r3(0, 0, 1);
-                F.e[0] = unit(cross(F.e[2], least));
-                F.e[1] = cross(F.e[2], F.e[0]);
-            } else point_face(fi, &F);
-            // the grid's box in the face's coordinates
-            Box grid;
-            for (int l = 0; l < 3; l++) grid.lo[l] = a->g.org[l], grid.hi[l] = a->g.top[l];
-            real lo[3], hi[3];
-            bool behind = face_extent(B, F, grid, lo, hi);
-            if (B.point) {
-                if (!(hi[2] > 0)) continue;  // the box is behind the face
-                if (behind) lo[0] = lo[1] = -1, hi[0] = hi[1] = 1, lo[2] = 0;
-                if (B.pieces) {  // the pieces hold the box whatever the rounding of a ray's depth
-                    lo[2] = lo[2] - margin > 0 ? lo[2] - margin : 0;
-                    hi[2] += margin;
-                }
-                for (int l = 0; l < 2; l++) {
-                    lo[l] = lo[l] < -1 ? -1 : lo[l];
-                    hi[l] = hi[l] > 1 ? 1 : hi[l];
-                }
-                real mid = (lo[2] + hi[2]) / 2;
-                F.h[0] = F.h[1] = cell / mid;
-                F.h[2] = cell;
-            } else {
-                for (int l = 0; l < 3; l++) lo[l] -= margin, hi[l] += margin;
-                F.h[0] = F.h[1] = F.h[2] = cell;
-                B.top = hi[2];
-            }
-            for (int l = 0; l < 3; l++) {
-                double n = ceil((double)(hi[l] - lo[l]) / (double)F.h[l]);
-                F.n[l] = n < 1 ? 1 : n > 256 ? 256 : (int)n;
-                F.h[l] = (hi[l] - lo[l]) / (real)F.n[l];
-                if (!(F.h[l] > 0)) F.h[l] = cell;
-                F.inv[l] = (real)1 / F.h[l];
-                F.lo[l] = lo[l];
-            }
+            if (!face_layout(B, F, fi, B.point ? r3(0, 0, 0) : s->lights[li].v, a->g, cell, margin)) continue;
             F.base = (int)total;
             total += (long)F.n[0] * F.n[1] * F.n[2];
             F.cbase = (int)cells;
@@ -5118,35 +5161,7 @@ bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool
             // each primitive's cells (its footprint) and its depths, which decide its slabs
             key.n = 2 * np;
             foot.n = 4 * np;
-            for (int i = 0; i < np; i++) {
-                const Box &bx = eff[i];
-                int *ft = foot.p + 4 * i;
-                ft[0] = 0, ft[1] = F.n[0] - 1, ft[2] = 0, ft[3] = F.n[1] - 1;
-                key[2 * i] = -REAL_BIG;
-                key[2 * i + 1] = REAL_BIG;
-                if (box_empty(bx)) {
-                    ft[0] = 1, ft[1] = 0;
-                    continue;
-                }
-                if (!box_finite(bx)) continue;
-                if (B.point && box_dist2(bx, B.o) <= r * r) continue;
-                real lo[3], hi[3];
-                bool behind = face_extent(B, F, bx, lo, hi);
-                if (B.point && !(hi[2] > 0)) {  // behind the face: no zone reaches it
-                    ft[0] = 1, ft[1] = 0;
-                    continue;
-                }
-                key[2 * i + 1] = hi[2];
-                if (B.point && behind) continue;
-                key[2 * i] = lo[2];
-                real wid = B.point ? eps : margin;
-                for (int l = 0; l < 2; l++) {
-                    double g0 = ((double)(lo[l] - wid) - (double)F.lo[l]) / (double)F.h[l];
-                    double g1 = ((double)(hi[l] + wid) - (double)F.lo[l]) / (double)F.h[l];
-                    ft[2 * l] = g0 < 0 ? 0 : g0 >= F.n[l] ? F.n[l] : (int)g0;
-                    ft[2 * l + 1] = g1 < 0 ? -1 : g1 >= F.n[l] ? F.n[l] - 1 : (int)g1;
-                }
-            }
+            face_footprints(B, F, eff, np, r, B.point ? eps : margin, key.p, foot.p);
             // candidates per cell
             int ncell = F.n[0] * F.n[1], dim[3] = {F.n[0], F.n[1], 1};
             ok = bucket(c, dim, np, Footprint(foot.p), cand, start);
@@ -5329,6 +5344,109 @@ bool grid_region(pray_ctx *c, const Array<Box> &parts, Box *region) {
     return true;
 }
 
+// The lists' plans (option plans 0: every list is evaluated in full).
+pray_status accel_plans(pray_ctx *c, const Scene *s, Accel *a) {
+    bool plans = opt_int(c, OPT_PLANS) != 0;
+    int nn = s->nodes.n + 1;
+    int *kids = (int *)mem_zalloc(c, sizeof(int) * (size_t)nn);
+    int *solid = (int *)mem_alloc(c, sizeof(int) * (size_t)nn);
+    pray_status st = kids && solid ? PRAY_OK : c->status;
+    for (int j = 0; st == PRAY_OK && j < nn; j++) solid[j] = -1;
+    for (int L = 0; st == PRAY_OK && L < a->off.n; L++) {
+        if (over_time(c)) {
+            st = fail_cancelled(c);
+            break;
+        }
+        int where = plans ? list_plan(c, s, a->data.p + a->off[L], kids, solid, &a->plan) : -1;
+        if (where == -2 || !a->plan_at.push(c, where))
+            st = c->status;
+    }
+    mem_free(c, kids);
+    mem_free(c, solid);
+    return st;
+}
+
+// What the structure holds, into its memory and the statistics; once it is `built`, a light
+// buffer without a list to give is dropped (it costs nothing), and a voxel whose list is not
+// plain is left to the grid.
+void accel_account(pray_ctx *c, Accel *a, bool built) {
+    long lbv = 0, ebv = 0, eruns = 0;  // the light buffers' voxels, the eye's, its runs' numbers
+    for (int i = 0; built && a->lbuf && i <= a->nlbuf; i++) {
+        LightBuf &B = a->lbuf[i];
+        long nv = 0;
+        for (int f = 0; f < B.faces; f++) nv += (long)B.f[f].n[0] * B.f[f].n[1] * B.f[f].n[2];
+        (B.pieces ? ebv : lbv) += nv;
+        if (B.pieces) {
+            eruns += B.nruns;
+            continue;
+        }
+        bool any = false;  // a buffer without a list to give is dropped, and costs nothing
+        for (long v = 0; v < nv; v++) {
+            // a list answers a shadow ray in one evaluation when it is plain; else walking
+            // the grid, which stops at the first blocker, is cheaper
+            if (B.list[v] > 0 && !list_plain(a, B.list[v])) B.list[v] = -1;
+            any = any || B.list[v] >= 0;
+        }
+        if (!any) B.faces = 0;
+    }
+    a->eye = a->lbuf && a->lbuf[a->nlbuf].faces ? &a->lbuf[a->nlbuf] : NULL;
+    long nv = (long)a->g.n[0] * a->g.n[1] * a->g.n[2];
+    long nested = 0;
+    for (int i = 0; i < a->nested.n; i++) nested += (long)a->nested[i].n[0] * a->nested[i].n[1] * a->nested[i].n[2];
+    a->memory = (double)sizeof(Accel) + (double)(nv + nested) * (sizeof(int) + 1) +
+                (double)a->nested.cap * sizeof(Grid) + (double)a->data.cap * sizeof(int) +
+                (double)a->off.cap * sizeof(int) + (double)(a->plan_at.cap + a->plan.cap) * sizeof(int) +
+                (double)(a->lbuf ? a->nlbuf + 1 : 0) * sizeof(LightBuf) +
+                (double)(lbv + eruns) * sizeof(int);
+    c->stats.lightbuf_voxels = lbv;
+    c->stats.eyebuf_voxels = ebv;
+    c->stats.grid[0] = a->g.n[0];
+    c->stats.grid[1] = a->g.n[1];
+    c->stats.grid[2] = a->g.n[2];
+    c->stats.voxels = nv;
+    c->stats.nested_grids = a->nested.n;
+    c->stats.nested_voxels = nested;
+    c->stats.lists = a->off.n - 1;
+    c->stats.areas = a->areas;
+    c->stats.memory = a->memory;
+}
+
+// The grid's box (accel_build): with bounds, the finite boxes of the scene's parts (a union of a
+// floor and furniture: the furniture's); otherwise, or when that finds nothing, the finite boxes
+// of the primitives; in both cases but for a few lone ones far from the rest (grid_region).
+// stk: room for a stack.
+pray_status grid_box(pray_ctx *c, const Scene *s, bool bounds, Array<int> &stk, Box *region) {
+    pray_status st = PRAY_OK;
+    int np = s->prims.n;
+    for (int l = 0; l < 3; l++) region->lo[l] = REAL_BIG, region->hi[l] = -REAL_BIG;
+    Array<Box> parts;  // their finite boxes
+    parts.init();
+    if (!parts.reserve(c, np + s->nodes.n + 1)) st = c->status;
+    if (st == PRAY_OK && bounds && s->root >= 0) {
+        stk.n = 0;
+        if (!stk.push(c, s->root)) st = c->status;
+        while (st == PRAY_OK && stk.n) {
+            int e = stk[--stk.n];
+            const Box &bx = elem_box(s, e);
+            if (e_is_node(e) && s->nodes[e_index(e)].op == O_UNION) {  // (its box: their hull)
+                const Node &nd = s->nodes[e_index(e)];
+                for (int i = 0; i < nd.n && st == PRAY_OK; i++)
+                    if (!stk.push(c, s->kids[nd.k0 + i])) st = c->status;
+            } else if (box_finite(bx)) {
+                if (!box_empty(bx) && !parts.push(c, bx)) st = c->status;
+            } else if (e_is_node(e) && s->nodes[e_index(e)].op == O_DIFF) {
+                if (!stk.push(c, s->kids[s->nodes[e_index(e)].k0])) st = c->status;
+            }
+        }
+    }
+    for (int i = 0; st == PRAY_OK && parts.n == 0 && i < np; i++)
+        if (box_finite(s->prims[i].box) && !parts.push(c, s->prims[i].box)) st = c->status;
+    if (st == PRAY_OK && !grid_region(c, parts, region)) st = c->status;
+    parts.release(c);
+    if (bounds && s->root >= 0) box_clip(region, elem_box(s, s->root));
+    return st;
+}
+
 // Build the acceleration structure: the lists of the grid's voxels and of the space around it,
 // and the buffers of the lights and, for a render (`render`), of the eye.
 pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
@@ -5357,37 +5475,8 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     }
     pray_status st = PRAY_OK;
     int np = s->prims.n;
-    // The grid's box: with bounds, the finite boxes of the scene's parts (a union of a floor and
-    // furniture: the furniture's); otherwise, or when that finds nothing, the finite boxes of the
-    // primitives; in both cases but for a few lone ones far from the rest (grid_region).
     Box region;
-    for (int l = 0; l < 3; l++) region.lo[l] = REAL_BIG, region.hi[l] = -REAL_BIG;
-    Array<Box> parts;  // their finite boxes
-    parts.init();
-    if (!parts.reserve(c, np + s->nodes.n + 1)) st = c->status;
-    if (st == PRAY_OK && a->bounds && s->root >= 0) {
-        Array<int> &stk = b.touched;
-        stk.n = 0;
-        if (!stk.push(c, s->root)) st = c->status;
-        while (st == PRAY_OK && stk.n) {
-            int e = stk[--stk.n];
-            const Box &bx = elem_box(s, e);
-            if (e_is_node(e) && s->nodes[e_index(e)].op == O_UNION) {  // (its box: their hull)
-                const Node &nd = s->nodes[e_index(e)];
-                for (int i = 0; i < nd.n && st == PRAY_OK; i++)
-                    if (!stk.push(c, s->kids[nd.k0 + i])) st = c->status;
-            } else if (box_finite(bx)) {
-                if (!box_empty(bx) && !parts.push(c, bx)) st = c->status;
-            } else if (e_is_node(e) && s->nodes[e_index(e)].op == O_DIFF) {
-                if (!stk.push(c, s->kids[s->nodes[e_index(e)].k0])) st = c->status;
-            }
-        }
-    }
-    for (int i = 0; st == PRAY_OK && parts.n == 0 && i < np; i++)
-        if (box_finite(s->prims[i].box) && !parts.push(c, s->prims[i].box)) st = c->status;
-    if (st == PRAY_OK && !grid_region(c, parts, &region)) st = c->status;
-    parts.release(c);
-    if (a->bounds && s->root >= 0) box_clip(&region, elem_box(s, s->root));
+    if (st == PRAY_OK && grid_box(c, s, a->bounds != 0, b.touched, &region)) st = c->status;
     int bounded = 0;  // primitives that reach into the grid's box
     for (int i = 0; i < np && !box_empty(region); i++) bounded += box_overlap(s->prims[i].box, region);
     double ext = 0, fill = 1;
@@ -5504,64 +5593,8 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     start.release(c);
     mem_free(c, eff);
     lb_release(b);
-    if (st == PRAY_OK) {  // the lists' plans (option plans 0: every list is evaluated in full)
-        bool plans = opt_int(c, OPT_PLANS) != 0;
-        int nn = s->nodes.n + 1;
-        int *kids = (int *)mem_zalloc(c, sizeof(int) * (size_t)nn);
-        int *solid = (int *)mem_alloc(c, sizeof(int) * (size_t)nn);
-        if (!kids || !solid) st = c->status;
-        for (int j = 0; st == PRAY_OK && j < nn; j++) solid[j] = -1;
-        for (int L = 0; st == PRAY_OK && L < a->off.n; L++) {
-            if (over_time(c)) {
-                st = fail_cancelled(c);
-                break;
-            }
-            int where = plans ? list_plan(c, s, a->data.p + a->off[L], kids, solid, &a->plan) : -1;
-            if (where == -2 || !a->plan_at.push(c, where))
-                st = c->status;
-        }
-        mem_free(c, kids);
-        mem_free(c, solid);
-    }
-    long lbv = 0, ebv = 0, eruns = 0;  // the light buffers' voxels, the eye's, its runs' numbers
-    for (int i = 0; st == PRAY_OK && a->lbuf && i <= a->nlbuf; i++) {
-        LightBuf &B = a->lbuf[i];
-        long nv = 0;
-        for (int f = 0; f < B.faces; f++) nv += (long)B.f[f].n[0] * B.f[f].n[1] * B.f[f].n[2];
-        (B.pieces ? ebv : lbv) += nv;
-        if (B.pieces) {
-            eruns += B.nruns;
-            continue;
-        }
-        bool any = false;  // a buffer without a list to give is dropped, and costs nothing
-        for (long v = 0; v < nv; v++) {
-            // a list answers a shadow ray in one evaluation when it is plain; else walking
-            // the grid, which stops at the first blocker, is cheaper
-            if (B.list[v] > 0 && !list_plain(a, B.list[v])) B.list[v] = -1;
-            any = any || B.list[v] >= 0;
-        }
-        if (!any) B.faces = 0;
-    }
-    a->eye = a->lbuf && a->lbuf[a->nlbuf].faces ? &a->lbuf[a->nlbuf] : NULL;
-    nv = (long)a->g.n[0] * a->g.n[1] * a->g.n[2];
-    long nested = 0;
-    for (int i = 0; i < a->nested.n; i++) nested += (long)a->nested[i].n[0] * a->nested[i].n[1] * a->nested[i].n[2];
-    a->memory = (double)sizeof(Accel) + (double)(nv + nested) * (sizeof(int) + 1) +
-                (double)a->nested.cap * sizeof(Grid) + (double)a->data.cap * sizeof(int) +
-                (double)a->off.cap * sizeof(int) + (double)(a->plan_at.cap + a->plan.cap) * sizeof(int) +
-                (double)(a->lbuf ? a->nlbuf + 1 : 0) * sizeof(LightBuf) +
-                (double)(lbv + eruns) * sizeof(int);
-    c->stats.lightbuf_voxels = lbv;
-    c->stats.eyebuf_voxels = ebv;
-    c->stats.grid[0] = a->g.n[0];
-    c->stats.grid[1] = a->g.n[1];
-    c->stats.grid[2] = a->g.n[2];
-    c->stats.voxels = nv;
-    c->stats.nested_grids = a->nested.n;
-    c->stats.nested_voxels = nested;
-    c->stats.lists = a->off.n - 1;
-    c->stats.areas = a->areas;
-    c->stats.memory = a->memory;
+    if (st == PRAY_OK) st = accel_plans(c, s, a);
+    accel_account(c, a, st == PRAY_OK);
     return st;
 }
 
@@ -6675,6 +6708,100 @@ struct TexImage {
     float *rgb;
 };
 
+// The directory's `count` entries at ifd: the tags pray reads, checked against the file.
+pray_status tiff_tags(TiffIn &in, unsigned long ifd, unsigned count, TiffTag *tags) {
+    memset(tags, 0, sizeof(TiffTag) * NTIFF_TAGS);
+    for (unsigned e = 0; e < count; e++) {
+        size_t at = (size_t)ifd + 2 + (size_t)e * 12;
+        unsigned tag = in.u16(at);
+        for (int k = 0; k < NTIFF_TAGS; k++) {
+            if (TIFF_TAGS[k] != tag) continue;
+            TiffTag &t = tags[k];
+            t.type = in.u16(at + 2);
+            t.count = in.u32(at + 4);
+            t.at = at + 8;
+            t.value = in.u32(at + 8);
+            size_t sz = tiff_type_size(t.type);
+            if (!sz) return in.err("tag %u has an unknown type %u", tag, t.type);
+            if (t.count > in.n) return in.err("tag %u claims %lu values", tag, t.count);
+            if (t.count * sz > 4 && (t.value > in.n || t.count * sz > in.n - t.value))
+                return in.err("the values of tag %u lie outside the file", tag);
+            t.present = 1;
+        }
+    }
+    return PRAY_OK;
+}
+
+// The name of a compression pray does not read.
+const char *tiff_compression(unsigned long comp) {
+    return comp == 2 || comp == 3 || comp == 4 ? "CCITT fax" : comp == 6 || comp == 7 ? "JPEG"
+           : comp == 8 || comp == 32946 ? "Deflate" : comp == 34925 ? "LZMA"
+           : comp == 50000 ? "Zstandard" : comp == 50001 ? "WebP" : "an unknown method";
+}
+
+// What a block's samples are, for tiff_block.
+struct TiffPixels {
+    unsigned long width, height, spp, bps, photo, colors, maxv, bw, bh;
+    const TiffTag *cmap;
+    float *rgb;
+};
+
+// Block (bx, by) of `rows` rows of rowbytes each into the image: the horizontal differences of
+// predictor 2 undone (pred), then each pixel's colour.
+void tiff_block(const TiffIn &in, const TiffPixels &f, unsigned char *block, size_t rows, size_t rowbytes,
+                unsigned long bx, unsigned long by, unsigned long pred) {
+    const unsigned long spp = f.spp, bps = f.bps, bw = f.bw, maxv = f.maxv;
+    if (pred == 2)
+        for (size_t r = 0; r < rows; r++) {
+            unsigned char *row = block + r * rowbytes;
+            if (bps == 8) {
+                for (size_t i = spp; i < bw * spp; i++) row[i] = (unsigned char)(row[i] + row[i - spp]);
+            } else {
+                for (size_t i = spp; i < bw * spp; i++) {
+                    unsigned char *a = row + 2 * i, *b = row + 2 * (i - spp);
+                    unsigned v = in.big ? ((unsigned)a[0] << 8 | a[1]) + ((unsigned)b[0] << 8 | b[1])
+                                        : ((unsigned)a[1] << 8 | a[0]) + ((unsigned)b[1] << 8 | b[0]);
+                    a[in.big ? 0 : 1] = (unsigned char)(v >> 8 & 255);
+                    a[in.big ? 1 : 0] = (unsigned char)(v & 255);
+                }
+            }
+        }
+    for (size_t r = 0; r < rows; r++) {
+        unsigned long y = by * f.bh + r;
+        if (y >= f.height) break;
+        const unsigned char *row = block + r * rowbytes;
+        for (unsigned long x0 = 0; x0 < bw; x0++) {
+            unsigned long x = bx * bw + x0;
+            if (x >= f.width) break;
+            unsigned long v[4] = {0, 0, 0, 0};
+            for (unsigned long q = 0; q < f.colors; q++) {
+                size_t bit = (size_t)(x0 * spp + q) * bps;
+                if (bps == 16) {
+                    const unsigned char *a = row + bit / 8;
+                    v[q] = in.big ? ((unsigned long)a[0] << 8 | a[1]) : ((unsigned long)a[1] << 8 | a[0]);
+                } else if (bps == 8) v[q] = row[bit / 8];
+                else v[q] = (unsigned long)(row[bit / 8] >> (8 - bps - bit % 8)) & maxv;
+            }
+            float *o = f.rgb + ((size_t)y * f.width + x) * 3;
+            if (f.photo == 3) {
+                unsigned long r0 = 0, g0 = 0, b0 = 0;
+                tiff_value(in, *f.cmap, v[0], &r0);
+                tiff_value(in, *f.cmap, v[0] + maxv + 1, &g0);
+                tiff_value(in, *f.cmap, v[0] + 2 * (maxv + 1), &b0);
+                o[0] = (float)(r0 / 65535.0);
+                o[1] = (float)(g0 / 65535.0);
+                o[2] = (float)(b0 / 65535.0);
+            } else if (f.photo == 2) {
+                for (int q = 0; q < 3; q++) o[q] = (float)((double)v[q] / maxv);
+            } else {
+                double g = (double)v[0] / maxv;
+                if (f.photo == 0) g = 1 - g;  // white is zero
+                o[0] = o[1] = o[2] = (float)g;
+            }
+        }
+    }
+}
+
 pray_status tiff_decode(pray_ctx *c, const char *name, const unsigned char *p, size_t n, double max_bytes,
                         TexImage *img) {
     TiffIn in;
@@ -6695,25 +6822,7 @@ pray_status tiff_decode(pray_ctx *c, const char *name, const unsigned char *p, s
     unsigned count = in.u16((size_t)ifd);
     if ((size_t)ifd + 2 + (size_t)count * 12 > n) return in.err("the directory runs past the end of the file");
     TiffTag tags[NTIFF_TAGS];
-    memset(tags, 0, sizeof tags);
-    for (unsigned e = 0; e < count; e++) {
-        size_t at = (size_t)ifd + 2 + (size_t)e * 12;
-        unsigned tag = in.u16(at);
-        for (int k = 0; k < NTIFF_TAGS; k++) {
-            if (TIFF_TAGS[k] != tag) continue;
-            TiffTag &t = tags[k];
-            t.type = in.u16(at + 2);
-            t.count = in.u32(at + 4);
-            t.at = at + 8;
-            t.value = in.u32(at + 8);
-            size_t sz = tiff_type_size(t.type);
-            if (!sz) return in.err("tag %u has an unknown type %u", tag, t.type);
-            if (t.count > n) return in.err("tag %u claims %lu values", tag, t.count);
-            if (t.count * sz > 4 && (t.value > n || t.count * sz > n - t.value))
-                return in.err("the values of tag %u lie outside the file", tag);
-            t.present = 1;
-        }
-    }
+    if (tiff_tags(in, ifd, count, tags)) return c->status;
     struct Idx {
         static int of(unsigned x) {
             for (int k = 0; k < NTIFF_TAGS; k++)
@@ -6744,12 +6853,8 @@ pray_status tiff_decode(pray_ctx *c, const char *name, const unsigned char *p, s
     if (fmt != 1) return in.err("unsupported TIFF: sample format %lu (only unsigned integers)", fmt);
     if (bps != 1 && bps != 4 && bps != 8 && bps != 16)
         return in.err("unsupported TIFF: %lu bits per sample", bps);
-    if (comp != 1 && comp != 5 && comp != 32773) {
-        const char *what = comp == 2 || comp == 3 || comp == 4 ? "CCITT fax" : comp == 6 || comp == 7 ? "JPEG"
-                           : comp == 8 || comp == 32946 ? "Deflate" : comp == 34925 ? "LZMA"
-                           : comp == 50000 ? "Zstandard" : comp == 50001 ? "WebP" : "an unknown method";
-        return in.err("unsupported TIFF: %s compression (%lu)", what, comp);
-    }
+    if (comp != 1 && comp != 5 && comp != 32773)
+        return in.err("unsupported TIFF: %s compression (%lu)", tiff_compression(comp), comp);
     if (pred != 1 && pred != 2) return in.err("unsupported TIFF: predictor %lu", pred);
     if (pred == 2 && bps != 8 && bps != 16) return in.err("unsupported TIFF: predictor with %lu bits", bps);
     if (spp > 1 && planar != 1) return in.err("unsupported TIFF: separate colour planes");
@@ -6795,6 +6900,7 @@ pray_status tiff_decode(pray_ctx *c, const char *name, const unsigned char *p, s
         mem_free(c, rgb);
         return c->status;
     }
+    TiffPixels px = {width, height, spp, bps, photo, colors, maxv, bw, bh, &cmap, rgb};
     pray_status st = PRAY_OK;
     for (unsigned long by = 0; by < down && st == PRAY_OK; by++)
         for (unsigned long bx = 0; bx < across && st == PRAY_OK; bx++) {
@@ -6832,55 +6938,7 @@ pray_status tiff_decode(pray_ctx *c, const char *name, const unsigned char *p, s
                 st = in.err("block %lu is truncated or corrupt", k);
                 break;
             }
-            if (pred == 2)  // undo the horizontal differences, row by row
-                for (size_t r = 0; r < rows; r++) {
-                    unsigned char *row = block + r * rowbytes;
-                    if (bps == 8) {
-                        for (size_t i = spp; i < bw * spp; i++) row[i] = (unsigned char)(row[i] + row[i - spp]);
-                    } else {
-                        for (size_t i = spp; i < bw * spp; i++) {
-                            unsigned char *a = row + 2 * i, *b = row + 2 * (i - spp);
-                            unsigned v = in.big ? ((unsigned)a[0] << 8 | a[1]) + ((unsigned)b[0] << 8 | b[1])
-                                                : ((unsigned)a[1] << 8 | a[0]) + ((unsigned)b[1] << 8 | b[0]);
-                            a[in.big ? 0 : 1] = (unsigned char)(v >> 8 & 255);
-                            a[in.big ? 1 : 0] = (unsigned char)(v & 255);
-                        }
-                    }
-                }
-            for (size_t r = 0; r < rows; r++) {
-                unsigned long y = by * bh + r;
-                if (y >= height) break;
-                const unsigned char *row = block + r * rowbytes;
-                for (unsigned long x0 = 0; x0 < bw; x0++) {
-                    unsigned long x = bx * bw + x0;
-                    if (x >= width) break;
-                    unsigned long v[4] = {0, 0, 0, 0};
-                    for (unsigned long q = 0; q < colors; q++) {
-                        size_t bit = (size_t)(x0 * spp + q) * bps;
-                        if (bps == 16) {
-                            const unsigned char *a = row + bit / 8;
-                            v[q] = in.big ? ((unsigned long)a[0] << 8 | a[1]) : ((unsigned long)a[1] << 8 | a[0]);
-                        } else if (bps == 8) v[q] = row[bit / 8];
-                        else v[q] = (unsigned long)(row[bit / 8] >> (8 - bps - bit % 8)) & maxv;
-                    }
-                    float *o = rgb + ((size_t)y * width + x) * 3;
-                    if (photo == 3) {
-                        unsigned long r0 = 0, g0 = 0, b0 = 0;
-                        tiff_value(in, cmap, v[0], &r0);
-                        tiff_value(in, cmap, v[0] + maxv + 1, &g0);
-                        tiff_value(in, cmap, v[0] + 2 * (maxv + 1), &b0);
-                        o[0] = (float)(r0 / 65535.0);
-                        o[1] = (float)(g0 / 65535.0);
-                        o[2] = (float)(b0 / 65535.0);
-                    } else if (photo == 2) {
-                        for (int q = 0; q < 3; q++) o[q] = (float)((double)v[q] / maxv);
-                    } else {
-                        double g = (double)v[0] / maxv;
-                        if (photo == 0) g = 1 - g;  // white is zero
-                        o[0] = o[1] = o[2] = (float)g;
-                    }
-                }
-            }
+            tiff_block(in, px, block, rows, rowbytes, bx, by, pred);
         }
     mem_free(c, block);
     if (st != PRAY_OK) {
@@ -11882,6 +11940,102 @@ Stmt **freeze_stmts(Parser &P, Array<Stmt *> &a) {
     return p;
 }
 
+// include "F", alone on its line (t: the word).
+Stmt *parse_include(Parser &P, const Tok &t) {
+    const Tok &f = P.t[P.pos + 1];
+    if (f.kind != T_STR) {
+        syn(P, f.kind == T_NL ? t : f, "'include' takes a file name in double quotes: include \"F\"");
+        return NULL;
+    }
+    if (f.line != t.line || f.n == 0) {
+        syn(P, f, f.n ? "'include' stands alone on its line: the file name must be on the line of 'include'"
+                      : "'include' takes a file name, not an empty string");
+        return NULL;
+    }
+    Stmt *s = new_stmt(P, ST_INCLUDE, t);
+    if (!s) return NULL;
+    P.pos++;
+    Expr *e = parse_primary(P);
+    s->args = e ? (Expr **)P.arena->get(P.c, sizeof(Expr *)) : NULL;
+    if (!s->args) return NULL;
+    s->args[0] = e;
+    s->nargs = 1;
+    if (cur(P).kind != T_NL) {
+        char buf[80];
+        syn(P, cur(P), "'include' stands alone on its line: expected end of line after the file name, found '%s'",
+            tok_text(cur(P), buf, sizeof buf));
+        return NULL;
+    }
+    return next_line(P) ? NULL : s;
+}
+
+// if COND [then] ... [else ...] endif, or while COND ... endwhile (t: the word).
+Stmt *parse_block_statement(Parser &P, const Tok &t) {
+    bool is_if = is_word(t, "if");
+    Tok word = t;  // (the block takes the lines after this one's)
+    word.s = is_if ? "if" : "while";
+    Stmt *s = new_stmt(P, is_if ? ST_IF : ST_WHILE, word);
+    if (!s) return NULL;
+    P.pos++;
+    if (cur(P).kind == T_NL) {
+        syn(P, cur(P), "'%s' needs a condition", word.s);
+        return NULL;
+    }
+    Expr *cond = parse_expr(P);
+    if (!cond) return NULL;
+    s->args = (Expr **)P.arena->get(P.c, sizeof(Expr *));
+    if (!s->args) return NULL;
+    s->args[0] = cond;
+    s->nargs = 1;
+    if (is_if && is_word(cur(P), "then")) P.pos++;
+    if (end_of_line(P)) return NULL;
+    if (++P.blocks > P.maxnest) {
+        char msg[160];
+        syn(P, word, "%s", nest_message(msg, sizeof msg, "blocks", P.maxnest, P.base));
+        return NULL;
+    }
+    Array<Stmt *> body;
+    body.init();
+    const char *stop = NULL;
+    bool ok = parse_block(P, &body, &stop);
+    if (ok) {
+        s->body = freeze_stmts(P, body);
+        s->nbody = body.n;
+        ok = s->body != NULL;
+    }
+    body.release(P.c);
+    if (!ok) return NULL;
+    if (is_if && stop && strcmp(stop, "else") == 0) {
+        P.pos++;
+        if (end_of_line(P)) return NULL;
+        Array<Stmt *> els;
+        els.init();
+        ok = parse_block(P, &els, &stop);
+        if (ok) {
+            s->els = freeze_stmts(P, els);
+            s->nels = els.n;
+            ok = s->els != NULL;
+        }
+        els.release(P.c);
+        if (!ok) return NULL;
+    }
+    const char *want = is_if ? "endif" : "endwhile";
+    if (!stop || strcmp(stop, want) != 0) {
+        char msg[200];
+        if (stop)
+            snprintf(msg, sizeof msg, "'%s' where '%s' was expected to close the '%s' of line %d",
+                     stop, want, word.s, word.line);
+        else
+            snprintf(msg, sizeof msg, "'%s' without '%s'", word.s, want);
+        if (stop) syn(P, cur(P), "%s", msg);
+        else syn(P, word, "%s", msg);
+        return NULL;
+    }
+    P.pos++;
+    P.blocks--;
+    return end_of_line(P) ? NULL : s;
+}
+
 // statement -> NAME '=' expr | 'delete' NAME {',' NAME} | 'print' args | 'quit'
 //            | 'if' expr ['then'] NL block ['else' NL block] 'endif'
 //            | 'while' expr NL block 'endwhile' | 'background' expr [',' expr]
@@ -11950,98 +12104,8 @@ Stmt *parse_statement(Parser &P) {
                 }
         return end_of_line(P) ? NULL : s;
     }
-    if (is_word(t, "include")) {  // include "F", alone on its line
-        const Tok &f = P.t[P.pos + 1];
-        if (f.kind != T_STR) {
-            syn(P, f.kind == T_NL ? t : f, "'include' takes a file name in double quotes: include \"F\"");
-            return NULL;
-        }
-        if (f.line != t.line || f.n == 0) {
-            syn(P, f, f.n ? "'include' stands alone on its line: the file name must be on the line of 'include'"
-                          : "'include' takes a file name, not an empty string");
-            return NULL;
-        }
-        s = new_stmt(P, ST_INCLUDE, t);
-        if (!s) return NULL;
-        P.pos++;
-        Expr *e = parse_primary(P);
-        s->args = e ? (Expr **)P.arena->get(P.c, sizeof(Expr *)) : NULL;
-        if (!s->args) return NULL;
-        s->args[0] = e;
-        s->nargs = 1;
-        if (cur(P).kind != T_NL) {
-            char buf[80];
-            syn(P, cur(P), "'include' stands alone on its line: expected end of line after the file name, found '%s'",
-                tok_text(cur(P), buf, sizeof buf));
-            return NULL;
-        }
-        return next_line(P) ? NULL : s;
-    }
-    if (is_word(t, "if") || is_word(t, "while")) {
-        bool is_if = is_word(t, "if");
-        Tok word = t;  // (the block takes the lines after this one's)
-        word.s = is_if ? "if" : "while";
-        s = new_stmt(P, is_if ? ST_IF : ST_WHILE, word);
-        if (!s) return NULL;
-        P.pos++;
-        if (cur(P).kind == T_NL) {
-            syn(P, cur(P), "'%s' needs a condition", word.s);
-            return NULL;
-        }
-        Expr *cond = parse_expr(P);
-        if (!cond) return NULL;
-        s->args = (Expr **)P.arena->get(P.c, sizeof(Expr *));
-        if (!s->args) return NULL;
-        s->args[0] = cond;
-        s->nargs = 1;
-        if (is_if && is_word(cur(P), "then")) P.pos++;
-        if (end_of_line(P)) return NULL;
-        if (++P.blocks > P.maxnest) {
-            char msg[160];
-            syn(P, word, "%s", nest_message(msg, sizeof msg, "blocks", P.maxnest, P.base));
-            return NULL;
-        }
-        Array<Stmt *> body;
-        body.init();
-        const char *stop = NULL;
-        bool ok = parse_block(P, &body, &stop);
-        if (ok) {
-            s->body = freeze_stmts(P, body);
-            s->nbody = body.n;
-            ok = s->body != NULL;
-        }
-        body.release(P.c);
-        if (!ok) return NULL;
-        if (is_if && stop && strcmp(stop, "else") == 0) {
-            P.pos++;
-            if (end_of_line(P)) return NULL;
-            Array<Stmt *> els;
-            els.init();
-            ok = parse_block(P, &els, &stop);
-            if (ok) {
-                s->els = freeze_stmts(P, els);
-                s->nels = els.n;
-                ok = s->els != NULL;
-            }
-            els.release(P.c);
-            if (!ok) return NULL;
-        }
-        const char *want = is_if ? "endif" : "endwhile";
-        if (!stop || strcmp(stop, want) != 0) {
-            char msg[200];
-            if (stop)
-                snprintf(msg, sizeof msg, "'%s' where '%s' was expected to close the '%s' of line %d",
-                         stop, want, word.s, word.line);
-            else
-                snprintf(msg, sizeof msg, "'%s' without '%s'", word.s, want);
-            if (stop) syn(P, cur(P), "%s", msg);
-            else syn(P, word, "%s", msg);
-            return NULL;
-        }
-        P.pos++;
-        P.blocks--;
-        return end_of_line(P) ? NULL : s;
-    }
+    if (is_word(t, "include")) return parse_include(P, t);
+    if (is_word(t, "if") || is_word(t, "while")) return parse_block_statement(P, t);
     if (is_word(t, "else") || is_word(t, "endif") || is_word(t, "endwhile")) {
         syn(P, t, "'%s' without a matching '%s'", t.s, is_word(t, "endwhile") ? "while" : "if");
         return NULL;
@@ -14297,6 +14361,55 @@ void catch_signals(pray_ctx *c) {
 
 } // namespace
 
+// The command line's program run: its callbacks (standard output, progress, warnings, parts,
+// frames, statistics) and the exit status.
+int run_program_main(pray_ctx *c, const char *program, const char *output, bool stats, bool quiet, Split &sp,
+                     int argc, char **argv) {
+    bool piped = output && strcmp(output, "-") == 0;
+    if (piped && (sp.row1 || sp.n)) return usage_error("-o - writes whole images: not with --rows or --part%s", "");
+    if (piped) {  // (and `print` goes to standard error, out of the images' way)
+#if defined(_WIN32)
+        _setmode(_fileno(stdout), _O_BINARY);
+#elif defined(__DJGPP__)
+        setmode(fileno(stdout), O_BINARY);
+#endif
+        pray_set_frame(c, write_stdout, c);
+        pray_set_print(c, to_stderr, NULL);
+    }
+    if (!quiet && stderr_is_terminal()) pray_set_progress(c, progress_bar, NULL);
+    if (!quiet) pray_set_warning(c, to_stderr, NULL);
+    if (sp.row1 || sp.n || sp.frame1) pray_set_render(c, render_part, &sp);
+    if (sp.row1 || sp.n) {
+        render_id(c, sp.id, program, argc, argv);
+        pray_set_frame(c, write_part, &sp);
+    }
+    FrameLog flog;
+    memset(&flog, 0, sizeof flog);
+    flog.c = c;
+    if (stats && !sp.row1 && !sp.n) pray_set_frame(c, log_frame, &flog);
+    catch_signals(c);
+    pray_status st = pray_run_file(c, program);
+    catch_signals(NULL);
+    int rc = 0;
+    if (st != PRAY_OK) {
+        const char *m = pray_error(c);
+        if (strncmp(m, "error: ", 7) == 0) fprintf(stderr, "pray: %s\n", m);
+        else fprintf(stderr, "%s\n", m);
+        rc = exit_code(st);
+        if (st == PRAY_ERR_ARG) rc = 1;  // a bad option value inside the program
+    } else if (sp.frame1 && !sp.rendered) {
+        if (pray_frames(c) == 0)
+            fprintf(stderr, "pray: error: --frames %d:%d selects no frame: the program renders none\n", sp.frame0,
+                    sp.frame1);
+        else
+            fprintf(stderr, "pray: error: --frames %d:%d selects no frame: the program renders frames 0:%d\n", sp.frame0,
+                    sp.frame1, pray_frames(c));
+        rc = 1;
+    } else if (stats)
+        print_stats(c);
+    return rc;
+}
+
 int main(int argc, char **argv) {
 #ifdef SIGXFSZ
     // a file over the size limit (ulimit -f): a write error (EFBIG) like any other, not death
@@ -14435,50 +14548,7 @@ int main(int argc, char **argv) {
         pray_free(c);
         return rc;
     }
-    bool piped = output && strcmp(output, "-") == 0;
-    if (piped && (sp.row1 || sp.n)) {
-        pray_free(c);
-        return usage_error("-o - writes whole images: not with --rows or --part%s", "");
-    }
-    if (piped) {  // (and `print` goes to standard error, out of the images' way)
-#if defined(_WIN32)
-        _setmode(_fileno(stdout), _O_BINARY);
-#elif defined(__DJGPP__)
-        setmode(fileno(stdout), O_BINARY);
-#endif
-        pray_set_frame(c, write_stdout, c);
-        pray_set_print(c, to_stderr, NULL);
-    }
-    if (!quiet && stderr_is_terminal()) pray_set_progress(c, progress_bar, NULL);
-    if (!quiet) pray_set_warning(c, to_stderr, NULL);
-    if (sp.row1 || sp.n || sp.frame1) pray_set_render(c, render_part, &sp);
-    if (sp.row1 || sp.n) {
-        render_id(c, sp.id, program, argc, argv);
-        pray_set_frame(c, write_part, &sp);
-    }
-    FrameLog flog;
-    memset(&flog, 0, sizeof flog);
-    flog.c = c;
-    if (stats && !sp.row1 && !sp.n) pray_set_frame(c, log_frame, &flog);
-    catch_signals(c);
-    pray_status st = pray_run_file(c, program);
-    catch_signals(NULL);
-    if (st != PRAY_OK) {
-        const char *m = pray_error(c);
-        if (strncmp(m, "error: ", 7) == 0) fprintf(stderr, "pray: %s\n", m);
-        else fprintf(stderr, "%s\n", m);
-        rc = exit_code(st);
-        if (st == PRAY_ERR_ARG) rc = 1;  // a bad option value inside the program
-    } else if (sp.frame1 && !sp.rendered) {
-        if (pray_frames(c) == 0)
-            fprintf(stderr, "pray: error: --frames %d:%d selects no frame: the program renders none\n", sp.frame0,
-                    sp.frame1);
-        else
-            fprintf(stderr, "pray: error: --frames %d:%d selects no frame: the program renders frames 0:%d\n", sp.frame0,
-                    sp.frame1, pray_frames(c));
-        rc = 1;
-    } else if (stats)
-        print_stats(c);
+    rc = run_program_main(c, program, output, stats != 0, quiet != 0, sp, argc, argv);
     fflush(stdout);
     pray_free(c);
     return rc;

@@ -12,8 +12,8 @@
 #   [SECTION] N   BUDGET  title...
 # and the line "whole file: at most TOTAL lines". The check fails when a section is over its
 # budget, when the file is over its total, or when a banner has no budget in the index (or a
-# budget no banner). Budgets are lowered as sections shrink; raising one is a decision, made in
-# the index. Needs only a POSIX shell and awk.
+# budget no banner), and when a function is longer than 150 lines. Budgets are lowered as
+# sections shrink; raising one is a decision, made in the index. Needs only a POSIX shell and awk.
 
 quiet=0
 if [ "${1:-}" = -q ]; then
@@ -90,4 +90,30 @@ awk -v quiet=$quiet '
         if (bad) { print "sections.sh: FAILED"; exit 1 }
         printf "sections.sh: %s, %d lines in %d sections, each within its budget\n", FILENAME, NR, nf
     }
-' "$file"
+' "$file" || st=1
+
+# No function of more than 150 lines, from the line that opens its body to the one that closes
+# it (a block at the top level of the file that is not a namespace); comments, strings and
+# character literals are left out of the count of braces.
+awk '
+    /^(namespace|} *\/\/ namespace|extern "C" *\{)/ { next }
+    {
+        line = $0
+        gsub(/\/\/.*/, "", line)
+        gsub(/"(\\.|[^"\\])*"/, "\"\"", line)
+        gsub(/\047(\\.|[^\047\\])*\047/, "\047\047", line)
+        for (i = 1; i <= length(line); i++) {
+            ch = substr(line, i, 1)
+            if (ch == "{") { if (depth == 0) { start = NR; name = $0 } depth++ }
+            else if (ch == "}") {
+                depth--
+                if (depth == 0 && start && NR - start + 1 > 150) {
+                    printf "sections.sh: %d lines in the function at line %d (150 at most): %s\n", NR - start + 1, start, name
+                    bad = 1
+                }
+            }
+        }
+    }
+    END { if (bad) { print "sections.sh: FAILED"; exit 1 } }
+' "$file" || st=1
+exit ${st:-0}
