@@ -4549,6 +4549,10 @@ struct GridPlan {
 // along some axis (a floor, a wall, a long rod) is no part of a crowd: the box leaves it out,
 // and the rest of the voxel checks it, unless that would crowd the rest.
 const int NEST_CHECKS = 32;
+// Nested grids have at most this many voxels for each primitive of the scene, all together; and
+// a nested grid is built only where it separates the voxel's primitives: its voxels reach, on
+// average, at most this share of the primitives the voxel has to check.
+const double NEST_PER_PRIM = 64, NEST_SEPARATES = 0.5;
 
 bool grid_lists(ListBuilder &b, Grid &G, GridPlan &gp, const Array<int> &cand, const Array<int> &start, double margin,
                 int steps, int depth);
@@ -4648,6 +4652,13 @@ int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const
     steps += (m > S.n[2] ? m : S.n[2]) + 4;
     double margin = (double)S.h * 1e-6 + gp.round * steps;
     if (margin > (double)S.h / 4) return -1;  // (b.rprims and b.rcls left as they are)
+    double refs = 0;  // (the voxels the candidates reach: a crowd all in the same place is not separated)
+    for (int i = 0; i < n; i++) {
+        int a0[3], a1[3];
+        if (voxel_range(S, gp.eff[ids[i]], margin, a0, a1))
+            refs += (double)(a1[0] - a0[0] + 1) * (a1[1] - a0[1] + 1) * (a1[2] - a0[2] + 1);
+    }
+    if (refs > NEST_SEPARATES * checks * nv) return -1;
     // the rest of the voxel: what is inside it all, and the primitives to check that reach
     // out of the box
     Array<int> rp, cand, start;
@@ -5558,12 +5569,13 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     if (want > 0 && st == PRAY_OK) {
         for (int l = 0; l < 3; l++) a->g.top[l] = (real)((double)a->g.org[l] + a->g.n[l] * (double)a->g.h);
         a->g.voxel = (int *)mem_zalloc(c, sizeof(int) * (size_t)nv);
-        // nested grids take what the budget leaves, and no more voxels than the image has rays
+        // nested grids take what the budget leaves, and no more than NEST_PER_PRIM voxels for
+        // each primitive: the scene decides, never the image
         GridPlan gp;
         gp.eff = eff;
         gp.round = 64 * REAL_EPS * (mag + ext);
         gp.budget = (budget - (double)nv * (2 * sizeof(int) + 1)) / 16;
-        gp.budget = gp.budget < rays / 2 ? gp.budget : rays / 2;
+        gp.budget = gp.budget < NEST_PER_PRIM * np ? gp.budget : NEST_PER_PRIM * np;
         if (!a->g.voxel || !bucket(c, a->g.n, np, VoxelRange(a->g, eff, NULL, margin), cand, start) ||
             !grid_lists(b, a->g, gp, cand, start, margin, want + 4, opt_int(c, OPT_NEST)))
             st = c->status;
