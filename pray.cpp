@@ -14,7 +14,7 @@
    [SECTION] 8     450  Ray/primitive intersection; primitives in a frame (box, rod, cone, torus,
                           stretched)
    [SECTION] 9     450  CSG status-tree sweep (the brute-force reference, thesis 3.4)
-   [SECTION] 9b   2750  Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
+   [SECTION] 9b   2800  Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
                           [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas
                           and jumps, [9b.4] light and eye buffers, [9b.5] accel_build; per ray: [9b.6]
                           list evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver
@@ -4481,6 +4481,17 @@ bool voxel_range(const Grid &G, const Box &bx, double margin, int *lo, int *hi) 
     return true;
 }
 
+// How many voxels of G the boxes of primitives ids[0 .. n) (NULL: 0 .. n) meet, all together.
+double voxel_refs(const Grid &G, const Box *eff, const int *ids, int n, double margin) {
+    double refs = 0;
+    for (int i = 0; i < n; i++) {
+        int lo[3], hi[3];
+        if (voxel_range(G, eff[ids ? ids[i] : i], margin, lo, hi))
+            refs += (double)(hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
+    }
+    return refs;
+}
+
 // The items of each cell of a grid of dim[0] x dim[1] x dim[2] cells, x fastest, as
 // cand[start[v] .. start[v + 1]), in two passes (count, then fill): `range(k, &id, lo, hi)`
 // gives item k's number and the cells it meets, lo[l] to hi[l] along each axis (false: none).
@@ -4652,13 +4663,8 @@ int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const
     steps += (m > S.n[2] ? m : S.n[2]) + 4;
     double margin = (double)S.h * 1e-6 + gp.round * steps;
     if (margin > (double)S.h / 4) return -1;  // (b.rprims and b.rcls left as they are)
-    double refs = 0;  // (the voxels the candidates reach: a crowd all in the same place is not separated)
-    for (int i = 0; i < n; i++) {
-        int a0[3], a1[3];
-        if (voxel_range(S, gp.eff[ids[i]], margin, a0, a1))
-            refs += (double)(a1[0] - a0[0] + 1) * (a1[1] - a0[1] + 1) * (a1[2] - a0[2] + 1);
-    }
-    if (refs > NEST_SEPARATES * checks * nv) return -1;
+    // (a crowd all in the same place is not separated)
+    if (voxel_refs(S, gp.eff, ids, n, margin) > NEST_SEPARATES * checks * nv) return -1;
     // the rest of the voxel: what is inside it all, and the primitives to check that reach
     // out of the box
     Array<int> rp, cand, start;
@@ -5554,11 +5560,7 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
             a->g.org[l] = (real)((double)(region.lo[l] + region.hi[l]) / 2 - a->g.n[l] * (double)a->g.h / 2);
             vox *= a->g.n[l];
         }
-        double refs = 0;
-        for (int i = 0; i < np && vox <= 268435456.0; i++) {
-            int lo[3], hi[3];
-            if (voxel_range(a->g, eff[i], margin, lo, hi)) refs += (double)(hi[0] - lo[0] + 1) * (hi[1] - lo[1] + 1) * (hi[2] - lo[2] + 1);
-        }
+        double refs = vox <= 268435456.0 ? voxel_refs(a->g, eff, NULL, np, margin) : 0;
         if (vox <= 268435456.0 && refs <= 64.0 * 1048576 && (2 * vox + refs) * sizeof(int) + vox <= budget) {
             nv = (long)vox;
             break;
