@@ -2881,8 +2881,6 @@ pray_status scene_compact(pray_ctx *c, Scene *s) {
 // ---- where materials meet (language 12) ----
 // Values compared by their bits (here, and between the frames of a sequence, 10b).
 inline bool same_bytes(const void *a, const void *b, size_t n) { return memcmp(a, b, n) == 0; }
-inline bool same_real(real a, real b) { return same_bytes(&a, &b, sizeof a); }
-inline bool same_r3(R3 a, R3 b) { return same_real(a.x, b.x) && same_real(a.y, b.y) && same_real(a.z, b.z); }
 inline bool same_rgb_bits(pray_rgb a, pray_rgb b) { return same_bytes(&a, &b, sizeof a); }
 
 bool tex_same(const pray_texture *a, const pray_texture *b) {
@@ -8026,12 +8024,9 @@ inline size_t coh_word(size_t u, int i, int words) {
 inline bool coh_sampled(size_t u, int width, bool bands) {
     return bands ? u % 4 == 0 : (u % (size_t)width) % 8 == 0 && (u / (size_t)width) % 8 == 0;
 }
-// A sampled unit's place among the sample's records, and their number.
+// A sampled unit's place among the sample's records (their number: coh_slots, 10b).
 inline size_t coh_slot(size_t u, int width, bool bands) {
     return bands ? u / 4 : u / (size_t)width / 8 * (((size_t)width + 7) / 8) + u % (size_t)width / 8;
-}
-inline size_t coh_slots(size_t units, int width, bool bands) {
-    return bands ? (units + 3) / 4 : (units / (size_t)width + 7) / 8 * (((size_t)width + 7) / 8);
 }
 
 struct Worker {
@@ -8483,11 +8478,7 @@ Worker &worker_at(char *buf, size_t stride, int i) { return *(Worker *)(buf + LI
 // a record (with its walk's setting out), a cell of the grid it crosses, a word of a record
 // emptied; taking a unit over, and testing one word of its record for change.
 const double COH_RAY_WORK = 530, COH_TEST_WORK = 100, COH_STEP_WORK = 100, COH_ACTION_WORK = 25;
-const double COH_NOTE_WORK = 200, COH_CELL_WORK = 10, COH_WORD_WORK = 2;
-const double COH_KEEP_WORK = 30, COH_HIT_WORK = 4;
-// Recording pays only when the next frame saves this many times what it costs (coh_plan): the
-// weights are good to a fifth, and the share of units to trace again is the frame before's.
-const double COH_MARGIN = 1.5;
+const double COH_NOTE_WORK = 200, COH_CELL_WORK = 10;
 
 double trace_work(const Counters &k) {
     double rays = k.rays[0] + k.rays[1] + k.rays[2] + k.rays[3];
@@ -8647,6 +8638,15 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
 // the render driver samples alone. The records of a frame are at most COH_BYTES; a frame that
 // cannot have them is traced in full (docs/acceleration.md, "Image sequences").
 #ifndef PRAY_NO_SEQUENCES  // (a build without them: option coherence changes nothing)
+const double COH_WORD_WORK = 2, COH_KEEP_WORK = 30, COH_HIT_WORK = 4;  // (with COH_RAY_WORK ..., section 10)
+// Recording pays only when the next frame saves this many times what it costs (coh_plan): the
+// weights are good to a fifth, and the share of units to trace again is the frame before's.
+const double COH_MARGIN = 1.5;
+inline size_t coh_slots(size_t units, int width, bool bands) {
+    return bands ? (units + 3) / 4 : (units / (size_t)width + 7) / 8 * (((size_t)width + 7) / 8);
+}
+inline bool same_real(real a, real b) { return same_bytes(&a, &b, sizeof a); }
+inline bool same_r3(R3 a, R3 b) { return same_real(a.x, b.x) && same_real(a.y, b.y) && same_real(a.z, b.z); }
 const double COH_BYTES = 64.0 * 1048576;  // the records of a frame at most
 const int COH_CELLS = 12;                 // cells along an axis at most (4 at least)
 
@@ -10519,6 +10519,7 @@ pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, cons
         if (st == PRAY_OK && coh) st = coh_keep(c, &s, out.rgb, &plan);
         if (st != PRAY_OK || !coh) coh_release(c);
 #else
+        coh_release(c);  // (nothing to release)
         st = render_scene(c, &s, r, out, &plan);
 #endif
     }
