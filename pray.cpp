@@ -11984,6 +11984,20 @@ Stmt *parse_include(Parser &P, const Tok &t) {
     return next_line(P) ? NULL : s;
 }
 
+// The statements of a block, up to the word that ends it (*stop), into *body and *n.
+bool parse_body(Parser &P, Stmt ***body, int *n, const char **stop) {
+    Array<Stmt *> a;
+    a.init();
+    bool ok = parse_block(P, &a, stop);
+    if (ok) {
+        *body = freeze_stmts(P, a);
+        *n = a.n;
+        ok = *body != NULL;
+    }
+    a.release(P.c);
+    return ok;
+}
+
 // if COND [then] ... [else ...] endif, or while COND ... endwhile (t: the word).
 Stmt *parse_block_statement(Parser &P, const Tok &t) {
     bool is_if = is_word(t, "if");
@@ -12009,30 +12023,11 @@ Stmt *parse_block_statement(Parser &P, const Tok &t) {
         syn(P, word, "%s", nest_message(msg, sizeof msg, "blocks", P.maxnest, P.base));
         return NULL;
     }
-    Array<Stmt *> body;
-    body.init();
     const char *stop = NULL;
-    bool ok = parse_block(P, &body, &stop);
-    if (ok) {
-        s->body = freeze_stmts(P, body);
-        s->nbody = body.n;
-        ok = s->body != NULL;
-    }
-    body.release(P.c);
-    if (!ok) return NULL;
+    if (!parse_body(P, &s->body, &s->nbody, &stop)) return NULL;
     if (is_if && stop && strcmp(stop, "else") == 0) {
         P.pos++;
-        if (end_of_line(P)) return NULL;
-        Array<Stmt *> els;
-        els.init();
-        ok = parse_block(P, &els, &stop);
-        if (ok) {
-            s->els = freeze_stmts(P, els);
-            s->nels = els.n;
-            ok = s->els != NULL;
-        }
-        els.release(P.c);
-        if (!ok) return NULL;
+        if (end_of_line(P) || !parse_body(P, &s->els, &s->nels, &stop)) return NULL;
     }
     const char *want = is_if ? "endif" : "endwhile";
     if (!stop || strcmp(stop, want) != 0) {

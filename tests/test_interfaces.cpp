@@ -15,16 +15,10 @@
 namespace {
 
 using testkit::Frame;
+using testkit::vec;
 
-pray_vec V(double x, double y, double z) {
-    pray_vec v;
-    v.x = x;
-    v.y = y;
-    v.z = z;
-    return v;
-}
 double dot(pray_vec a, pray_vec b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-pray_vec cross(pray_vec a, pray_vec b) { return V(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x); }
+pray_vec cross(pray_vec a, pray_vec b) { return vec(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x); }
 double len(pray_vec a) { return std::sqrt(dot(a, a)); }
 
 // The tolerance of directions and distances: the renderer's precision (PRAY_REAL double or float).
@@ -133,10 +127,10 @@ TEST_CASE("interfaces: a face between boxes of one material is none; between two
     pray_rgb t = {0.9, 0.9, 0.9};
     pray_model *g1 = pray_transparent(c, t, 1.5), *g2 = pray_transparent(c, t, 1.5), *g3 = pray_transparent(c, t, 1.4);
     for (pray_model *m : {g2, g3}) {
-        pray_object *root = pray_csg(c, PRAY_UNION, pray_box(c, g1, V(-1, -1, -1), V(0, 1, 1)), pray_box(c, m, V(0, -1, -1), V(1, 1, 1)));
+        pray_object *root = pray_csg(c, PRAY_UNION, pray_box(c, g1, vec(-1, -1, -1), vec(0, 1, 1)), pray_box(c, m, vec(0, -1, -1), vec(1, 1, 1)));
         pray_scene *s = pray_prepare(c, root);
         REQUIRE(s);
-        std::vector<pray_hit> h = hits_of(c, s, V(-3, 0.1, 0.2), V(1, 0, 0));
+        std::vector<pray_hit> h = hits_of(c, s, vec(-3, 0.1, 0.2), vec(1, 0, 0));
         if (m == g2) {  // equal values made apart: one material, one solid
             REQUIRE(h.size() == 2);
             CHECK(h[0].t == 2);
@@ -159,19 +153,19 @@ TEST_CASE("interfaces: a slab inside a slab of the same index is invisible at th
     pray_rgb one = {1, 1, 1}, z = {0, 0, 0};
     pray_model *outer = pray_transparent(c, one, 1.5);
     pray_model *inner = pray_model_add(c, pray_transparent(c, one, 1.5), pray_phong(c, z, z, z, 2));
-    pray_object *root = pray_csg(c, PRAY_UNION, pray_box(c, outer, V(-2, -2, -1), V(2, 2, 1)),
-                                 pray_box(c, inner, V(-1, -1, -0.5), V(1, 1, 0.5)));
+    pray_object *root = pray_csg(c, PRAY_UNION, pray_box(c, outer, vec(-2, -2, -1), vec(2, 2, 1)),
+                                 pray_box(c, inner, vec(-1, -1, -0.5), vec(1, 1, 0.5)));
     pray_scene *s = pray_prepare(c, root);
     REQUIRE(s);
-    pray_vec d = V(0.3, 0.2, -1);
-    d = V(d.x / len(d), d.y / len(d), d.z / len(d));
-    std::vector<pray_hit> h = hits_of(c, s, V(0, 0, 3), d);
+    pray_vec d = vec(0.3, 0.2, -1);
+    d = vec(d.x / len(d), d.y / len(d), d.z / len(d));
+    std::vector<pray_hit> h = hits_of(c, s, vec(0, 0, 3), d);
     REQUIRE(h.size() == 4);  // into the outer slab, into the inner one, out of it, out of the outer
     CHECK(h[0].entering == 1);
     CHECK(h[1].entering == 2);
     CHECK(h[2].entering == 2);
     CHECK(h[3].entering == 0);
-    CHECK(h[1].t == doctest::Approx(0.5 * len(V(0.3, 0.2, -1)) * 5));
+    CHECK(h[1].t == doctest::Approx(0.5 * len(vec(0.3, 0.2, -1)) * 5));
     for (int k = 1; k <= 2; k++) {  // the ratio 1.5 / 1.5: straight on
         CHECK(h[k].refracted.x == doctest::Approx(d.x).epsilon(tol()));
         CHECK(h[k].refracted.y == doctest::Approx(d.y).epsilon(tol()));
@@ -187,20 +181,20 @@ TEST_CASE("interfaces: water in a glass bends at the inner wall by Snell's law w
     pray_rgb t = {0.9, 0.9, 0.9};
     pray_model *glass = pray_transparent(c, t, 1.5), *water = pray_transparent(c, t, 1.33);
     // a glass of wall 0.2 and bottom 0.2 on the origin, water to 1.5 inside, written after it
-    pray_object *cup = pray_csg(c, PRAY_DIFFERENCE, pray_rod(c, glass, V(0, 0, 0), V(0, 0, 2), 1),
-                                pray_rod(c, glass, V(0, 0, 0.2), V(0, 0, 3), 0.8));
-    pray_object *root = pray_csg(c, PRAY_UNION, cup, pray_rod(c, water, V(0, 0, 0.2), V(0, 0, 1.5), 0.8));
+    pray_object *cup = pray_csg(c, PRAY_DIFFERENCE, pray_rod(c, glass, vec(0, 0, 0), vec(0, 0, 2), 1),
+                                pray_rod(c, glass, vec(0, 0, 0.2), vec(0, 0, 3), 0.8));
+    pray_object *root = pray_csg(c, PRAY_UNION, cup, pray_rod(c, water, vec(0, 0, 0.2), vec(0, 0, 1.5), 0.8));
     pray_scene *s = pray_prepare(c, root);
     REQUIRE(s);
     for (double a : {0.0, 0.3, 0.6, 0.9}) {
         CAPTURE(a);
         // from inside the wall at (0.9, 0, 1) towards the axis, tilted down by a
-        pray_vec d = V(-std::cos(a), 0.1, -std::sin(a));
-        std::vector<pray_hit> h = hits_of(c, s, V(0.9, 0, 1), d);
+        pray_vec d = vec(-std::cos(a), 0.1, -std::sin(a));
+        std::vector<pray_hit> h = hits_of(c, s, vec(0.9, 0, 1), d);
         REQUIRE(h.size() >= 2);
         CHECK(h[0].entering == 2);  // glass -> water at the inner wall, x = 0.8
         double u = h[0].t / len(d);  // (t is along the unit direction)
-        pray_vec p = V(0.9 + u * d.x, u * d.y, 1 + u * d.z);
+        pray_vec p = vec(0.9 + u * d.x, u * d.y, 1 + u * d.z);
         double r = std::hypot(p.x, p.y);
         CHECK(r == doctest::Approx(0.8).epsilon(tol()));
         CHECK(h[0].normal.x == doctest::Approx(p.x / r).epsilon(100 * tol()));  // the wall's, out of the glass
@@ -210,15 +204,15 @@ TEST_CASE("interfaces: water in a glass bends at the inner wall by Snell's law w
         CHECK(std::fabs(1.5 * s1 - 1.33 * s2) < tol());
         CHECK(s2 > s1);
         // and back: from the water into the glass, where the ray may be reflected whole
-        pray_vec e = V(std::cos(a), 0.1, -std::sin(a) * 0.5);
-        std::vector<pray_hit> k = hits_of(c, s, V(0, 0, 1), e);
+        pray_vec e = vec(std::cos(a), 0.1, -std::sin(a) * 0.5);
+        std::vector<pray_hit> k = hits_of(c, s, vec(0, 0, 1), e);
         REQUIRE(k.size() >= 2);
         CHECK(k[0].entering == 2);
         snell_sines(e, k[0].normal, k[0].refracted, &s1, &s2);
         CHECK(std::fabs(1.33 * s1 - 1.5 * s2) < tol());
     }
     // where the water meets air: its own index, the glass's at the glass
-    std::vector<pray_hit> up = hits_of(c, s, V(0.3, 0, 1), V(0, 0, 1));
+    std::vector<pray_hit> up = hits_of(c, s, vec(0.3, 0, 1), vec(0, 0, 1));
     REQUIRE(up.size() == 1);
     CHECK(up[0].entering == 0);
     pray_free(c);

@@ -20,15 +20,9 @@
 namespace {
 
 using testkit::Frame;
+using testkit::vec;
 using testkit::Result;
 
-pray_vec vec3(double x, double y, double z) {
-    pray_vec v;
-    v.x = x;
-    v.y = y;
-    v.z = z;
-    return v;
-}
 pray_rgb rgb3(double r, double g, double b) {
     pray_rgb c;
     c.r = r;
@@ -381,9 +375,9 @@ TEST_CASE("perspective: pixel centres at u = 2(i+1/2)/W - 1, v = 2(j+1/2)/H - 1,
     pray_option(c, "width", 4);
     pray_option(c, "height", 2);
     pray_background(c, rgb3(0.9, 0.9, 0.9), rgb3(0.9, 0.9, 0.9));
-    REQUIRE(pray_perspective(c, vec3(1, 0, 0), vec3(0, 0, 1), vec3(0, -4, 0), vec3(0, 0, 0)) == PRAY_OK);
-    pray_object *o = pray_csg(c, PRAY_UNION, pray_sphere(c, pray_color(c, rgb3(1, 0, 0)), vec3(0.75, 0, -0.5), 0.1),
-                              pray_sphere(c, pray_color(c, rgb3(0, 1, 0)), vec3(-0.75, 0, 0.5), 0.1));
+    REQUIRE(pray_perspective(c, vec(1, 0, 0), vec(0, 0, 1), vec(0, -4, 0), vec(0, 0, 0)) == PRAY_OK);
+    pray_object *o = pray_csg(c, PRAY_UNION, pray_sphere(c, pray_color(c, rgb3(1, 0, 0)), vec(0.75, 0, -0.5), 0.1),
+                              pray_sphere(c, pray_color(c, rgb3(0, 1, 0)), vec(-0.75, 0, 0.5), 0.1));
     pray_image img;
     REQUIRE(pray_render(c, o, NULL, &img) == PRAY_OK);
     Frame g;
@@ -454,43 +448,43 @@ TEST_CASE("two lights add; lights combine with | and +") {
 // The API and the language build the same image
 // =============================================================================================
 namespace {
-pray_vec v_sub(pray_vec a, pray_vec b) { return vec3(a.x - b.x, a.y - b.y, a.z - b.z); }
-pray_vec v_mul(pray_vec a, double s) { return vec3(a.x * s, a.y * s, a.z * s); }
+pray_vec v_sub(pray_vec a, pray_vec b) { return vec(a.x - b.x, a.y - b.y, a.z - b.z); }
+pray_vec v_mul(pray_vec a, double s) { return vec(a.x * s, a.y * s, a.z * s); }
 pray_vec v_cross(pray_vec a, pray_vec b) {
-    return vec3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
+    return vec(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);
 }
 pray_vec v_norm(pray_vec a) { return v_mul(a, 1.0 / std::sqrt(a.x * a.x + a.y * a.y + a.z * a.z)); }
 
 // CSG.RAY of the thesis (examples/csg.ray), built through the API.
 pray_object *csg_ray_scene(pray_ctx *c, pray_light **light) {
-    pray_vec X = vec3(1, 0, 0), Eye = vec3(2, -5, 2), Point = vec3(0.5, 0.5, 0.5);
+    pray_vec X = vec(1, 0, 0), Eye = vec(2, -5, 2), Point = vec(0.5, 0.5, 0.5);
     pray_vec View = v_sub(Point, Eye);
     pray_vec Y = v_mul(v_norm(v_cross(X, View)), -1.1);
     X = v_mul(v_norm(v_cross(Y, View)), 1.1);
     if (pray_perspective(c, X, Y, Eye, Point) != PRAY_OK) return NULL;
-    *light = pray_dirlight(c, rgb3(1, 1, 1), vec3(-0.3, 0.6, -0.4));
+    *light = pray_dirlight(c, rgb3(1, 1, 1), vec(-0.3, 0.6, -0.4));
     pray_model *White = pray_phong(c, rgb3(0.6, 0.6, 0.6), rgb3(0.3, 0.3, 0.3), rgb3(0.1, 0.1, 0.1), 10);
-    pray_object *o1 = pray_plane(c, White, vec3(-0.1, 0, 0), vec3(-1, 0, 0));
-    pray_object *o2 = pray_plane(c, White, vec3(0.1, 0, 0), vec3(1, 0, 0));
-    pray_object *o3 = pray_plane(c, White, vec3(0, -0.1, 0), vec3(0, -1, 0));
-    pray_object *o4 = pray_plane(c, White, vec3(0, 0.1, 0), vec3(0, 1, 0));
-    pray_object *o5 = pray_plane(c, White, vec3(0, 0, -0.1), vec3(0, 0, -1));
-    pray_object *o6 = pray_plane(c, White, vec3(0, 0, 0.1), vec3(0, 0, 1));
+    pray_object *o1 = pray_plane(c, White, vec(-0.1, 0, 0), vec(-1, 0, 0));
+    pray_object *o2 = pray_plane(c, White, vec(0.1, 0, 0), vec(1, 0, 0));
+    pray_object *o3 = pray_plane(c, White, vec(0, -0.1, 0), vec(0, -1, 0));
+    pray_object *o4 = pray_plane(c, White, vec(0, 0.1, 0), vec(0, 1, 0));
+    pray_object *o5 = pray_plane(c, White, vec(0, 0, -0.1), vec(0, 0, -1));
+    pray_object *o6 = pray_plane(c, White, vec(0, 0, 0.1), vec(0, 0, 1));
     pray_object *Cube = o1;
     pray_object *rest[] = {o2, o3, o4, o5, o6};
     for (int i = 0; i < 5; i++) Cube = pray_csg(c, PRAY_INTERSECTION, Cube, rest[i]);
-    pray_object *o7 = pray_cylinder(c, White, vec3(0, 0, 0), vec3(0, 0, 1), 0.05);
-    pray_object *o8 = pray_plane(c, White, vec3(0, 0, 0.15), vec3(0, 0, 1));
-    pray_object *o9 = pray_plane(c, White, vec3(0, 0, -0.15), vec3(0, 0, -1));
+    pray_object *o7 = pray_cylinder(c, White, vec(0, 0, 0), vec(0, 0, 1), 0.05);
+    pray_object *o8 = pray_plane(c, White, vec(0, 0, 0.15), vec(0, 0, 1));
+    pray_object *o9 = pray_plane(c, White, vec(0, 0, -0.15), vec(0, 0, -1));
     pray_object *Cylinder = pray_csg(c, PRAY_INTERSECTION, pray_csg(c, PRAY_INTERSECTION, o7, o8), o9);
     pray_object *Uni = pray_csg(c, PRAY_UNION, Cube, Cylinder);
     pray_object *Int = pray_csg(c, PRAY_INTERSECTION, Cube, Cylinder);
     pray_object *Dif = pray_csg(c, PRAY_DIFFERENCE, Cube, Cylinder);
-    pray_object *Ope = pray_csg(c, PRAY_UNION, pray_csg(c, PRAY_UNION, pray_translate(c, Uni, vec3(-0.3, 0, 0)), Dif),
-                                pray_translate(c, Int, vec3(0.25, 0, 0)));
-    pray_object *Pri = pray_csg(c, PRAY_UNION, pray_translate(c, Cube, vec3(-0.15, 0, 0.4)),
-                                pray_translate(c, Cylinder, vec3(0.2, 0, 0.4)));
-    return pray_translate(c, pray_scale(c, pray_csg(c, PRAY_UNION, Ope, Pri), 1.3), vec3(0.55, 0.5, 0.25));
+    pray_object *Ope = pray_csg(c, PRAY_UNION, pray_csg(c, PRAY_UNION, pray_translate(c, Uni, vec(-0.3, 0, 0)), Dif),
+                                pray_translate(c, Int, vec(0.25, 0, 0)));
+    pray_object *Pri = pray_csg(c, PRAY_UNION, pray_translate(c, Cube, vec(-0.15, 0, 0.4)),
+                                pray_translate(c, Cylinder, vec(0.2, 0, 0.4)));
+    return pray_translate(c, pray_scale(c, pray_csg(c, PRAY_UNION, Ope, Pri), 1.3), vec(0.55, 0.5, 0.25));
 }
 
 Frame render_api_csg(int w, int h) {
@@ -643,7 +637,7 @@ TEST_CASE("a memory limit makes a render fail with PRAY_ERR_NOMEM and a message"
     pray_ctx *c = pray_new();
     pray_option(c, "width", 64);
     pray_option(c, "height", 64);
-    pray_object *s = pray_sphere(c, pray_color(c, rgb3(1, 0, 0)), vec3(0, 0, 0), 1);
+    pray_object *s = pray_sphere(c, pray_color(c, rgb3(1, 0, 0)), vec(0, 0, 0), 1);
     REQUIRE(s != NULL);
     pray_set_memory_limit(c, 8192);  // the 64 x 64 float image alone needs 48 KiB
     pray_image img;

@@ -12,6 +12,12 @@
 
 namespace testkit {
 
+// A vector of the API from its three components.
+inline pray_vec vec(double x, double y, double z) {
+    pray_vec v = {x, y, z};
+    return v;
+}
+
 // The command-line program the tests start: $PRAY (CTest sets it to the program it built), else
 // ./pray, where make builds it. pray_shell() is the same, quoted for the shell.
 inline std::string pray_program() {
