@@ -130,10 +130,10 @@ sections:
 # precision, three in float, test_buffers.cpp without file access, each run as tests/quick.sh
 # chooses; the C example; the programs of the manual; the options as --help and the manual
 # present them; every fifth case of the bad inputs.
-QUICK_TESTS = test_main test_internal test_smoke test_lang test_lang2 test_render test_sampling \
+QUICK_TESTS = test_main test_internal test_smoke test_lang test_lang2 test_lang3 test_render test_sampling \
               test_accel test_coherence test_gallery test_docs test_buffers test_image test_texture \
               test_api test_limits test_interfaces
-QUICK_FLOAT = test_main test_smoke test_render test_gallery
+QUICK_FLOAT = test_main test_smoke test_render test_gallery test_lang3
 QUICKFLAGS = -std=c++17 -O0 -Wall -Wextra -DPRAY_CHECKS
 QUICK = build/quick/pray_tests$(EXE) build/quick/pray_tests_float$(EXE) build/quick/pray_tests_nostdio$(EXE)
 build/quick/%.o: tests/%.cpp $(TEST_HDR) | deps

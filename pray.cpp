@@ -8,7 +8,7 @@
    [SECTION] 2     300  Context: allocator with a cap, status and messages
    [SECTION] 3     100  Tiny containers on the context allocator
    [SECTION] 4     200  Vector math and the `.` transformations
-   [SECTION] 5     650  Scene values: models, lights, solids (reference counted handles)
+   [SECTION] 5     700  Scene values: models, lights, solids (reference counted handles)
    [SECTION] 6     150  Options
    [SECTION] 7    1150  Prepared scene: flattened n-ary CSG tree, boxes, simplification, snapping
    [SECTION] 8     450  Ray/primitive intersection; primitives in a frame (box, rod, cone, torus,
@@ -23,13 +23,13 @@
    [SECTION] 10   1200  Whitted shading, textured surfaces, the render driver (threads, undersampling)
    [SECTION] 10b   600  Image sequences (3.7): the regions a ray crosses, comparing a frame's scene
                           with the one before, records
-   [SECTION] 11   1750  Image writers: TIFF, PPM, PNG; writing files safely; public functions
+   [SECTION] 11   1800  Image writers: TIFF, PPM, PNG; writing files safely; public functions
    [SECTION] 12    500  PRAY lexer
-   [SECTION] 13    800  PRAY parser
-   [SECTION] 14   1500  PRAY interpreter: values, operators, builtins, statements
+   [SECTION] 13   1100  PRAY parser
+   [SECTION] 14   1650  PRAY interpreter: values, operators, builtins, statements
    [SECTION] 15    200  One-call helpers and the running of programs
    [SECTION] 16    800  Command-line program (PRAY_MAIN)
-   The whole file: at most 14600 lines.
+   The whole file: at most 15200 lines.
 */
 
 // =============================================================================================
@@ -1084,7 +1084,7 @@ pray_vec xf_normal(const Xform &f, pray_vec n) { return xf_dir(f, n); }
 namespace {
 enum HandleKind { H_OBJECT = 1, H_MODEL, H_LIGHT, H_KIDS, H_STRING, H_TEXTURE };
 // Models: plain coefficients, or a tree of textured parts evaluated where a ray hits.
-enum ModelKind { M_FLAT, M_TEX, M_BUMP, M_MOVE, M_SUM, M_SCALE };
+enum ModelKind { M_FLAT, M_TEX, M_BUMP, M_MOVE, M_SUM, M_SCALE, M_CHECK };
 // Texture coordinates of a primitive: none, a plane's, a sphere's.
 enum MapKind { MAP_NONE, MAP_PLANE, MAP_SPHERE };
 const int MAX_MODEL_DEPTH = 256;
@@ -1114,6 +1114,9 @@ struct LightSrc {
     int point;  // 1: point light at v; 0: directional light travelling along v
     pray_rgb intensity;
     pray_vec v;
+    int spot;     // a point light that shines along d: fully within a1 degrees of it, not beyond a2
+    pray_vec d;
+    double a1, a2;
 };
 struct Kids;
 } // namespace
@@ -1125,7 +1128,8 @@ struct pray_model {
     int has_exponent, has_index;
     // M_TEX: a (where the texture is 0) and b (where it is 1) blended by tex; M_BUMP: a with its
     // normal tilted by amount x the texture's luminance gradient; M_MOVE: a with its texture
-    // coordinates shifted by (dx, dy); M_SUM: a + b; M_SCALE: a x factor.
+    // coordinates shifted by (dx, dy); M_SUM: a + b; M_SCALE: a x factor; M_CHECK: a where the
+    // cells of side `amount` of the primitive's pattern coordinates have an even sum, else b.
     int kind, depth;
     pray_model *a, *b;
     struct pray_texture *tex;
@@ -1136,7 +1140,7 @@ struct pray_model {
     // shifted along any path of moves; no mirror and no transparency anywhere (model_lit_only);
     // the pyramids of its textures are built (model_pyramids).
     double clear, parts, shift;
-    int lit_only, pyramids;
+    int lit_only, pyramids, checks;  // checks: an M_CHECK anywhere
     double most[3];  // not M_FLAT: model_most
 };
 
@@ -1171,6 +1175,9 @@ struct pray_object {
     // world. NULL: they are in the world. box, rod, cone and torus always have one; a sphere or a
     // cylinder gets one when stretched. (A half-space is stretched exactly without one.)
     Xform *fr;
+    // A primitive whose model has a checker: the map from its pattern's coordinates (the world's
+    // when it was made or painted) to the world. NULL: the world's (not moved since).
+    Xform *pat;
     Kids *kids;
     int nkids, k0;
     long nprims;
@@ -1208,6 +1215,7 @@ void release_handle(pray_ctx *c, void *p) {
         release_handle(c, o->kids);
         mem_free(c, o->map);
         mem_free(c, o->fr);
+        mem_free(c, o->pat);
         break;
     }
     case H_KIDS: {
@@ -1266,6 +1274,15 @@ pray_object *obj_new(pray_ctx *c, int kind, pray_model *m) {
     o->nprims = is_prim(kind) ? 1 : 0;
     o->depth = 1;
     return o;
+}
+
+// The pattern of primitive a, moved by f, for its copy o (a checker moves with its primitive);
+// false when out of memory.
+bool pat_carry(pray_ctx *c, pray_object *o, const pray_object *a, const Xform &f) {
+    if (!a->mat || !a->mat->checks) return true;
+    o->pat = (Xform *)mem_alloc(c, sizeof(Xform));
+    if (o->pat) *o->pat = a->pat ? xf_compose(f, *a->pat) : f;
+    return o->pat != NULL;
 }
 
 // Give primitive o texture coordinates; false when out of memory.
@@ -1424,7 +1441,8 @@ pray_object *obj_reframe(pray_ctx *c, const pray_object *a, const Xform &f, cons
     o->r = a->r;
     o->r2 = a->r2;
     o->fr = (Xform *)mem_alloc(c, sizeof(Xform));
-    if (!o->fr || (a->map && !obj_map(c, o, a->map->kind, a->map->u, a->map->v, a->map->mirrored))) {
+    if (!o->fr || (a->map && !obj_map(c, o, a->map->kind, a->map->u, a->map->v, a->map->mirrored)) ||
+        !pat_carry(c, o, a, f)) {
         release_handle(c, o);
         return NULL;
     }
@@ -1436,6 +1454,30 @@ pray_object *obj_reframe(pray_ctx *c, const pray_object *a, const Xform &f, cons
     }
     return o;
 }
+
+// Node o of a copy of tree a: its children made by fn(c, child, arg); o, or NULL (o freed).
+pray_object *copy_kids(pray_ctx *c, pray_object *o, const pray_object *a,
+                       pray_object *(*fn)(pray_ctx *, pray_object *, const void *), const void *arg) {
+    o->kids = kids_new(c, a->nkids);
+    for (int i = 0; o->kids && i < a->nkids; i++) {
+        pray_object *k = fn(c, kid(a, i), arg);
+        if (!k) break;
+        o->kids->k[o->kids->used++] = k;
+    }
+    if (!o->kids || o->kids->used < a->nkids) {
+        release_handle(c, o);
+        return NULL;
+    }
+    o->nkids = a->nkids;
+    o->nprims = a->nprims;
+    o->depth = a->depth;
+    return o;
+}
+
+pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f);
+pray_object *obj_stretch(pray_ctx *c, pray_object *a, pray_vec v);
+pray_object *transform_kid(pray_ctx *c, pray_object *a, const void *f) { return obj_transform(c, a, *(const Xform *)f); }
+pray_object *stretch_kid(pray_ctx *c, pray_object *a, const void *v) { return obj_stretch(c, a, *(const pray_vec *)v); }
 
 // A copy of the tree with the map applied to every primitive.
 pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
@@ -1455,6 +1497,10 @@ pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
     default: break;
     }
     bool map_ok = true;
+    if (!pat_carry(c, o, a, f)) {
+        release_handle(c, o);
+        return NULL;
+    }
     if (a->map) {  // texture coordinates go with the solid, scale included
         if (!obj_map(c, o, a->map->kind, xf_dir(f, a->map->u), xf_dir(f, a->map->v),
                      a->map->mirrored ^ (xf_scale_of(f) < 0))) {
@@ -1478,25 +1524,7 @@ pray_object *obj_transform(pray_ctx *c, pray_object *a, const Xform &f) {
         fail(c, PRAY_ERR_ARG, "the transformation takes a primitive out of the range of numbers");
         return NULL;
     }
-    if (is_node(a->kind)) {
-        o->kids = kids_new(c, a->nkids);
-        if (!o->kids) {
-            release_handle(c, o);
-            return NULL;
-        }
-        for (int i = 0; i < a->nkids; i++) {
-            pray_object *k = obj_transform(c, kid(a, i), f);
-            if (!k) {
-                release_handle(c, o);
-                return NULL;
-            }
-            o->kids->k[o->kids->used++] = k;
-        }
-        o->nkids = a->nkids;
-        o->nprims = a->nprims;
-        o->depth = a->depth;
-    }
-    return o;
+    return is_node(a->kind) ? copy_kids(c, o, a, transform_kid, &f) : o;
 }
 
 // A copy of the tree scaled by the components of v along the world axes (none of them 0).
@@ -1511,6 +1539,10 @@ pray_object *obj_stretch(pray_ctx *c, pray_object *a, pray_vec v) {
     if (a->kind == O_PLANE) {
         o->p = vmake(a->p.x * v.x, a->p.y * v.y, a->p.z * v.z);
         o->v = vunit(vmake(a->v.x / v.x, a->v.y / v.y, a->v.z / v.z));
+        if (!pat_carry(c, o, a, xf_stretch(v))) {
+            release_handle(c, o);
+            return NULL;
+        }
         bool ok = vfinite(o->p) && vlen(o->v) > 0;
         if (ok && a->map) {
             // s = (x - p).u / |u|^2 for x = S y: u' = w |u|^2 / |w|^2 with w = S^-1 u
@@ -1533,24 +1565,28 @@ pray_object *obj_stretch(pray_ctx *c, pray_object *a, pray_vec v) {
         }
         return o;
     }
-    o->kids = kids_new(c, a->nkids);
-    if (!o->kids) {
+    return copy_kids(c, o, a, stretch_kid, &v);
+}
+
+// A copy of the tree with model m on every primitive (and `one`): shapes, frames and texture
+// coordinates stay; a checker in m takes the world's coordinates as they are now.
+pray_object *paint_kid(pray_ctx *c, pray_object *a, const void *m);
+pray_object *obj_paint(pray_ctx *c, pray_object *a, pray_model *m) {
+    pray_object *o = obj_new(c, a->kind, is_node(a->kind) || a->kind == O_NOTHING ? NULL : m);
+    if (!o) return NULL;
+    o->p = a->p;
+    o->v = a->v;
+    o->r = a->r;
+    o->r2 = a->r2;
+    o->fr = a->fr ? (Xform *)mem_alloc(c, sizeof(Xform)) : NULL;
+    if ((a->fr && !o->fr) || (a->map && !obj_map(c, o, a->map->kind, a->map->u, a->map->v, a->map->mirrored))) {
         release_handle(c, o);
         return NULL;
     }
-    for (int i = 0; i < a->nkids; i++) {
-        pray_object *k = obj_stretch(c, kid(a, i), v);
-        if (!k) {
-            release_handle(c, o);
-            return NULL;
-        }
-        o->kids->k[o->kids->used++] = k;
-    }
-    o->nkids = a->nkids;
-    o->nprims = a->nprims;
-    o->depth = a->depth;
-    return o;
+    if (a->fr) *o->fr = *a->fr;
+    return is_node(a->kind) ? copy_kids(c, o, a, paint_kid, m) : o;
 }
+pray_object *paint_kid(pray_ctx *c, pray_object *a, const void *m) { return obj_paint(c, a, (pray_model *)m); }
 
 pray_light *light_transform(pray_ctx *c, const pray_light *a, const Xform &f) {
     pray_light *l = light_new(c, a->n);
@@ -1558,7 +1594,9 @@ pray_light *light_transform(pray_ctx *c, const pray_light *a, const Xform &f) {
     for (int i = 0; i < a->n; i++) {
         l->src[i] = a->src[i];
         l->src[i].v = a->src[i].point ? xf_point(f, a->src[i].v) : xf_dir(f, a->src[i].v);
-        if (!vfinite(l->src[i].v) || (!l->src[i].point && vmaxabs(l->src[i].v) == 0)) {
+        l->src[i].d = xf_dir(f, a->src[i].d);
+        if (!vfinite(l->src[i].v) || (!l->src[i].point && vmaxabs(l->src[i].v) == 0) ||
+            (l->src[i].spot && (!vfinite(l->src[i].d) || vmaxabs(l->src[i].d) == 0))) {
             release_handle(c, l);
             fail(c, PRAY_ERR_ARG, "the transformation takes a light out of the range of numbers");
             return NULL;
@@ -1643,6 +1681,7 @@ pray_model *model_node(pray_ctx *c, int kind, pray_model *a, pray_model *b, doub
     m->parts = parts;
     m->shift = shift;
     m->lit_only = model_lit_only(a) && (!b || model_lit_only(b));
+    m->checks = kind == M_CHECK || a->checks || (b && b->checks);
     for (int i = 0; i < 3; i++) {
         double ma = model_most(a, i), mb = b ? model_most(b, i) : 0;
         m->most[i] = kind == M_SUM ? ma + mb : ma > mb ? ma : mb;
@@ -1872,6 +1911,10 @@ inline R3 operator+(R3 a, R3 b) { return r3(a.x + b.x, a.y + b.y, a.z + b.z); }
 inline R3 operator-(R3 a, R3 b) { return r3(a.x - b.x, a.y - b.y, a.z - b.z); }
 inline R3 operator*(R3 a, real s) { return r3(a.x * s, a.y * s, a.z * s); }
 inline real dot(R3 a, R3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline real absmax(R3 a) {
+    real x = a.x < 0 ? -a.x : a.x, y = a.y < 0 ? -a.y : a.y, z = a.z < 0 ? -a.z : a.z;
+    return x > y ? (x > z ? x : z) : (y > z ? y : z);
+}
 inline R3 cross(R3 a, R3 b) { return r3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x); }
 inline R3 unit(R3 a) {
     real l = (real)sqrt((double)dot(a, a));
@@ -1904,6 +1947,7 @@ struct Box {
 struct PrimMap {
     R3 u, v;
     int mirrored;  // longitudes of a spheremap run the other way
+    R3 pt, pinv[3];  // a model with a checker: the pattern's coordinates of world x, pinv (x - pt)
 };
 
 // A primitive's own frame in render precision (local = inv (x - t)), and what the primitive
@@ -1951,6 +1995,9 @@ struct Light {
     int point;
     R3 v;        // position, or unit direction towards the light
     pray_rgb intensity;
+    int spot;    // a spotlight: along unit d, full within a1 degrees, nothing beyond a2
+    R3 d;
+    double a1, a2;
 };
 
 struct Accel;
@@ -2393,16 +2440,22 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
         q.mat = o->mat;
         q.parent = -1;
         q.id = s->leaves++;
-        if (o->map) {
-            PrimMap *m = (PrimMap *)mem_alloc(c, sizeof(PrimMap));
+        if (o->map || o->mat->checks) {
+            PrimMap *m = (PrimMap *)mem_zalloc(c, sizeof(PrimMap));
             if (!m || !s->maps.push(c, m)) {
                 mem_free(c, m);
                 return -3;
             }
-            m->u = r3of(o->map->u);
-            m->v = r3of(o->map->v);
-            m->mirrored = o->map->mirrored;
-            q.map = o->map->kind;
+            if (o->map) {
+                m->u = r3of(o->map->u);
+                m->v = r3of(o->map->v);
+                m->mirrored = o->map->mirrored;
+                q.map = o->map->kind;
+            }
+            Xform inv = xf_identity();
+            if (o->pat) xf_inverse(*o->pat, &inv);  // (its moves had inverses)
+            m->pt = r3of(o->pat ? o->pat->t : vmake(0, 0, 0));
+            for (int i = 0; i < 3; i++) m->pinv[i] = r3of(vmake(inv.m[i][0], inv.m[i][1], inv.m[i][2]));
             q.tm = m;
         }
         if (o->kind == O_SPHERE) {
@@ -3766,7 +3819,7 @@ struct FirstHit {
 
 // Transmission along a shadow ray: the product of the transmit weights of every surface
 // crossed; stops at the first opaque one, at t.
-pray_rgb transmit_at(const Prim &q, R3 x);
+pray_rgb transmit_at(const Prim &q, R3 x, R3 d, bool ahead);
 
 struct ShadowHit {
     const Scene *s;
@@ -3776,7 +3829,7 @@ struct ShadowHit {
     bool operator()(const Hit &x) {
         if (x.from >= 0) return true;  // (a face between materials inside the solid: trace)
         const Prim &q = s->prims[x.prim];
-        f = cmul(f, q.mat->kind == M_FLAT ? q.mat->transmit : transmit_at(q, ray->o + ray->d * x.t));
+        f = cmul(f, q.mat->kind == M_FLAT ? q.mat->transmit : transmit_at(q, ray->o + ray->d * x.t, ray->d, x.root_enter));
         if (!czero(f)) return true;
         t = x.t;
         return false;
@@ -7546,7 +7599,8 @@ void shade_blend(Shade *o, const Shade &a, const Shade &b, pray_rgb wa, pray_rgb
     o->bt = a.bt + b.bt;
 }
 
-void shade_of(const pray_model *m, double s, double t, Shade *o) {
+// Model m at texture coordinates (s, t) and pattern point cell (checkers).
+void shade_of(const pray_model *m, double s, double t, Shade *o, R3 cell = R3()) {
     switch (m->kind) {
     case M_FLAT:
         o->diffuse = m->diffuse;
@@ -7563,30 +7617,35 @@ void shade_of(const pray_model *m, double s, double t, Shade *o) {
         return;
     case M_TEX: {
         Shade a, b;
-        shade_of(m->a, s, t, &a);
-        shade_of(m->b, s, t, &b);
+        shade_of(m->a, s, t, &a, cell);
+        shade_of(m->b, s, t, &b, cell);
         pray_rgb c = tex_lookup(m->tex, s, t);
         shade_blend(o, a, b, cmake(1 - c.r, 1 - c.g, 1 - c.b), c);
         return;
     }
     case M_BUMP: {
-        shade_of(m->a, s, t, o);
+        shade_of(m->a, s, t, o, cell);
         double es = 0.5 / m->tex->w, et = 0.5 / m->tex->hgt;  // half a texel
         o->bs += m->amount * (tex_luminance(m->tex, s + es, t) - tex_luminance(m->tex, s - es, t)) / (2 * es);
         o->bt += m->amount * (tex_luminance(m->tex, s, t + et) - tex_luminance(m->tex, s, t - et)) / (2 * et);
         return;
     }
-    case M_MOVE: shade_of(m->a, s + m->dx, t + m->dy, o); return;
+    case M_MOVE: shade_of(m->a, s + m->dx, t + m->dy, o, cell); return;
+    case M_CHECK: {
+        double k = floor((double)cell.x / m->amount) + floor((double)cell.y / m->amount) + floor((double)cell.z / m->amount);
+        shade_of(fmod(k, 2) == 0 ? m->a : m->b, s, t, o, cell);
+        return;
+    }
     case M_SUM: {
         Shade a, b;
-        shade_of(m->a, s, t, &a);
-        shade_of(m->b, s, t, &b);
+        shade_of(m->a, s, t, &a, cell);
+        shade_of(m->b, s, t, &b, cell);
         shade_blend(o, a, b, cmake(1, 1, 1), cmake(1, 1, 1));
         return;
     }
     default: {  // M_SCALE
         Shade a, zero;
-        shade_of(m->a, s, t, &a);
+        shade_of(m->a, s, t, &a, cell);
         memset(&zero, 0, sizeof zero);
         shade_blend(o, a, zero, m->factor, cmake(0, 0, 0));
         return;
@@ -7621,9 +7680,11 @@ bool tex_beyond(const pray_texture *tx, const double *s, const double *t, int n,
 
 // Whether the model's look may change between the samples by more than `th` in a way they do
 // not show: a texture or a bump map with detail between them (tex_beyond).
+// (A checker is taken to vary: its cells are not told by texture coordinates.)
 bool model_varies(const pray_model *m, const double *s, const double *t, int n, double th) {
     switch (m->kind) {
     case M_FLAT: return false;
+    case M_CHECK: return true;
     case M_TEX:
         return tex_beyond(m->tex, s, t, n, 0, th) || model_varies(m->a, s, t, n, th) || model_varies(m->b, s, t, n, th);
     case M_BUMP: return tex_beyond(m->tex, s, t, n, 0.5, th) || model_varies(m->a, s, t, n, th);
@@ -7646,12 +7707,37 @@ bool model_pyramids(pray_ctx *c, pray_model *m) {
     return true;
 }
 
-pray_rgb transmit_at(const Prim &q, R3 x) {
+// Where x on the face of primitive `face` lies in the pattern of q (a checker's cells), a tiny
+// step off the face along its normal: ahead of a ray along d when `ahead`, else behind it (into
+// the material the surface shows), so that a face on a cell boundary takes one cell whole.
+R3 pattern_point(const Prim &q, R3 x, const Prim &face, R3 d, bool ahead) {
+    const PrimMap &m = *q.tm;
+    R3 ng = prim_normal(face, x), v = x - m.pt;
+    if ((dot(ng, d) > 0) != ahead) ng = ng * (real)-1;
+    R3 p = r3(dot(m.pinv[0], v), dot(m.pinv[1], v), dot(m.pinv[2], v));
+    R3 into = unit(r3(dot(m.pinv[0], ng), dot(m.pinv[1], ng), dot(m.pinv[2], ng)));
+    real size = absmax(p) + absmax(v) * (absmax(m.pinv[0]) + absmax(m.pinv[1]) + absmax(m.pinv[2]));
+    return p + into * (real)(1024 * REAL_EPS * size + 1e-30);
+}
+
+// The model of primitive q at x on the face of `face` hit by a ray along d (`ahead`: the
+// material is ahead of the ray), the texture coordinates and their directions there.
+void shade_at(const Prim &q, R3 x, Shade *sh, double *ts, double *tt, R3 *ds, R3 *dt, const Prim &face, R3 d,
+              bool ahead) {
+    *ts = *tt = 0;
+    *ds = *dt = r3(0, 0, 0);
+    if (q.mat->kind == M_FLAT) shade_of(q.mat, 0, 0, sh);
+    else {
+        tex_coords(q, x, ts, tt, ds, dt);
+        shade_of(q.mat, *ts, *tt, sh, q.mat->checks ? pattern_point(q, x, face, d, ahead) : R3());
+    }
+}
+
+pray_rgb transmit_at(const Prim &q, R3 x, R3 d, bool ahead) {
     double s, t;
     R3 ds, dt;
-    tex_coords(q, x, &s, &t, &ds, &dt);
     Shade sh;
-    shade_of(q.mat, s, t, &sh);
+    shade_at(q, x, &sh, &s, &t, &ds, &dt, q, d, ahead);
     return sh.transmit;
 }
 
@@ -7683,6 +7769,19 @@ bool toward_light(const Light &L, R3 x, R3 *l, real *dist) {
     if (*dist == 0) return false;
     *l = v * ((real)1 / *dist);
     return true;
+}
+
+// The share of a spotlight's intensity that reaches x (section 12 of the language): all of it
+// within a1 degrees of its direction, none beyond a2, and t^2 (3 - 2t) between, t = (a2 - angle)
+// / (a2 - a1).
+double spot_share(const Light &L, R3 x) {
+    R3 v = x - L.v;
+    double len = sqrt((double)dot(v, v)), c = len > 0 ? (double)dot(v, L.d) / len : 1;
+    double a = acos(c > 1 ? 1 : c < -1 ? -1 : c) * (180 / 3.14159265358979323846);
+    if (a <= L.a1) return 1;
+    if (a >= L.a2) return 0;
+    double t = (L.a2 - a) / (L.a2 - L.a1);
+    return t * t * (3 - 2 * t);
 }
 
 // x to the power e for a highlight: by repeated squaring when e is a whole number up to 1024
@@ -7732,29 +7831,18 @@ inline bool refract_dir(R3 d, R3 n, double eta, R3 *out) {
     return true;
 }
 
-// The model of primitive q at x, and the texture coordinates and their directions there.
-void shade_at(const Prim &q, R3 x, Shade *sh, double *ts, double *tt, R3 *ds, R3 *dt) {
-    *ts = *tt = 0;
-    *ds = *dt = r3(0, 0, 0);
-    if (q.mat->kind == M_FLAT) shade_of(q.mat, 0, 0, sh);
-    else {
-        tex_coords(q, x, ts, tt, ds, dt);
-        shade_of(q.mat, *ts, *tt, sh);
-    }
-}
-
 // A ray reflected back to the side a ray came from starts inside the solid where the ray was
 // inside before hit h.
 inline int inside_before(const Hit &h) { return !h.root_enter || h.from >= 0; }
 
 // The ratio of the refractive indices across hit h at x (m: the model that shades it): the
 // material the ray leaves over the one it enters; empty space counts 1.
-double hit_eta(const Scene *s, const Hit &h, R3 x, const Shade &m) {
+double hit_eta(const Scene *s, const Hit &h, R3 x, R3 d, const Shade &m) {
     if (h.from < 0) return h.root_enter ? 1.0 / m.index : m.index;
     Shade f;
     double ts, tt;
     R3 ds, dt;
-    shade_at(s->prims[h.from], x, &f, &ts, &tt, &ds, &dt);
+    shade_at(s->prims[h.from], x, &f, &ts, &tt, &ds, &dt, s->prims[h.prim], d, false);
     return f.index / m.index;
 }
 
@@ -7800,7 +7888,7 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
     const Shade *m = &sh;
     double ts, tt;
     R3 ds, dt;
-    shade_at(qm, x, &sh, &ts, &tt, &ds, &dt);
+    shade_at(qm, x, &sh, &ts, &tt, &ds, &dt, q, ray.d, h.root_enter || h.from >= 0);
     bool outward = h.prim_enter == h.root_enter;
     R3 n = shading_normal(q, x, sh, ds, dt, outward, ray.d);
     bool record = seen && qm.mat->kind != M_FLAT && s->lights.n <= SEEN_LIGHTS && model_lit_only(qm.mat);
@@ -7822,8 +7910,8 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
         if (!toward_light(L, x, &l, &dist)) continue;
         real ndl = dot(n, l);
         if (ndl <= 0) continue;
-        pray_rgb li = L.intensity;
-        if (s->shadows) {
+        pray_rgb li = L.spot ? cscale(L.intensity, spot_share(L, x)) : L.intensity;
+        if (s->shadows && !czero(li)) {
             ShadowHit sh;
             Ray sr;
             sr.o = x;
@@ -7852,7 +7940,7 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
     if (!czero(m->transmit) && level < s->depth) {
         double wt = weight * rgb_maxabs(m->transmit);
         Ray rr;
-        if (!refract_dir(ray.d, n, h.from < 0 ? (h.root_enter ? 1.0 / m->index : m->index) : hit_eta(s, h, x, sh), &rr.d)) {
+        if (!refract_dir(ray.d, n, h.from < 0 ? (h.root_enter ? 1.0 / m->index : m->index) : hit_eta(s, h, x, ray.d, sh), &rr.d)) {
             refl = cadd(refl, m->transmit);  // total internal reflection
         } else if (worth_tracing(tr, level, wt)) {
             rr.o = x;
@@ -7986,6 +8074,10 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
         L.point = src.point;
         L.intensity = src.intensity;
         L.v = src.point ? r3of(src.v) : r3of(vmul(vunit(src.v), -1.0));
+        L.spot = src.spot;
+        L.d = r3of(src.spot ? vunit(src.d) : src.d);
+        L.a1 = src.a1;
+        L.a2 = src.a2;
         if (!s->lights.push(c, L)) return c->status;
     }
     scene_camera(c, s);
@@ -8152,10 +8244,10 @@ void public_hit(const Scene *s, const Ray &ray, const Hit &h, pray_hit *o) {
     Shade sh;
     double ts, tt;
     R3 ds, dt, rd = r3(0, 0, 0);
-    shade_at(s->prims[h.mat], x, &sh, &ts, &tt, &ds, &dt);
+    shade_at(s->prims[h.mat], x, &sh, &ts, &tt, &ds, &dt, q, ray.d, h.root_enter || h.from >= 0);
     if (!czero(sh.transmit)) {
         R3 n = shading_normal(q, x, sh, ds, dt, h.prim_enter == h.root_enter, ray.d);
-        if (!refract_dir(ray.d, n, hit_eta(s, h, x, sh), &rd)) rd = r3(0, 0, 0);
+        if (!refract_dir(ray.d, n, hit_eta(s, h, x, ray.d, sh), &rd)) rd = r3(0, 0, 0);
     }
     o->refracted = vmake((double)rd.x, (double)rd.y, (double)rd.z);
 }
@@ -8269,9 +8361,8 @@ bool shade_cell(Worker &k, const Tile &t, int x0, int y0, int x1, int y1, const 
             }
             R3 p = r.o + r.d * at, ds, dt;
             double ts, tt;
-            tex_coords(q, p, &ts, &tt, &ds, &dt);
             Shade sh;
-            shade_of(q.mat, ts, tt, &sh);
+            shade_at(q, p, &sh, &ts, &tt, &ds, &dt, q, r.d, c0.enter != 0);
             R3 n = shading_normal(q, p, sh, ds, dt, c0.outward != 0, r.d);
             double fx = (x - x0) * sx, fy = (y - y0) * sy;
             double w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
@@ -8752,7 +8843,8 @@ bool prim_same(const Prim &a, const Prim &b) {
     if (!same_r3(a.p, b.p) || !same_r3(a.n, b.n) || !same_real(a.r, b.r) || !same_real(a.r2, b.r2) ||
         !same_real(a.d, b.d) || !same_bytes(&a.box, &b.box, sizeof a.box))
         return false;
-    if (a.tm && (!same_r3(a.tm->u, b.tm->u) || !same_r3(a.tm->v, b.tm->v) || a.tm->mirrored != b.tm->mirrored))
+    if (a.tm && (!same_r3(a.tm->u, b.tm->u) || !same_r3(a.tm->v, b.tm->v) || a.tm->mirrored != b.tm->mirrored ||
+                 !same_bytes(&a.tm->pt, &b.tm->pt, sizeof(R3) * 4)))
         return false;
     if (!a.fr != !b.fr) return false;
     if (a.fr) {  // (a solid turned within its own box: the same box, another frame)
@@ -8997,7 +9089,9 @@ bool coh_same_view(const Scene *a, const Scene *b) {
         if (!same_r3(*u[i], *v[i])) return false;
     for (int i = 0; i < a->lights.n; i++) {
         const Light &p = a->lights[i], &q = b->lights[i];
-        if (p.point != q.point || !same_r3(p.v, q.v) || !same_rgb_bits(p.intensity, q.intensity)) return false;
+        if (p.point != q.point || !same_r3(p.v, q.v) || !same_rgb_bits(p.intensity, q.intensity) || p.spot != q.spot ||
+            !same_r3(p.d, q.d) || !same_bytes(&p.a1, &q.a1, sizeof p.a1) || !same_bytes(&p.a2, &q.a2, sizeof p.a2))
+            return false;
     }
     return same_rgb_bits(a->bg_top, b->bg_top) && same_rgb_bits(a->bg_bottom, b->bg_bottom) &&
            same_bytes(a->most, b->most, sizeof(double) * (size_t)(a->depth + 1)) && same_bytes(&a->cut, &b->cut, sizeof a->cut);
@@ -10294,6 +10388,20 @@ pray_object *pray_stretch(pray_ctx *c, pray_object *a, pray_vec v) {
     }
     return obj_stretch(c, a, v);
 }
+pray_object *pray_paint(pray_ctx *c, pray_object *a, pray_model *m) {
+    if (!c || !object_ok(c, a, "pray_paint") || !model_ok(c, m, "pray_paint")) return NULL;
+    return obj_paint(c, a, m);
+}
+pray_model *pray_checker(pray_ctx *c, pray_model *m0, pray_model *m1, double s) {
+    if (!c || !model_ok(c, m0, "pray_checker", "model m0") || !model_ok(c, m1, "pray_checker", "model m1")) return NULL;
+    if (!(finite_num(s) && s > 0)) {
+        fail(c, PRAY_ERR_ARG, "checker: the size of a cell must be a number > 0, not %g", nan_clean(s));
+        return NULL;
+    }
+    pray_model *m = model_node(c, M_CHECK, m0, m1);
+    if (m) m->amount = s;
+    return m;
+}
 int pray_object_primitives(const pray_object *a) {
     return a ? (a->nprims > INT_MAX ? INT_MAX : (int)a->nprims) : 0;
 }
@@ -10316,6 +10424,23 @@ pray_light *pray_pointlight(pray_ctx *c, pray_rgb i, pray_vec p) {
     l->src[0].point = 1;
     l->src[0].intensity = i;
     l->src[0].v = p;
+    return l;
+}
+pray_light *pray_spotlight(pray_ctx *c, pray_rgb i, pray_vec p, pray_vec d, double a1, double a2) {
+    if (!c) return NULL;
+    if (bad_rgb(c, i, "spotlight") || bad_vec(c, p, "spotlight", false) || bad_vec(c, d, "spotlight direction", true))
+        return NULL;
+    if (!(a1 >= 0 && a1 <= a2 && a2 < 180)) {
+        fail(c, PRAY_ERR_ARG, "spotlight: the angles must be 0 <= a1 <= a2 < 180 degrees, not %g and %g", nan_clean(a1),
+             nan_clean(a2));
+        return NULL;
+    }
+    pray_light *l = pray_pointlight(c, i, p);
+    if (!l) return NULL;
+    l->src[0].spot = 1;
+    l->src[0].d = d;
+    l->src[0].a1 = a1;
+    l->src[0].a2 = a2;
     return l;
 }
 pray_light *pray_light_add(pray_ctx *c, pray_light *a, pray_light *b) {
@@ -11413,14 +11538,15 @@ pray_status lex_start(Lexer &L, const char *text, size_t len, bool check) {
 // =============================================================================================
 namespace {
 
-enum { EX_NUM, EX_STR, EX_VAR, EX_CONST, EX_CALL, EX_UNARY, EX_BINARY, EX_CHAIN, EX_POINT, EX_VECTOR, EX_INTENS };
+enum { EX_NUM, EX_STR, EX_VAR, EX_CONST, EX_CALL, EX_UNARY, EX_BINARY, EX_CHAIN, EX_POINT, EX_VECTOR, EX_INTENS,
+       EX_PCALL, EX_LOCAL };
 enum { C_TRUE, C_FALSE, C_NOTHING, C_NONE, C_PI };
 
 struct Expr {
-    int kind, op, line, col;
+    int kind, op, line, col;  // op: an operator; of EX_PCALL its depth in the statement; of EX_LOCAL the global slot
     double num;
     const char *s;  // string literal or variable name
-    int n;          // string length; variable slot; constant; builtin index
+    int n;          // string length; variable slot; constant; builtin index; procedure; local
     Expr *a, *b, *c;
     Expr **args;
     int nargs;
@@ -11428,16 +11554,38 @@ struct Expr {
 
 enum {
     ST_ASSIGN, ST_DELETE, ST_PRINT, ST_IF, ST_WHILE, ST_QUIT, ST_BACKGROUND, ST_PERSPECTIVE,
-    ST_PARALLEL, ST_OPTION, ST_RENDER, ST_LOOKAT, ST_INCLUDE
+    ST_PARALLEL, ST_OPTION, ST_RENDER, ST_LOOKAT, ST_INCLUDE, ST_DEFINE, ST_RETURN, ST_CALL, ST_BRANCH
 };
 
+// An `if` holds a branch (ST_BRANCH: its statements in body) per condition args[i] of `if` and
+// `elseif`, and the statements of `else` in els: a chain of elseif is a loop, not nested ifs.
 struct Stmt {
     int kind, line, col;
-    int slot;  // assignment target
+    int slot;  // assignment target: a variable, or in a procedure's body (local) a local
+    int local;
     Expr **args;
     int nargs;
     Stmt **body, **els;
     int nbody, nels;
+};
+
+// A procedure (define NAME(...) ... enddefine): its name is known from the first time it is read;
+// it is defined (callable) once its define statement has run. Its body lives as long as the run.
+struct Proc {
+    const char *name, *file;  // (the run's names)
+    int line, col;            // of the define
+    int nparams, nlocals;     // the parameters are locals 0 .. nparams-1
+    int deep;                 // the levels of blocks and expressions its body nests, at most
+    Stmt **body;
+    int nbody;
+    int seen;     // a define of it has been read
+    int defined;  // its define has run
+};
+
+// A call of a procedure in the file being checked: known, and with the right number of arguments,
+// once the whole file is read (it may call a procedure defined further down).
+struct CallSite {
+    int proc, nargs, line, col;
 };
 
 struct Builtin;
@@ -11448,17 +11596,21 @@ int builtin_max(const Builtin *b);
 const char *builtin_name(int i);
 int builtin_count();
 
-const char *const KEYWORDS[] = {"if", "then", "else", "endif", "while", "endwhile", "background",
-                                "delete", "include", "lookat", "option", "parallel", "perspective",
-                                "print", "quit", "rendertiff", "true", "false", "nothing", "none", "pi"};
+const char *const KEYWORDS[] = {"if", "then", "else", "elseif", "endif", "while", "endwhile", "background",
+                                "define", "enddefine", "return", "delete", "include", "lookat", "option",
+                                "parallel", "perspective", "print", "quit", "rendertiff", "true", "false",
+                                "nothing", "none", "pi"};
 
-// The words version 2 of the language added: a program of version 1 may have used them as
+// The words versions 2 and 3 of the language added: an older program may have used them as
 // names, so its error says why the name is refused now.
 const char *version2_note(const char *s) {
-    static const char *const words[] = {"box", "ceil", "cone", "floor", "include", "lookat", "max",
-                                        "min", "rod", "round", "stretch", "torus"};
+    static const char *const words[] = {"box", "ceil", "cone", "floor", "include", "lookat", "max", "min", "rod",
+                                        "round", "stretch", "torus", "checker", "define", "elseif", "enddefine",
+                                        "paint", "return", "spotlight"};
     for (size_t i = 0; i < sizeof words / sizeof words[0]; i++)
-        if (strcmp(words[i], s) == 0) return " (a word of version 2 of the language: rename the variable)";
+        if (strcmp(words[i], s) == 0)
+            return i < 12 ? " (a word of version 2 of the language: rename the variable)"
+                          : " (a word of version 3 of the language: rename the variable)";
     return "";
 }
 
@@ -11484,6 +11636,13 @@ struct Parser {
     Array<Var> *vars;
     Array<int> *hash;  // open addressing: slot + 1, 0 = empty; size a power of two
     int included;      // reading a file that `include` named (the variables are the program's)
+    int run;           // reading to run (else to check)
+    Array<Proc> *procs;      // the run's procedures, by name
+    Array<CallSite> *sites;  // checking: the calls of procedures read so far in this file
+    Arena *keep;             // running: where the bodies of procedures go (they live as long as the run)
+    int in_proc;             // reading the body of a define
+    int peak;                // the deepest level (blocks and expression) reached in that body
+    int includes;            // the file has an include statement
 };
 
 // Past the T_NL at the current position: the tokens of the next line, when it takes them.
@@ -11556,6 +11715,17 @@ unsigned name_hash(const char *s) {
     return h;
 }
 
+// The slot of variable `name`, or -1 (then *at is where it would go; the table is not empty).
+int var_find(Parser &P, const char *name, unsigned *at = NULL) {
+    Array<int> &h = *P.hash;
+    if (h.n == 0) return -1;
+    unsigned k = name_hash(name) & (unsigned)(h.n - 1);
+    for (; h[(int)k]; k = (k + 1) & (unsigned)(h.n - 1))
+        if (strcmp((*P.vars)[h[(int)k] - 1].name, name) == 0) return h[(int)k] - 1;
+    if (at) *at = k;
+    return -1;
+}
+
 // The slot of a variable name, made on first sight. Programs written by generators may have
 // many thousands of names, so they are hashed.
 int var_slot(Parser &P, const char *name) {
@@ -11575,9 +11745,9 @@ int var_slot(Parser &P, const char *name) {
         h.release(P.c);
         h = nh;
     }
-    unsigned k = name_hash(name) & (unsigned)(h.n - 1);
-    for (; h[(int)k]; k = (k + 1) & (unsigned)(h.n - 1))
-        if (strcmp((*P.vars)[h[(int)k] - 1].name, name) == 0) return h[(int)k] - 1;
+    unsigned k = 0;
+    int found = var_find(P, name, &k);
+    if (found >= 0) return found;
     Var v;
     size_t len = strlen(name);
     char *kept = (char *)P.names->get(P.c, len + 1);
@@ -11669,6 +11839,88 @@ Expr *parse_literal(Parser &P, int kind, int close, const char *what) {
     return e;
 }
 
+// The arguments of a call, from the '(' after its name t: a node of the kind, its arguments in
+// args, a level of maxnest deeper than the expression around it (e->op).
+Expr *call_args(Parser &P, const Tok &t, int kind) {
+    if (!enter(P, &t)) return NULL;
+    P.pos++;
+    Expr *e = new_expr(P, kind, t);
+    if (!e) return NULL;
+    e->op = P.depth;
+    Array<Expr *> args;
+    args.init();
+    bool ok = true;
+    if (!is_op(cur(P), ')')) ok = parse_list(P, &args, false);
+    if (ok && expect_op(P, ')', "',' or ')' after an argument")) ok = false;
+    if (ok) {
+        e->args = freeze_list(P, args);
+        e->nargs = args.n;
+        ok = e->args != NULL;
+    }
+    args.release(P.c);
+    P.depth--;
+    return ok ? e : NULL;
+}
+
+// The procedure of that name, or -1.
+int proc_find(Parser &P, const char *name) {
+    for (int i = 0; i < P.procs->n; i++)
+        if (strcmp((*P.procs)[i].name, name) == 0) return i;
+    return -1;
+}
+
+// The procedure of that name, made on first sight (a call may come before its define); -1: no memory.
+int proc_index(Parser &P, const char *name) {
+    int i = proc_find(P, name);
+    if (i >= 0) return i;
+    Proc p;
+    memset(&p, 0, sizeof p);
+    size_t len = strlen(name);
+    char *kept = (char *)P.names->get(P.c, len + 1);
+    if (!kept) return -1;
+    memcpy(kept, name, len + 1);
+    p.name = kept;
+    return P.procs->push(P.c, p) ? P.procs->n - 1 : -1;
+}
+
+// NAME '(' [args] ')' of a procedure; checked when the file is read whole (check_calls).
+Expr *parse_pcall(Parser &P, const Tok &t) {
+    Expr *e = call_args(P, t, EX_PCALL);
+    if (!e || (e->n = proc_index(P, t.s)) < 0) return NULL;
+    e->s = (*P.procs)[e->n].name;
+    CallSite site = {e->n, e->nargs, t.line, t.col};
+    return P.run || P.sites->push(P.c, site) ? e : NULL;
+}
+
+// "unknown function 'F'", with the builtin or procedure it may have meant.
+pray_status unknown_function(pray_ctx *c, pray_status st, const char *file, int line, int col, const char *name,
+                             const Array<Proc> &procs, bool later) {
+    Suggest sg;
+    sg.init(name);
+    for (int i = 0; i < builtin_count(); i++) sg.offer(builtin_name(i));
+    for (int i = 0; i < procs.n; i++)
+        if (procs[i].seen && strcmp(procs[i].name, name) != 0) sg.offer(procs[i].name);
+    return perr(c, file, line, col, st, "unknown function '%s'%s%s%s", *Shown(name),
+                later ? " (a procedure is known once its define has run)" : sg.best ? "; did you mean '" : "",
+                later ? "" : sg.best ? sg.best : "", !later && sg.best ? "'?" : "");
+}
+
+// The file read whole: every procedure it calls is defined in it or in a file read before, with
+// as many parameters as the call has arguments (a file that includes others is checked as it
+// runs, since they may define what it calls).
+pray_status check_calls(Parser &P) {
+    for (int i = 0; i < P.sites->n; i++) {
+        const CallSite &s = (*P.sites)[i];
+        const Proc &p = (*P.procs)[s.proc];
+        if (!p.seen && !P.includes)
+            return unknown_function(P.c, PRAY_ERR_SYNTAX, P.name, s.line, s.col, p.name, *P.procs, false);
+        if (p.seen && p.nparams != s.nargs)
+            return perr(P.c, P.name, s.line, s.col, PRAY_ERR_SYNTAX, "%s takes %d argument%s, not %d", p.name,
+                        p.nparams, p.nparams == 1 ? "" : "s", s.nargs);
+    }
+    return PRAY_OK;
+}
+
 // primary -> NUMBER | STRING | NAME | NAME '(' [args] ')' | '(' expr ')' | literal
 Expr *parse_primary(Parser &P) {
     Tok &t = cur(P);
@@ -11704,48 +11956,28 @@ Expr *parse_primary(Parser &P) {
                 syn(P, t, "'%s' is a function: write it with its arguments in parentheses%s", t.s, version2_note(t.s));
                 return NULL;
             }
-            if (!enter(P, &t)) return NULL;
-            P.pos++;
-            Expr *e = new_expr(P, EX_CALL, t);
+            Expr *e = call_args(P, t, EX_CALL);
             if (!e) return NULL;
             e->n = builtin_index(b);
             e->s = builtin_name(e->n);
-            Array<Expr *> args;
-            args.init();
-            bool ok = true;
-            if (!is_op(cur(P), ')')) ok = parse_list(P, &args, false);
-            if (ok && expect_op(P, ')', "',' or ')' after an argument")) ok = false;
-            if (ok) {
-                int lo = builtin_min(b), hi = builtin_max(b);
-                if (args.n < lo || args.n > hi) {
-                    char msg[160];
-                    if (lo == hi) snprintf(msg, sizeof msg, "%s takes %d argument%s, not %d", t.s, lo, lo == 1 ? "" : "s", args.n);
-                    else snprintf(msg, sizeof msg, "%s takes %d to %d arguments, not %d", t.s, lo, hi, args.n);
-                    syn(P, t, "%s", msg);
-                    ok = false;
-                }
+            int lo = builtin_min(b), hi = builtin_max(b);
+            if (e->nargs < lo || e->nargs > hi) {
+                char msg[160];
+                if (lo == hi) snprintf(msg, sizeof msg, "%s takes %d argument%s, not %d", t.s, lo, lo == 1 ? "" : "s", e->nargs);
+                else snprintf(msg, sizeof msg, "%s takes %d to %d arguments, not %d", t.s, lo, hi, e->nargs);
+                syn(P, t, "%s", msg);
+                return NULL;
             }
-            if (ok) {
-                e->args = freeze_list(P, args);
-                e->nargs = args.n;
-                ok = e->args != NULL;
-            }
-            args.release(P.c);
-            P.depth--;
-            return ok ? e : NULL;
+            return e;
         }
         if (is_reserved(t.s)) {
             syn(P, t, "'%s' is a reserved word and cannot be used here%s", t.s, version2_note(t.s));
             return NULL;
         }
-        if (is_op(cur(P), '(')) {
-            Suggest sg;
-            sg.init(t.s);
-            for (int i = 0; i < builtin_count(); i++) sg.offer(builtin_name(i));
-            char msg[200];
-            if (sg.best) snprintf(msg, sizeof msg, "unknown function '%s'; did you mean '%s'?", *Shown(t.s), sg.best);
-            else snprintf(msg, sizeof msg, "unknown function '%s'", *Shown(t.s));
-            syn(P, t, "%s", msg);
+        if (is_op(cur(P), '(')) return parse_pcall(P, t);
+        int pi = proc_find(P, t.s);
+        if (pi >= 0 && (*P.procs)[pi].seen) {
+            syn(P, t, "'%s' is a procedure: call it with its arguments in parentheses", t.s);
             return NULL;
         }
         Expr *e = new_expr(P, EX_VAR, t);
@@ -11783,6 +12015,7 @@ const char *nest_message(char *msg, size_t size, const char *what, double lim, i
 
 // One level deeper, at token `at` (default: the current token).
 bool enter(Parser &P, const Tok *at) {
+    if (P.depth + 1 + P.blocks > P.peak) P.peak = P.depth + 1 + P.blocks;
     if (++P.depth + P.blocks > P.maxnest) {
         char msg[160];
         syn(P, at ? *at : cur(P), "%s", nest_message(msg, sizeof msg, "expression", P.maxnest, P.blocks));
@@ -11914,6 +12147,20 @@ Stmt *new_stmt(Parser &P, int kind, const Tok &t) {
     return s;
 }
 
+// The word that ends a block ('else', 'elseif', 'endif', 'endwhile', 'enddefine') at the current
+// token, or NULL.
+const char *block_end(Parser &P) {
+    static const char *const ends[] = {"else", "elseif", "endif", "endwhile", "enddefine"};
+    for (int i = 0; i < 5; i++)
+        if (is_word(cur(P), ends[i])) return ends[i];
+    return NULL;
+}
+
+// The word that opens the block an end word closes.
+const char *block_opener(const char *end) {
+    return strcmp(end, "endwhile") == 0 ? "while" : strcmp(end, "enddefine") == 0 ? "define" : "if";
+}
+
 bool parse_block(Parser &P, Array<Stmt *> *out, const char **stop);
 
 // The statement's arguments: exactly n (n > 0), or between lo and hi.
@@ -12006,25 +12253,41 @@ Stmt *parse_block_statement(Parser &P, const Tok &t) {
     Stmt *s = new_stmt(P, is_if ? ST_IF : ST_WHILE, word);
     if (!s) return NULL;
     P.pos++;
-    if (cur(P).kind == T_NL) {
-        syn(P, cur(P), "'%s' needs a condition", word.s);
-        return NULL;
-    }
-    Expr *cond = parse_expr(P);
-    if (!cond) return NULL;
-    s->args = (Expr **)P.arena->get(P.c, sizeof(Expr *));
-    if (!s->args) return NULL;
-    s->args[0] = cond;
-    s->nargs = 1;
-    if (is_if && is_word(cur(P), "then")) P.pos++;
-    if (end_of_line(P)) return NULL;
-    if (++P.blocks > P.maxnest) {
-        char msg[160];
-        syn(P, word, "%s", nest_message(msg, sizeof msg, "blocks", P.maxnest, P.base));
-        return NULL;
-    }
+    // the condition and statements of the block; of an if, of each elseif too (a branch each)
+    Array<Expr *> conds;
+    Array<Stmt *> branches;
+    conds.init();
+    branches.init();
     const char *stop = NULL;
-    if (!parse_body(P, &s->body, &s->nbody, &stop)) return NULL;
+    bool ok = true;
+    do {
+        if (stop) P.pos++;  // (past 'elseif')
+        Stmt *b = is_if ? new_stmt(P, ST_BRANCH, cur(P)) : s;
+        ok = b && cur(P).kind != T_NL;
+        if (b && !ok) syn(P, cur(P), "'%s' needs a condition", stop ? stop : word.s);
+        Expr *cond = ok ? parse_expr(P) : NULL;
+        ok = cond && conds.push(P.c, cond) && (!is_if || branches.push(P.c, b));
+        if (ok && is_word(cur(P), "then")) P.pos += is_if;
+        ok = ok && !end_of_line(P);
+        if (ok && ++P.blocks > P.maxnest) {
+            char msg[160];
+            syn(P, word, "%s", nest_message(msg, sizeof msg, "blocks", P.maxnest, P.base));
+            ok = false;
+        }
+        if (P.blocks > P.peak) P.peak = P.blocks;
+        ok = ok && parse_body(P, &b->body, &b->nbody, &stop);
+        P.blocks -= ok;
+    } while (ok && is_if && stop && strcmp(stop, "elseif") == 0);
+    P.blocks++;  // (the else's statements, if any, and the end of the block)
+    if (ok) {
+        s->args = freeze_list(P, conds);
+        s->nargs = conds.n;
+        if (is_if) s->body = freeze_stmts(P, branches), s->nbody = branches.n;
+        ok = s->args && s->body;
+    }
+    conds.release(P.c);
+    branches.release(P.c);
+    if (!ok) return NULL;
     if (is_if && stop && strcmp(stop, "else") == 0) {
         P.pos++;
         if (end_of_line(P) || !parse_body(P, &s->els, &s->nels, &stop)) return NULL;
@@ -12046,6 +12309,155 @@ Stmt *parse_block_statement(Parser &P, const Tok &t) {
     return end_of_line(P) ? NULL : s;
 }
 
+// The variables of a procedure's body: its parameters (locals[0 .. nparams)), then every name
+// the body assigns or deletes, are the call's own; reads of them look there first.
+struct Locals {
+    Array<int> slots;  // the global slot of each local's name
+    int *of;           // by global slot: the local, or -1
+};
+bool add_local(pray_ctx *c, Locals &L, int slot) {
+    if (L.of[slot] >= 0) return true;
+    L.of[slot] = L.slots.n;
+    return L.slots.push(c, slot);
+}
+bool collect_locals(pray_ctx *c, Locals &L, Stmt **body, int n) {
+    for (int i = 0; i < n; i++) {
+        const Stmt *s = body[i];
+        if (s->kind == ST_ASSIGN && !add_local(c, L, s->slot)) return false;
+        for (int k = 0; s->kind == ST_DELETE && k < s->nargs; k++)
+            if (!add_local(c, L, s->args[k]->n)) return false;
+        if (!collect_locals(c, L, s->body, s->nbody) || !collect_locals(c, L, s->els, s->nels)) return false;
+    }
+    return true;
+}
+void localize(const Locals &L, Expr *e) {
+    if (!e) return;
+    if (e->kind == EX_VAR && L.of[e->n] >= 0) {
+        e->kind = EX_LOCAL;
+        e->op = e->n;
+        e->n = L.of[e->n];
+    }
+    localize(L, e->a);
+    if (e->b != e->a) localize(L, e->b);
+    if (e->c != e->a) localize(L, e->c);
+    for (int i = 0; i < e->nargs; i++) localize(L, e->args[i]);
+}
+void localize(const Locals &L, Stmt **body, int n) {
+    for (int i = 0; i < n; i++) {
+        Stmt *s = body[i];
+        if (s->kind == ST_ASSIGN) {
+            s->local = 1;
+            s->slot = L.of[s->slot];
+        }
+        for (int k = 0; k < s->nargs; k++) localize(L, s->args[k]);
+        localize(L, s->body, s->nbody);
+        localize(L, s->els, s->nels);
+    }
+}
+
+// define NAME(P1, ..., Pn) ... enddefine, at the top level of a file (t: the word). Checking, it
+// makes the procedure known (seen); running, its body is kept for the run (P.keep).
+Stmt *parse_define(Parser &P, const Tok &word) {
+    Tok t = word;  // (the body takes the lines after this one's)
+    if (P.in_proc || P.blocks != P.base) {
+        syn(P, t, "'define' stands only at the top level of a file, not inside %s", P.in_proc ? "another define" : "a block");
+        return NULL;
+    }
+    const Tok &nm = P.t[P.pos + 1];
+    if (nm.kind != T_NAME) {
+        syn(P, nm.kind == T_NL ? t : nm, "'define' takes a name and parameters: define NAME(P1, ..., Pn)");
+        return NULL;
+    }
+    if (is_reserved(nm.s)) {
+        syn(P, nm, "'%s' is %s and cannot be defined%s", nm.s, builtin_find(nm.s) ? "a function" : "a reserved word",
+            version2_note(nm.s));
+        return NULL;
+    }
+    if (!P.run && var_find(P, nm.s) >= 0) {
+        syn(P, nm, "'%s' is the name of a variable and cannot be defined as a procedure", nm.s);
+        return NULL;
+    }
+    int idx = proc_index(P, nm.s);
+    if (idx < 0) return NULL;
+    if (!P.run && (*P.procs)[idx].seen) {
+        const Proc &p = (*P.procs)[idx];
+        syn(P, nm, "'%s' is defined twice (first at %s:%d:%d)", nm.s, *ShownPath(p.file), p.line, p.col);
+        return NULL;
+    }
+    P.pos += 2;
+    if (expect_op(P, '(', "'(' after the name of the procedure")) return NULL;
+    Locals L;
+    L.slots.init();
+    L.of = NULL;
+    bool ok = true;
+    while (ok && !is_op(cur(P), ')')) {
+        const Tok &a = cur(P);
+        int pi = a.kind == T_NAME ? proc_find(P, a.s) : -1;
+        char buf[80];
+        bool bad = a.kind != T_NAME || is_reserved(a.s) || (pi >= 0 && (*P.procs)[pi].seen);
+        if (a.kind != T_NAME) syn(P, a, "expected the name of a parameter, found '%s'", tok_text(a, buf, sizeof buf));
+        else if (bad)
+            syn(P, a, "'%s' is %s and cannot be a parameter", a.s,
+                pi >= 0 ? "a procedure" : builtin_find(a.s) ? "a function" : "a reserved word");
+        int slot = bad ? -1 : var_slot(P, a.s);
+        for (int i = 0; slot >= 0 && i < L.slots.n; i++)
+            if (L.slots[i] == slot) slot = -1, syn(P, a, "'%s' is the name of two parameters", a.s);
+        ok = slot >= 0 && L.slots.push(P.c, slot);
+        P.pos++;
+        if (ok && !is_op(cur(P), ')')) ok = !expect_op(P, ',', "',' or ')' after a parameter");
+    }
+    int nparams = L.slots.n;
+    Stmt *s = ok && !expect_op(P, ')', "')'") && !end_of_line(P) ? new_stmt(P, ST_DEFINE, t) : NULL;
+    Stmt **body = NULL;
+    int nbody = 0, blocks = P.blocks, peak = P.peak;
+    const char *stop = NULL;
+    Arena *outer = P.arena;
+    if (s) {
+        s->slot = idx;
+        if (P.run) P.arena = P.keep;
+        P.in_proc = 1;
+        P.blocks = P.peak = 0;
+        ok = parse_body(P, &body, &nbody, &stop);
+        P.in_proc = 0;
+        P.blocks = blocks;
+        P.arena = outer;
+    }
+    if (s && ok && (!stop || strcmp(stop, "enddefine") != 0)) {
+        if (stop) syn(P, cur(P), "'%s' where 'enddefine' was expected to close the 'define' of line %d", stop, t.line);
+        else syn(P, t, "'define' without 'enddefine'");
+        ok = false;
+    }
+    if (s && ok) {
+        L.of = (int *)mem_alloc(P.c, sizeof(int) * (size_t)(P.vars->n + 1));
+        for (int i = 0; L.of && i <= P.vars->n; i++) L.of[i] = -1;
+        for (int i = 0; L.of && i < L.slots.n; i++) L.of[L.slots[i]] = i;
+        ok = L.of && collect_locals(P.c, L, body, nbody);
+    }
+    if (s && ok) {
+        localize(L, body, nbody);
+        Proc &p = (*P.procs)[idx];
+        size_t len = strlen(P.name);
+        char *file = (char *)P.names->get(P.c, len + 1);
+        ok = file != NULL;
+        if (ok) memcpy(file, P.name, len + 1);
+        p.file = file;
+        p.line = t.line;
+        p.col = t.col;
+        p.nparams = nparams;
+        p.nlocals = L.slots.n;
+        p.deep = P.peak;
+        p.seen = 1;
+        if (P.run) p.body = body, p.nbody = nbody;
+        s->body = body;  // (for note_uses)
+        s->nbody = nbody;
+        P.pos++;
+    }
+    P.peak = peak;
+    mem_free(P.c, L.of);
+    L.slots.release(P.c);
+    return s && ok && !end_of_line(P) ? s : NULL;
+}
+
 // statement -> NAME '=' expr | 'delete' NAME {',' NAME} | 'print' args | 'quit'
 //            | 'if' expr ['then'] NL block ['else' NL block] 'endif'
 //            | 'while' expr NL block 'endwhile' | 'background' expr [',' expr]
@@ -12062,6 +12474,11 @@ Stmt *parse_statement(Parser &P) {
     if (is_op(P.t[P.pos + 1], '=')) {
         if (is_reserved(t.s)) {
             syn(P, t, "'%s' is a reserved word and cannot be assigned to%s", t.s, version2_note(t.s));
+            return NULL;
+        }
+        int pi = proc_find(P, t.s);
+        if (pi >= 0 && (*P.procs)[pi].seen) {
+            syn(P, t, "'%s' is a procedure and cannot be assigned to", t.s);
             return NULL;
         }
         s = new_stmt(P, ST_ASSIGN, t);
@@ -12114,10 +12531,38 @@ Stmt *parse_statement(Parser &P) {
                 }
         return end_of_line(P) ? NULL : s;
     }
-    if (is_word(t, "include")) return parse_include(P, t);
+    if (is_word(t, "include") && P.in_proc) {
+        syn(P, t, "'include' is not allowed in the body of a procedure");
+        return NULL;
+    }
+    if (is_word(t, "include")) {
+        P.includes = 1;
+        return parse_include(P, t);
+    }
     if (is_word(t, "if") || is_word(t, "while")) return parse_block_statement(P, t);
-    if (is_word(t, "else") || is_word(t, "endif") || is_word(t, "endwhile")) {
-        syn(P, t, "'%s' without a matching '%s'", t.s, is_word(t, "endwhile") ? "while" : "if");
+    if (is_word(t, "define")) return parse_define(P, t);
+    if (is_word(t, "return")) {
+        if (!P.in_proc) {
+            syn(P, t, "'return' outside the body of a procedure");
+            return NULL;
+        }
+        s = new_stmt(P, ST_RETURN, t);
+        P.pos++;
+        return s && stmt_args(P, s, t, 0, 1) && !end_of_line(P) ? s : NULL;
+    }
+    if (!is_reserved(t.s) && is_op(P.t[P.pos + 1], '(')) {  // a call of a procedure, as a statement
+        s = new_stmt(P, ST_CALL, t);
+        if (!s) return NULL;
+        P.pos++;
+        Expr *e = parse_pcall(P, t);
+        s->args = e ? (Expr **)P.arena->get(P.c, sizeof(Expr *)) : NULL;
+        if (!s->args) return NULL;
+        s->args[0] = e;
+        s->nargs = 1;
+        return end_of_line(P) ? NULL : s;
+    }
+    if (block_end(P)) {
+        syn(P, t, "'%s' without a matching '%s'", t.s, block_opener(t.s));
         return NULL;
     }
     if (is_word(t, "then")) {
@@ -12140,14 +12585,6 @@ Stmt *parse_statement(Parser &P) {
     if (sg.best) snprintf(msg, sizeof msg, "unknown statement '%s'; did you mean '%s'?", t.s, sg.best);
     else snprintf(msg, sizeof msg, "expected a statement or an assignment, found '%s'", t.s);
     syn(P, t, "%s", msg);
-    return NULL;
-}
-
-// The word that ends a block ('else', 'endif', 'endwhile') at the current token, or NULL.
-const char *block_end(Parser &P) {
-    static const char *const ends[] = {"else", "endif", "endwhile"};
-    for (int i = 0; i < 3; i++)
-        if (is_word(cur(P), ends[i])) return ends[i];
     return NULL;
 }
 
@@ -12227,6 +12664,12 @@ struct Interp {
     int frames;
     Array<NameCount> names;  // output names used so far, and their frames
     int warned_aspect;       // the run has said that its pixels are not square
+    Array<Proc> procs;       // the procedures, by the index calls name them with
+    Value *frame;            // the locals of the call running, NULL at the top level
+    Value ret;               // what `return` gave, while `returning`
+    int returning;
+    int called;              // the error's message has the places of this many calls that led to it
+    size_t chain_end;        // where the eighth of them ends in the message
 };
 
 Value vnum(double x) {
@@ -12476,6 +12919,20 @@ pray_status bi_plane(Interp &I, const Expr *call, Value *a, Value *out) {
         return I.c->status;
     return made(I, call, V_OBJECT, pray_plane(I.c, (pray_model *)a[0].ref, vec_of(a[1]), vec_of(a[2])), out);
 }
+pray_status bi_spotlight(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_INTENS) || want(I, call, a, 1, V_POINT) || want(I, call, a, 2, V_VECTOR) ||
+        want(I, call, a, 3, V_NUM) || want(I, call, a, 4, V_NUM))
+        return I.c->status;
+    return made(I, call, V_LIGHT, pray_spotlight(I.c, rgb_of(a[0]), vec_of(a[1]), vec_of(a[2]), a[3].v[0], a[4].v[0]), out);
+}
+pray_status bi_checker(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_MODEL) || want(I, call, a, 1, V_MODEL) || want(I, call, a, 2, V_NUM)) return I.c->status;
+    return made(I, call, V_MODEL, pray_checker(I.c, (pray_model *)a[0].ref, (pray_model *)a[1].ref, a[2].v[0]), out);
+}
+pray_status bi_paint(Interp &I, const Expr *call, Value *a, Value *out) {
+    if (want(I, call, a, 0, V_OBJECT) || want(I, call, a, 1, V_MODEL)) return I.c->status;
+    return made(I, call, V_OBJECT, pray_paint(I.c, (pray_object *)a[0].ref, (pray_model *)a[1].ref), out);
+}
 pray_status bi_pointlight(Interp &I, const Expr *call, Value *a, Value *out) {
     if (want(I, call, a, 0, V_INTENS) || want(I, call, a, 1, V_POINT)) return I.c->status;
     return made(I, call, V_LIGHT, pray_pointlight(I.c, rgb_of(a[0]), vec_of(a[1])), out);
@@ -12596,7 +13053,8 @@ const Builtin BUILTINS[] = {
     {"abs", 1, 1, bi_abs},           {"arccos", 1, 1, bi_arccos},
     {"arcsin", 1, 1, bi_arcsin},     {"arctan", 1, 1, bi_arctan},
     {"arctan2", 2, 2, bi_arctan2},   {"box", 3, 3, bi_box},
-    {"ceil", 1, 1, bi_ceil},         {"color", 1, 1, bi_color},
+    {"ceil", 1, 1, bi_ceil},         {"checker", 3, 3, bi_checker},
+    {"color", 1, 1, bi_color},
     {"cone", 5, 5, bi_cone},
     {"cos", 1, 1, bi_cos},           {"cylinder", 4, 4, bi_cylinder},
     {"directionlight", 2, 2, bi_dirlight}, {"dirlight", 2, 2, bi_dirlight},
@@ -12605,11 +13063,13 @@ const Builtin BUILTINS[] = {
     {"min", 2, 2, bi_min},
     {"mirror", 1, 1, bi_mirror},     {"move", 3, 3, bi_move},
     {"norm", 1, 1, bi_norm},         {"one", 1, 1, bi_one},
+    {"paint", 2, 2, bi_paint},
     {"phong", 3, 4, bi_phong},       {"plane", 3, 3, bi_plane},
     {"planemap", 5, 5, bi_planemap}, {"pointlight", 2, 2, bi_pointlight},
     {"rod", 4, 4, bi_rod},           {"round", 1, 1, bi_round},
     {"sin", 1, 1, bi_sin},           {"sphere", 3, 3, bi_sphere},
-    {"spheremap", 5, 5, bi_spheremap}, {"sqrt", 1, 1, bi_sqrt},
+    {"spheremap", 5, 5, bi_spheremap}, {"spotlight", 5, 5, bi_spotlight},
+    {"sqrt", 1, 1, bi_sqrt},
     {"stretch", 2, 2, bi_stretch},
     {"tan", 1, 1, bi_tan},           {"text", 8, 8, bi_text},
     {"tiff", 3, 3, bi_tiff},         {"tiffbump", 3, 3, bi_tiffbump},
@@ -12885,6 +13345,65 @@ pray_status undefined_var(Interp &I, const Expr *e) {
     return rerr(I, e, PRAY_ERR_RUNTIME, "undefined variable '%s'", *Shown(e->s));
 }
 
+pray_status exec_block(Interp &I, Stmt **body, int n);
+
+// An error inside a procedure's body: its message gets the place of each call that led there,
+// the innermost first, as an include's (include_chain); past the eighth, how many more.
+PRAY_NOINLINE void called_from(Interp &I, const Expr *e) {
+    char *m = I.c->msg;
+    size_t size = sizeof I.c->msg, n = I.called ? I.chain_end - 1 : strlen(m);  // (before the ')')
+    if (++I.called <= 8) {
+        snprintf(m + n, size - n, "%scalled from %s:%d:%d)", I.called > 1 ? ", " : " (", *ShownPath(I.name), e->line, e->col);
+        I.chain_end = strlen(m);
+    } else
+        snprintf(m + n, size - n, ", and %d more)", I.called - 8);
+}
+
+// A call of a procedure: the arguments are evaluated where the call is, the body runs in a scope
+// of its own; *out is what its `return` gave. `want`: the call is a value, so a body that ends
+// without one is an error. A `quit` in a body called for a value ends the run from there: the
+// evaluations around it unwind with an error status that read_statements takes back.
+PRAY_NOINLINE pray_status call_proc(Interp &I, const Expr *e, Value *out, bool want) {
+    pray_ctx *c = I.c;
+    const Proc &p = I.procs[e->n];
+    memset(out, 0, sizeof *out);
+    if (!p.defined) return unknown_function(c, PRAY_ERR_RUNTIME, I.name, e->line, e->col, e->s, I.procs, p.seen);
+    if (e->nargs != p.nparams)
+        return rerr(I, e, PRAY_ERR_RUNTIME, "%s takes %d argument%s, not %d", e->s, p.nparams, p.nparams == 1 ? "" : "s",
+                    e->nargs);
+    double lim = I.parser->maxnest;
+    if (I.depth + e->op + p.deep > lim) {
+        char msg[160];
+        return rerr(I, e, PRAY_ERR_LIMIT, "%s", nest_message(msg, sizeof msg, "calls", lim, I.depth + e->op - 1));
+    }
+    Value *frame = (Value *)mem_zalloc(c, sizeof(Value) * (size_t)(p.nlocals + 1));
+    if (!frame) return api_err(I, e->line, e->col);
+    pray_status st = PRAY_OK;
+    for (int i = 0; i < p.nparams && st == PRAY_OK; i++) st = eval(I, e->args[i], &frame[i]);
+    if (st == PRAY_OK) {
+        Value *outer = I.frame;
+        const char *name = I.name;
+        I.frame = frame;
+        I.name = p.file;
+        I.depth += e->op;
+        st = exec_block(I, p.body, p.nbody);
+        I.frame = outer;
+        I.name = name;
+        I.depth -= e->op;
+        if (st && !I.quit) called_from(I, e);
+        else if (I.quit) st = want ? (c->status = PRAY_ERR_RUNTIME) : PRAY_OK;
+        else if (I.ret.t == V_NONE && want)
+            st = rerr(I, e, PRAY_ERR_RUNTIME, "%s returned no value", e->s);
+        *out = I.ret;
+        memset(&I.ret, 0, sizeof I.ret);
+        I.returning = 0;
+        if (st) vrelease(I, *out);
+    }
+    for (int i = 0; i < p.nlocals; i++) vrelease(I, frame[i]);
+    mem_free(c, frame);
+    return st;
+}
+
 pray_status eval(Interp &I, const Expr *e, Value *out) {
     memset(out, 0, sizeof *out);
     switch (e->kind) {
@@ -12909,8 +13428,11 @@ pray_status eval(Interp &I, const Expr *e, Value *out) {
             return l ? (*out = vref(V_LIGHT, l), PRAY_OK) : api_err(I, e->line, e->col);
         }
         }
+    case EX_PCALL: return call_proc(I, e, out, true);
+    case EX_LOCAL:
     case EX_VAR: {
-        const Value &v = I.vals[e->n];
+        bool local = e->kind == EX_LOCAL && I.frame && I.frame[e->n].t != V_NONE;
+        const Value &v = local ? I.frame[e->n] : I.vals[e->kind == EX_LOCAL ? e->op : e->n];
         if (v.t == V_NONE) return undefined_var(I, e);
         *out = v;
         retain(out->ref);
@@ -13171,8 +13693,10 @@ PRAY_NOINLINE void include_chain(Interp &I) {
     I.chained = 1;
     char *m = I.c->msg;
     size_t n = strlen(m), size = sizeof I.c->msg;
+    bool open = I.called && n > 0 && m[n - 1] == ')';  // after the calls' places, in their parentheses
+    n -= open;
     for (int i = I.files.n - 2; i >= 0 && n + 1 < size; i--)
-        n += (size_t)snprintf(m + n, size - n, "%sincluded from %s:%d%s", i == I.files.n - 2 ? " (" : ", ",
+        n += (size_t)snprintf(m + n, size - n, "%sincluded from %s:%d%s", i == I.files.n - 2 && !open ? " (" : ", ",
                               *ShownPath(I.files[i].name), I.files[i].line, i == 0 ? ")" : "");
 }
 
@@ -13315,23 +13839,40 @@ pray_status exec(Interp &I, const Stmt *s) {
     case ST_ASSIGN: {
         Value v;
         if (eval(I, s->args[0], &v)) return c->status;
-        vrelease(I, I.vals[s->slot]);
-        I.vals[s->slot] = v;
+        Value &to = s->local ? I.frame[s->slot] : I.vals[s->slot];
+        vrelease(I, to);
+        to = v;
         return PRAY_OK;
     }
     case ST_DELETE:
         for (int i = 0; i < s->nargs; i++) {
             const Expr *e = s->args[i];
-            if (I.vals[e->n].t == V_NONE) return undefined_var(I, e);
-            vrelease(I, I.vals[e->n]);
+            Value &v = e->kind == EX_LOCAL ? I.frame[e->n] : I.vals[e->n];
+            if (v.t == V_NONE) return undefined_var(I, e);
+            vrelease(I, v);
         }
         return PRAY_OK;
     case ST_QUIT: I.quit = 1; return PRAY_OK;
+    case ST_DEFINE: I.procs[s->slot].defined = 1; return PRAY_OK;
+    case ST_RETURN: {  // (the value is kept apart until the call takes it: calls in it return too)
+        Value v;
+        if (s->nargs && eval(I, s->args[0], &v)) return c->status;
+        I.ret = s->nargs ? v : I.ret;
+        I.returning = 1;
+        return PRAY_OK;
+    }
+    case ST_CALL: {
+        Value v;
+        pray_status st = call_proc(I, s->args[0], &v, false);
+        vrelease(I, v);
+        return st;
+    }
     case ST_IF: {
-        double x;
-        if (eval_num(I, s->args[0], &x)) return c->status;
+        int k = 0;
+        for (double x = 0; k < s->nargs && x == 0; k += x == 0)
+            if (eval_num(I, s->args[k], &x)) return c->status;
         I.depth++;
-        pray_status st = x != 0 ? exec_block(I, s->body, s->nbody) : exec_block(I, s->els, s->nels);
+        pray_status st = k < s->nargs ? exec_block(I, s->body[k]->body, s->body[k]->nbody) : exec_block(I, s->els, s->nels);
         I.depth--;
         return st;
     }
@@ -13344,7 +13885,7 @@ pray_status exec(Interp &I, const Stmt *s) {
             I.depth++;
             pray_status st = exec_block(I, s->body, s->nbody);
             I.depth--;
-            if (st || I.quit) return c->status;
+            if (st || I.quit || I.returning) return c->status;
         }
     default: break;
     }
@@ -13428,7 +13969,7 @@ pray_status exec(Interp &I, const Stmt *s) {
 }
 
 pray_status exec_block(Interp &I, Stmt **body, int n) {
-    for (int i = 0; i < n && !I.quit; i++)
+    for (int i = 0; i < n && !I.quit && !I.returning; i++)
         if (exec(I, body[i])) return I.c->status;
     return PRAY_OK;
 }
@@ -13440,12 +13981,12 @@ bool note_slot(Interp &I, int slot, int k) {
         if (!I.last.reserve(I.c, slot + 1)) return false;
         while (I.last.n <= slot) I.last.p[I.last.n++] = -1;
     }
-    I.last[slot] = k;
+    if (I.last[slot] < k) I.last[slot] = k;
     return true;
 }
 bool note_uses(Interp &I, const Expr *e, int k) {
     if (!e) return true;
-    if (e->kind == EX_VAR && !note_slot(I, e->n, k)) return false;
+    if ((e->kind == EX_VAR || e->kind == EX_LOCAL) && !note_slot(I, e->kind == EX_VAR ? e->n : e->op, k)) return false;
     if (!note_uses(I, e->a, k) || (e->b != e->a && !note_uses(I, e->b, k)) || (e->c != e->a && !note_uses(I, e->c, k)))
         return false;
     for (int i = 0; i < e->nargs; i++)
@@ -13453,8 +13994,9 @@ bool note_uses(Interp &I, const Expr *e, int k) {
     return true;
 }
 bool note_uses(Interp &I, const Stmt *s, int k) {
-    if (s->kind == ST_ASSIGN && !note_slot(I, s->slot, k)) return false;
+    if (s->kind == ST_ASSIGN && !s->local && !note_slot(I, s->slot, k)) return false;
     if (s->kind == ST_INCLUDE) I.include_last = k;  // an included file may name any variable
+    if (s->kind == ST_DEFINE) k = INT_MAX;  // a body may be called by any statement after
     for (int i = 0; i < s->nargs; i++)
         if (!note_uses(I, s->args[i], k)) return false;
     for (int i = 0; i < s->nbody; i++)
@@ -13510,6 +14052,11 @@ PRAY_NOINLINE pray_status read_statements(Parser &P, const char *text, size_t le
     double t0 = clock_seconds();
     P.depth = 0;
     P.blocks = P.base;
+    P.run = run;
+    P.includes = 0;
+    Array<CallSite> sites;
+    sites.init();
+    P.sites = &sites;
     pray_status st = lex_start(*P.L, text, len, !run);
     P.t = P.L->toks.p;
     P.pos = 0;
@@ -13521,7 +14068,7 @@ PRAY_NOINLINE pray_status read_statements(Parser &P, const char *text, size_t le
         }
         const char *stop = block_end(P);
         if (stop) {
-            st = syn(P, cur(P), "'%s' without a matching '%s'", stop, strcmp(stop, "endwhile") == 0 ? "while" : "if");
+            st = syn(P, cur(P), "'%s' without a matching '%s'", stop, block_opener(stop));
             break;
         }
         Stmt *s = parse_statement(P);
@@ -13549,6 +14096,7 @@ PRAY_NOINLINE pray_status read_statements(Parser &P, const char *text, size_t le
                 I->top_index = k;
             }
             st = exec(*I, s);
+            if (st && I->quit) st = c->status = PRAY_OK;  // (a quit in a call unwinds as an error)
             if (st == PRAY_OK && !P.included) release_dead(*I, k);
             t0 = clock_seconds();
             if (I->quit) break;
@@ -13556,6 +14104,8 @@ PRAY_NOINLINE pray_status read_statements(Parser &P, const char *text, size_t le
         k++;
         P.arena->reset(c);
     }
+    if (st == PRAY_OK && !run) st = check_calls(P);
+    sites.release(c);
     *parse_time += clock_seconds() - t0;
     if (st && !run && !P.L->failed) {
         // the program is wrong: an error of its characters, anywhere, is the one to report
@@ -13595,7 +14145,10 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
     I.vars.init();
     I.vals.init();
     I.files.init();
+    I.procs.init();
     I.include_last = -1;
+    Arena keep;  // the bodies of procedures
+    keep.init();
     Parser P;
     memset(&P, 0, sizeof P);
     P.c = c;
@@ -13605,6 +14158,8 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
     P.arena = &tree;
     P.names = &names;
     P.vars = &I.vars;
+    P.procs = &I.procs;
+    P.keep = &keep;
     Array<int> hash;
     hash.init();
     P.hash = &hash;
@@ -13631,7 +14186,10 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
     c->stats.time_parse += parse_time;
     mem_phase(c, MEM_RUN);
     for (int i = 0; i < I.vals.n; i++) vrelease(I, I.vals[i]);
+    vrelease(I, I.ret);
     I.vals.release(c);
+    I.procs.release(c);
+    keep.release(c);
     I.last.release(c);
     I.order.release(c);
     I.dropped.release(c);

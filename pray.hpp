@@ -292,6 +292,12 @@ pray_rgb pray_texture_pixel(const pray_texture *tex, int x, int y);
 pray_model *pray_tiff(pray_ctx *ctx, pray_model *m0, pray_model *m1, pray_texture *tex);
 pray_model *pray_tiffbump(pray_ctx *ctx, pray_model *m, double amount, pray_texture *tex);
 pray_model *pray_move(pray_ctx *ctx, pray_model *m, double x, double y);
+/* Language version 3, a checkered surface: m0 where floor(x/s) + floor(y/s) + floor(z/s) is even,
+   m1 where it is odd (s > 0), (x, y, z) being the point in the coordinates of the primitive as it
+   was made (or painted, pray_paint), so that the pattern moves, turns and stretches with it. On a
+   face lying on a cell boundary the cell is that of the point a tiny step inside the solid: a
+   floor at z = 0 shows whole squares. */
+pray_model *pray_checker(pray_ctx *ctx, pray_model *m0, pray_model *m1, double s);
 
 /* Solids. */
 pray_object *pray_sphere(pray_ctx *ctx, pray_model *m, pray_vec centre, double radius);
@@ -339,12 +345,20 @@ pray_object *pray_rotate(pray_ctx *ctx, pray_object *a, pray_vec degrees);
 /* `stretch`: a scaled by the components of `factors` along the world axes X, Y, Z (none 0; a
    negative one mirrors). */
 pray_object *pray_stretch(pray_ctx *ctx, pray_object *a, pray_vec factors);
+/* Language version 3: a copy of `a` with model m on every primitive (shapes and texture
+   coordinates unchanged); a checker in m takes the coordinates the primitives have now. */
+pray_object *pray_paint(pray_ctx *ctx, pray_object *a, pray_model *m);
 /* Primitives in the tree (what `print` shows as "object (N primitives)"); 0 for NULL. */
 int pray_object_primitives(const pray_object *a);
 
 /* Lights. */
 pray_light *pray_dirlight(pray_ctx *ctx, pray_rgb intensity, pray_vec direction);
 pray_light *pray_pointlight(pray_ctx *ctx, pray_rgb intensity, pray_vec position);
+/* Language version 3: a point light at `position` shining along `direction` (not zero): full
+   intensity within a1 degrees of it, none beyond a2 degrees, and between them the share
+   t^2 (3 - 2t), t = (a2 - angle) / (a2 - a1); 0 <= a1 <= a2 < 180 (a1 = a2: a sharp edge). */
+pray_light *pray_spotlight(pray_ctx *ctx, pray_rgb intensity, pray_vec position, pray_vec direction, double a1,
+                           double a2);
 pray_light *pray_light_add(pray_ctx *ctx, pray_light *a, pray_light *b);
 /* The `.` transformations of lights: point lights move, directions turn. */
 pray_light *pray_light_scale(pray_ctx *ctx, pray_light *l, double s);
