@@ -8,7 +8,7 @@ STD       = -std=c++11
 PORTFLAGS = -O2 -ffp-contract=off -fno-math-errno
 LDFLAGS   = -nostdlib++ -Wl,--strip-all -lwasi-emulated-signal
 EXE       = .wasm
-RUN       = node --no-warnings ports/wasm/run.mjs
+RUN       = node --no-warnings --experimental-wasi-unstable-preview1 ports/wasm/run.mjs
 CONFIG    = ports/wasm/prayconf.h
 PACKAGES  = clang lld wasi-libc libclang-rt-14-dev-wasm32 nodejs
 EXTRA     = $(OUT)/libpray.wasm
