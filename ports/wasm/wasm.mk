@@ -6,7 +6,10 @@ NAME      = wasm
 CXX       = clang++ --target=wasm32-wasi --sysroot=/usr
 STD       = -std=c++11
 PORTFLAGS = -O2 -ffp-contract=off -fno-math-errno
-LDFLAGS   = -nostdlib++ -Wl,--strip-all -lwasi-emulated-signal
+# The stack first in memory, so that running out of it traps instead of overwriting data; 8 MB
+# for the deepest CSG trees (2000 levels; wasm-ld's default is 64 KB).
+STACK     = -Wl,--stack-first -Wl,-z,stack-size=8388608
+LDFLAGS   = -nostdlib++ -Wl,--strip-all $(STACK) -lwasi-emulated-signal
 EXE       = .wasm
 RUN       = node --no-warnings --experimental-wasi-unstable-preview1 ports/wasm/run.mjs
 CONFIG    = ports/wasm/prayconf.h
@@ -21,4 +24,4 @@ PLAYGROUND_MEMORY = 1073741824
 $(OUT)/libpray.wasm: pray.cpp pray.hpp $(CONFIG) ports/wasm/glue.cpp
 	@mkdir -p $(OUT)
 	$(CXX) $(FLAGS) -DPRAY_NO_STDIO -mexec-model=reactor pray.cpp ports/wasm/glue.cpp -o $@ \
-	  -nostdlib++ -Wl,--strip-all -Wl,--max-memory=$(PLAYGROUND_MEMORY) -lm
+	  -nostdlib++ -Wl,--strip-all $(STACK) -Wl,--max-memory=$(PLAYGROUND_MEMORY) -lm

@@ -99,7 +99,11 @@ async function run(job) {
 }
 
 onmessage = (e) => {
-    run(e.data).catch((err) => postMessage({
-        type: 'done', status: -1, error: 'error: the renderer stopped: ' + (err && err.message || err),
-        line: 0, col: 0, frames: 0, stats: '', seconds: 0 }));
+    run(e.data).catch((err) => {
+        let why = 'error: the renderer stopped: ' + (err && err.message || err);
+        if (err instanceof RangeError && /stack/.test(err.message)) {
+            why += ' (the browser gives a worker less stack than the deepest CSG trees need)';
+        }
+        postMessage({ type: 'done', status: -1, error: why, line: 0, col: 0, frames: 0, stats: '', seconds: 0 });
+    });
 };
