@@ -247,6 +247,7 @@ double clock_seconds() {
     return (double)clock() / CLOCKS_PER_SEC;
 #endif
 }
+
 #if PRAY_HAS_STDIO
 // Processor ticks, to vary a seed (temporary names).
 unsigned long clock_ticks() {
@@ -256,9 +257,7 @@ unsigned long clock_ticks() {
     return (unsigned long)clock();
 #endif
 }
-#endif
 
-#if PRAY_HAS_STDIO
 // Replace `to` by `from`. Windows' rename refuses to overwrite, so remove the target first.
 bool file_replace(const char *from, const char *to) {
 #if defined(_WIN32) || defined(__DJGPP__)

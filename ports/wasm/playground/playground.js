@@ -181,6 +181,9 @@ async function start() {
     $('program').addEventListener('input', () => drawGutter(0));
     $('program').addEventListener('scroll', () => { $('gutter').scrollTop = $('program').scrollTop; });
     $('render').addEventListener('click', render);
+    $('program').addEventListener('keydown', (e) => {
+        if (e.key === 'Enter' && (e.ctrlKey || e.metaKey) && !$('render').disabled) { e.preventDefault(); render(); }
+    });
     $('cancel').addEventListener('click', cancel);
     $('example').addEventListener('change', () => loadExample($('example').value).catch((e) => showError(e.message, 0, 0)));
     try {
@@ -200,6 +203,7 @@ async function start() {
             }),
         ]);
         state.module = await WebAssembly.compile(bytes);
+        $('render').disabled = false;
         setStatus('Ready.');
     } catch (e) {
         setStatus('The playground could not start.');
