@@ -7,7 +7,7 @@
 //  2. runs a program with an error and checks the message (the native program's, word for
 //     word), the line marked in the editor and the text selected;
 //  3. starts a long render (fractal.ray at 1024x1024, antialias 4), cancels it after its first
-//     rows and checks that the workers are gone and no row arrives after;
+//     rows and checks that the workers are gone and that none sends a row afterwards;
 //  4. renders the red sphere (examples/redsph.ray, antialias 2, 2 workers, statistics) and
 //     compares it with ./pray -D antialias=2, and the statistics shown;
 //  5. renders csg.ray at 1024x1024 in 1 worker, timed against the native program (1 thread).
@@ -105,12 +105,11 @@ try {
     const set = (id, value) => page.$eval('#' + id, (e, v) => {
         if (e.type === 'checkbox') e.checked = v; else e.value = v;
     }, value);
+    // pick an example and wait until the editor holds its text
     const choose = async (name) => {
         await page.select('#example', name);
-        await page.waitForFunction((n) => document.getElementById('program').value.length > 0 &&
-            window.playground && document.getElementById('example').value === n, {}, name);
-        await page.waitForFunction((n) => fetch('examples/' + n).then((r) => r.text())
-            .then((t) => document.getElementById('program').value === t), {}, name);
+        await page.waitForFunction((t) => document.getElementById('program').value === t, { polling: 50 },
+                                   readFileSync('examples/' + name, 'utf8'));
     };
     const renderAndWait = async () => {
         await page.click('#render');
