@@ -13,6 +13,9 @@
 #                   ARGS=--scaling: time and memory against 10^3 .. 10^6 primitives)
 #   make charts     speed against accuracy and the benchmarks, drawn (bench/charts.sh), docs/images/bench-*.png
 #   make ports      build, run and compare every port (ports/check; installs cross compilers, qemu, wine)
+#   make wasm       the wasm32-wasi port, run under Node and compared with ./pray (ports/check wasm)
+#   make playground the PRAY playground page in ports/build/playground/ (docs/playground.md)
+#   make playground-check  the playground in headless Chromium, compared with ./pray (installs chromium)
 #   make check-bad  the catalogue of bad inputs (tests/bad/run.sh); the last step of check
 #   make cmake-check  pray as a CMake and pkg-config package: tests/cmake/run.sh builds a consumer
 #   make mpi        the MPI front end ./pray-mpi (ports/mpi; installs OpenMPI if missing)
@@ -43,7 +46,7 @@ TESTS = tests/pray_tests$(EXE)
 TESTS_FLOAT = tests/pray_tests_float$(EXE)
 TEST_SRC = $(wildcard tests/test_*.cpp)
 
-.PHONY: FORCE all examples test sections check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff fuzz-join fuzz-long textures gallery ports pov suite charts mpi mpi-deps check-mpi
+.PHONY: FORCE all examples test sections check deps matrix clean embed bench check-bad sanitize fuzz fuzz-tiff fuzz-join fuzz-long textures gallery ports wasm playground playground-check pov suite charts mpi mpi-deps check-mpi
 
 all: $(PRAY)
 
@@ -304,6 +307,16 @@ matrix:
 # Every port built, run under qemu-user or wine, its images compared with ./pray's (ports/README.md).
 ports:
 	sh ports/check
+
+# The wasm32-wasi port alone: built with clang, run under Node, compared with ./pray.
+wasm:
+	sh ports/check wasm
+
+# The playground (ports/wasm/playground, docs/playground.md), and its test in headless Chromium.
+playground: $(PRAY)
+	sh ports/wasm/playground.sh
+playground-check: $(PRAY)
+	sh ports/wasm/playground-check.sh
 
 clean:
 	rm -rf $(PRAY) $(PRAY_MPI) build/mpi build/tests build/tests-float build/sanitize build/quick $(TESTS) $(TESTS_FLOAT) \

@@ -46,6 +46,12 @@
 
 #include "pray.hpp"
 
+// wasm32-wasi (ports/wasm): the C library's <signal.h> is an emulation to be asked for (it
+// gives sig_atomic_t and signal; the command-line program links -lwasi-emulated-signal).
+#if defined(__wasi__) && !defined(_WASI_EMULATED_SIGNAL)
+#define _WASI_EMULATED_SIGNAL
+#endif
+
 // No fused multiply-add behind our back: the same bits on every target (ports/README.md).
 #if defined(__clang__)
 #pragma STDC FP_CONTRACT OFF
@@ -230,6 +236,9 @@ void pray_assert_failed(const char *file, int line, const char *what) {
 double clock_seconds() {
 #if defined(_WIN32)
     return (double)GetTickCount() / 1000.0;
+#elif defined(__wasi__)  // no processor clock: clock() is only an emulation there
+    struct timespec ts;
+    return clock_gettime(CLOCK_MONOTONIC, &ts) == 0 ? (double)ts.tv_sec + ts.tv_nsec * 1e-9 : 0.0;
 #elif defined(PRAY_HAS_UNISTD) && defined(_POSIX_TIMERS) && _POSIX_TIMERS > 0
     struct timespec ts;
     if (clock_gettime(CLOCK_MONOTONIC, &ts) == 0) return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
@@ -240,6 +249,15 @@ double clock_seconds() {
 }
 
 #if PRAY_HAS_STDIO
+// Processor ticks, to vary a seed (temporary names).
+unsigned long clock_ticks() {
+#if defined(__wasi__)
+    return (unsigned long)(clock_seconds() * 1e6);
+#else
+    return (unsigned long)clock();
+#endif
+}
+
 // Replace `to` by `from`. Windows' rename refuses to overwrite, so remove the target first.
 bool file_replace(const char *from, const char *to) {
 #if defined(_WIN32) || defined(__DJGPP__)
@@ -9572,7 +9590,7 @@ FILE *create_temp(pray_ctx *c, const char *path, char **tmp) {
     FILE *f = NULL;
     errno = EEXIST;
     for (int tries = 0; !f && errno == EEXIST && tries < 100; tries++) {
-        unsigned long h = process_id() * 2654435761u ^ (unsigned long)(size_t)c ^ (unsigned long)clock() * 40503u;
+        unsigned long h = process_id() * 2654435761u ^ (unsigned long)(size_t)c ^ clock_ticks() * 40503u;
         h = h * 31 + c->temp_serial++ * 2246822519u;
         char id[7];
         for (int i = 0; i < 6; i++, h /= 36) id[i] = "0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZ"[h % 36];
