@@ -33,8 +33,8 @@ std::vector<testkit::Frame> render(const std::string &path, bool brute) {
 TEST_CASE("gallery: every example renders, and equals the brute-force reference") {
     const char *scenes[] = {"anim",    "chess",  "csg",      "cube",   "fractal", "glass",    "glassab",
                             "holes",   "loop",   "machine",  "maketex", "mirror", "models",   "parallel",
-                            "pc",      "rabbit", "redsph",   "room",   "roomball", "sign",    "street",
-                            "textures"};
+                            "pc",      "rabbit", "redsph",   "room",   "roomball", "sign",    "spot",
+                            "street",  "textures", "water"};
     const char *dir = std::getenv("PRAY_EXAMPLES");
     for (const char *n : scenes) {
         std::string path = std::string(dir ? dir : "examples/") + n + ".ray";

@@ -195,6 +195,14 @@ TEST_CASE("limit maxnest: the deepest program the option allows runs on the stac
     chain("mixok", 3, 40, render);  // 3 includes and 120 blocks around 900 parentheses: 1023
     testkit::spit(d / "mixok.ray", tree + "include \"mixok0.ray\"\n");
     CHECK(pray_small_stack("mixok.ray", "-D maxnest=1024") == "0 ");
+    // calls: 1022 nested calls of a procedure (each one level, the body one more) rendering at the
+    // innermost, and one past the bound
+    const std::string rec = "define R(n)\n  if n == 0\n    rendertiff O, L\n    return 0\n  endif\n  return R(n - 1)\nenddefine\n";
+    testkit::spit(d / "calls.ray", tree + rec + "X = R(1022)\n");
+    CHECK(pray_small_stack("calls.ray", "-D maxnest=1024") == "0 ");
+    testkit::spit(d / "calls2.ray", tree + rec + "X = R(1023)\n");
+    r = pray_small_stack("calls2.ray", "-D maxnest=1024");
+    CHECK_MESSAGE(r.find("1 calls2.ray:14:10: error: calls nested deeper than 1024 levels") == 0, r);
     chain("crash", 255, 255, "print 1\n");
     r = pray_small_stack("crash0.ray", "");
     CHECK_MESSAGE(r.find("1 crash1.ray:1:1: error: blocks nested deeper than 256 levels") == 0, r);

@@ -95,6 +95,7 @@ examples/machine.ray|A turning flywheel (image-sequence coherence)
 examples/redsph.ray|The red sphere
 examples/chess.ray|Chess
 examples/water.ray|A glass of water on a table
+examples/spot.ray|Spotlights
 examples/redsphx.ray|The red sphere as printed|The red sphere of the thesis' appendix A exactly as printed, slips included.
 EOF
 # every example must be in the list
