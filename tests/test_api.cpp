@@ -78,6 +78,9 @@ TEST_CASE("api: every function takes a NULL context and returns its error value"
     CHECK(pray_nothing(nullptr) == nullptr);
     CHECK(pray_dirlight(nullptr, WHITE, ONE) == nullptr);
     CHECK(pray_pointlight(nullptr, WHITE, ONE) == nullptr);
+    CHECK(pray_spotlight(nullptr, WHITE, ONE, UP, 10, 20) == nullptr);
+    CHECK(pray_checker(nullptr, nullptr, nullptr, 1) == nullptr);
+    CHECK(pray_paint(nullptr, nullptr, nullptr) == nullptr);
     CHECK(pray_perspective(nullptr, ONE, UP, ONE, ORIGIN) == PRAY_ERR_ARG);
     CHECK(pray_parallel(nullptr, ONE, UP, ONE, ORIGIN) == PRAY_ERR_ARG);
     CHECK(pray_lookat(nullptr, ONE, ORIGIN, UP, 40) == PRAY_ERR_ARG);
@@ -173,6 +176,10 @@ TEST_CASE("api: a NULL handle gives NULL, with a message naming the call unless 
         {"error: pray_tiff: no texture", [&] { return (const void *)pray_tiff(c, m, m, nullptr); }},
         {"error: pray_tiffbump: no model", [&] { return (const void *)pray_tiffbump(c, nullptr, 1, nullptr); }},
         {"error: pray_move: no model", [&] { return (const void *)pray_move(c, nullptr, 1, 1); }},
+        {"error: pray_checker: no model m0", [&] { return (const void *)pray_checker(c, nullptr, m, 1); }},
+        {"error: pray_checker: no model m1", [&] { return (const void *)pray_checker(c, m, nullptr, 1); }},
+        {"error: pray_paint: no object", [&] { return (const void *)pray_paint(c, nullptr, m); }},
+        {"error: pray_paint: no model", [&] { return (const void *)pray_paint(c, o, nullptr); }},
         {"error: pray_text: no model",
          [&] { return (const void *)pray_text(c, nullptr, "A", ORIGIN, ONE, UP, 1, nullptr, 1); }},
         {"error: pray_text: no text", [&] { return (const void *)pray_text(c, m, nullptr, ORIGIN, ONE, UP, 1, nullptr, 1); }, false},
@@ -281,6 +288,9 @@ TEST_CASE("api: handles, scenes and images of another context are refused") {
         {"error: pray_tiff: the model m0 belongs to another context", [&] { return !pray_tiff(a, m, ma, nullptr); }},
         {"error: pray_tiffbump: the model belongs to another context", [&] { return !pray_tiffbump(a, m, 1, nullptr); }},
         {"error: pray_move: the model belongs to another context", [&] { return !pray_move(a, m, 1, 1); }},
+        {"error: pray_checker: the model m1 belongs to another context", [&] { return !pray_checker(a, ma, m, 1); }},
+        {"error: pray_paint: the model belongs to another context", [&] { return !pray_paint(a, oa, m); }},
+        {"error: pray_paint: the object belongs to another context", [&] { return !pray_paint(a, o, ma); }},
         {"error: pray_text: the model belongs to another context",
          [&] { return !pray_text(a, m, "A", ORIGIN, ONE, UP, 1, nullptr, 1); }},
         {"error: pray_csg: the object a belongs to another context", [&] { return !pray_csg(a, PRAY_UNION, o, oa); }},
