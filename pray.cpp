@@ -11636,6 +11636,13 @@ const char *version2_note(const char *s) {
 struct Var {
     const char *name;
 };
+// A table of names (variables, procedures), hashed: programs written by generators may have many
+// thousands of them. hash: open addressing, index + 1, 0 = empty; size a power of two.
+struct Names {
+    Array<Var> list;
+    Array<int> hash;
+};
+
 
 struct Parser {
     pray_ctx *c;
@@ -11651,11 +11658,11 @@ struct Parser {
     double maxnest;  // option maxnest as the run started
     Arena *arena;    // the syntax tree of the statement being read
     Arena *names;    // the names of variables, for the whole run
-    Array<Var> *vars;
-    Array<int> *hash;  // open addressing: slot + 1, 0 = empty; size a power of two
+    Names *vars;       // the variables; a variable's index is its slot
     int included;      // reading a file that `include` named (the variables are the program's)
     int run;           // reading to run (else to check)
-    Array<Proc> *procs;      // the run's procedures, by name
+    Names *pnames;           // the names of the run's procedures
+    Array<Proc> *procs;      // the procedures, by the index of their names
     Array<CallSite> *sites;  // checking: the calls of procedures read so far in this file
     Arena *keep;             // running: where the bodies of procedures go (they live as long as the run)
     int in_proc;             // reading the body of a define
@@ -11733,30 +11740,29 @@ unsigned name_hash(const char *s) {
     return h;
 }
 
-// The slot of variable `name`, or -1 (then *at is where it would go; the table is not empty).
-int var_find(Parser &P, const char *name, unsigned *at = NULL) {
-    Array<int> &h = *P.hash;
+// The index of `name` in the table, or -1 (then *at is where it would go; the hash is not empty).
+int name_find(const Names &t, const char *name, unsigned *at = NULL) {
+    const Array<int> &h = t.hash;
     if (h.n == 0) return -1;
     unsigned k = name_hash(name) & (unsigned)(h.n - 1);
     for (; h[(int)k]; k = (k + 1) & (unsigned)(h.n - 1))
-        if (strcmp((*P.vars)[h[(int)k] - 1].name, name) == 0) return h[(int)k] - 1;
+        if (strcmp(t.list[h[(int)k] - 1].name, name) == 0) return h[(int)k] - 1;
     if (at) *at = k;
     return -1;
 }
 
-// The slot of a variable name, made on first sight. Programs written by generators may have
-// many thousands of names, so they are hashed.
-int var_slot(Parser &P, const char *name) {
-    Array<int> &h = *P.hash;
-    if (2 * (P.vars->n + 1) > h.n) {  // grow and rehash
+// The index of `name` in the table, made on first sight (the name kept in the run's names).
+int name_slot(Parser &P, Names &t, const char *name) {
+    Array<int> &h = t.hash;
+    if (2 * (t.list.n + 1) > h.n) {  // grow and rehash
         int size = h.n ? 2 * h.n : 64;
         Array<int> nh;
         nh.init();
         if (!nh.reserve(P.c, size)) return -1;
         nh.n = size;
         memset(nh.p, 0, sizeof(int) * (size_t)size);
-        for (int i = 0; i < P.vars->n; i++) {
-            unsigned k = name_hash((*P.vars)[i].name) & (unsigned)(size - 1);
+        for (int i = 0; i < t.list.n; i++) {
+            unsigned k = name_hash(t.list[i].name) & (unsigned)(size - 1);
             while (nh[(int)k]) k = (k + 1) & (unsigned)(size - 1);
             nh[(int)k] = i + 1;
         }
@@ -11764,7 +11770,7 @@ int var_slot(Parser &P, const char *name) {
         h = nh;
     }
     unsigned k = 0;
-    int found = var_find(P, name, &k);
+    int found = name_find(t, name, &k);
     if (found >= 0) return found;
     Var v;
     size_t len = strlen(name);
@@ -11772,10 +11778,12 @@ int var_slot(Parser &P, const char *name) {
     if (!kept) return -1;
     memcpy(kept, name, len + 1);
     v.name = kept;
-    if (!P.vars->push(P.c, v)) return -1;
-    h[(int)k] = P.vars->n;
-    return P.vars->n - 1;
+    if (!t.list.push(P.c, v)) return -1;
+    h[(int)k] = t.list.n;
+    return t.list.n - 1;
 }
+inline int var_find(Parser &P, const char *name) { return name_find(*P.vars, name); }
+inline int var_slot(Parser &P, const char *name) { return name_slot(P, *P.vars, name); }
 
 Expr *new_expr(Parser &P, int kind, const Tok &t) {
     Expr *e = (Expr *)P.arena->get(P.c, sizeof(Expr));
@@ -11881,24 +11889,16 @@ Expr *call_args(Parser &P, const Tok &t, int kind) {
 }
 
 // The procedure of that name, or -1.
-int proc_find(Parser &P, const char *name) {
-    for (int i = 0; i < P.procs->n; i++)
-        if (strcmp((*P.procs)[i].name, name) == 0) return i;
-    return -1;
-}
+inline int proc_find(Parser &P, const char *name) { return name_find(*P.pnames, name); }
 
 // The procedure of that name, made on first sight (a call may come before its define); -1: no memory.
 int proc_index(Parser &P, const char *name) {
-    int i = proc_find(P, name);
-    if (i >= 0) return i;
+    int i = name_slot(P, *P.pnames, name);
+    if (i < 0 || i < P.procs->n) return i;
     Proc p;
     memset(&p, 0, sizeof p);
-    size_t len = strlen(name);
-    char *kept = (char *)P.names->get(P.c, len + 1);
-    if (!kept) return -1;
-    memcpy(kept, name, len + 1);
-    p.name = kept;
-    return P.procs->push(P.c, p) ? P.procs->n - 1 : -1;
+    p.name = P.pnames->list[i].name;
+    return P.procs->push(P.c, p) ? i : -1;
 }
 
 // NAME '(' [args] ')' of a procedure; checked when the file is read whole (check_calls).
@@ -12002,7 +12002,7 @@ Expr *parse_primary(Parser &P) {
         if (!e) return NULL;
         e->n = var_slot(P, t.s);
         if (e->n < 0) return NULL;
-        e->s = (*P.vars)[e->n].name;
+        e->s = P.vars->list[e->n].name;
         return e;
     }
     if (is_op(t, '(')) {
@@ -12446,8 +12446,8 @@ Stmt *parse_define(Parser &P, const Tok &word) {
         ok = false;
     }
     if (s && ok) {
-        L.of = (int *)mem_alloc(P.c, sizeof(int) * (size_t)(P.vars->n + 1));
-        for (int i = 0; L.of && i <= P.vars->n; i++) L.of[i] = -1;
+        L.of = (int *)mem_alloc(P.c, sizeof(int) * (size_t)(P.vars->list.n + 1));
+        for (int i = 0; L.of && i <= P.vars->list.n; i++) L.of[i] = -1;
         for (int i = 0; L.of && i < L.slots.n; i++) L.of[L.slots[i]] = i;
         ok = L.of && collect_locals(P.c, L, body, nbody);
     }
@@ -12666,7 +12666,7 @@ struct Interp {
     int include_last;  // the last statement of the top level with an include in it, -1: none
     int depth;         // the blocks and includes around the statement running (option maxnest)
     int chained;       // the error's message has the places of the includes that led to it
-    Array<Var> vars;
+    Names vars;
     Array<Value> vals;  // by variable slot
     // Values no statement after will use are released (release_dead): last[slot] is the last
     // statement of the top level that names the slot; `order` the slots by it, `dead` how many of
@@ -13356,8 +13356,8 @@ pray_status eval_num(Interp &I, const Expr *e, double *x) {
 pray_status undefined_var(Interp &I, const Expr *e) {
     Suggest sg;
     sg.init(e->s);
-    for (int i = 0; i < I.vars.n; i++)
-        if (I.vals[i].t != V_NONE || (i < I.dropped.n && I.dropped[i])) sg.offer(I.vars[i].name);
+    for (int i = 0; i < I.vars.list.n; i++)
+        if (I.vals[i].t != V_NONE || (i < I.dropped.n && I.dropped[i])) sg.offer(I.vars.list[i].name);
     if (sg.best)
         return rerr(I, e, PRAY_ERR_RUNTIME, "undefined variable '%s'; did you mean '%s'?", *Shown(e->s), sg.best);
     return rerr(I, e, PRAY_ERR_RUNTIME, "undefined variable '%s'", *Shown(e->s));
@@ -14035,7 +14035,7 @@ int slot_last_cmp(const void *pa, const void *pb) {
 
 // I.order: the slots in the order in which they die (by I.last).
 bool order_slots(Interp &I) {
-    int n = I.vars.n;
+    int n = I.vars.list.n;
     if (!I.last.reserve(I.c, n)) return false;
     while (I.last.n < n) I.last.p[I.last.n++] = -1;  // (every slot was named; kept safe all the same)
     SlotLast *sl = (SlotLast *)mem_alloc(I.c, sizeof(SlotLast) * (size_t)n);
@@ -14099,13 +14099,13 @@ PRAY_NOINLINE pray_status read_statements(Parser &P, const char *text, size_t le
             break;
         }
         if (run) {
-            if (I->vars.n > I->vals.n) {  // (the check found every name already)
-                if (!I->vals.reserve(c, I->vars.n)) {
+            if (I->vars.list.n > I->vals.n) {  // (the check found every name already)
+                if (!I->vals.reserve(c, I->vars.list.n)) {
                     st = c->status;
                     break;
                 }
-                memset(I->vals.p + I->vals.n, 0, sizeof(Value) * (size_t)(I->vars.n - I->vals.n));
-                I->vals.n = I->vars.n;
+                memset(I->vals.p + I->vals.n, 0, sizeof(Value) * (size_t)(I->vars.list.n - I->vals.n));
+                I->vals.n = I->vars.list.n;
             }
             double t1 = clock_seconds();
             *parse_time += t1 - t0;
@@ -14160,7 +14160,8 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
     memset(&I, 0, sizeof I);
     I.c = c;
     I.name = I.prog = name;
-    I.vars.init();
+    I.vars.list.init();
+    I.vars.hash.init();
     I.vals.init();
     I.files.init();
     I.procs.init();
@@ -14176,11 +14177,12 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
     P.arena = &tree;
     P.names = &names;
     P.vars = &I.vars;
+    Names pnames;  // (the procedures' names)
+    pnames.list.init();
+    pnames.hash.init();
+    P.pnames = &pnames;
     P.procs = &I.procs;
     P.keep = &keep;
-    Array<int> hash;
-    hash.init();
-    P.hash = &hash;
     I.parser = &P;
     IncFile prog;
     prog.name = (char *)name;
@@ -14193,11 +14195,12 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
     I.order.init();
     I.dropped.init();
     if (st == PRAY_OK) st = read_statements(P, text, len, &I, false, &parse_time);
-    if (st == PRAY_OK && I.vars.n && (!I.vals.reserve(c, I.vars.n) || !order_slots(I))) st = c->status;
+    int nvars = I.vars.list.n;
+    if (st == PRAY_OK && nvars && (!I.vals.reserve(c, nvars) || !order_slots(I))) st = c->status;
     mem_phase(c, MEM_PARSE);
     if (st == PRAY_OK) {
-        if (I.vars.n) memset(I.vals.p, 0, sizeof(Value) * (size_t)I.vars.n);
-        I.vals.n = I.vars.n;
+        if (nvars) memset(I.vals.p, 0, sizeof(Value) * (size_t)nvars);
+        I.vals.n = nvars;
         tree.reset(c);
         st = read_statements(P, text, len, &I, true, &parse_time);
     }
@@ -14213,8 +14216,10 @@ pray_status run_program(pray_ctx *c, const char *name, const char *text, size_t 
     I.dropped.release(c);
     for (int i = 0; i < I.names.n; i++) mem_free(c, I.names[i].name);
     I.names.release(c);
-    I.vars.release(c);
-    hash.release(c);
+    I.vars.list.release(c);
+    I.vars.hash.release(c);
+    pnames.list.release(c);
+    pnames.hash.release(c);
     I.files.release(c);
     L.toks.release(c);
     tree.release(c);
