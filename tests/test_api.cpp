@@ -94,7 +94,7 @@ TEST_CASE("api: every function takes a NULL context and returns its error value"
     CHECK(pray_write_ppm(nullptr, &img, 8, nullptr, nullptr) == PRAY_ERR_ARG);
     CHECK(pray_write_png(nullptr, &img, nullptr, nullptr) == PRAY_ERR_ARG);
     float rgb[3] = {0, 0, 0};
-    pray_buffers bufs = {rgb, nullptr, nullptr, nullptr, 0};
+    pray_buffers bufs = {rgb, nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0};
     CHECK(pray_render_into(nullptr, nullptr, nullptr, nullptr, &bufs) == PRAY_ERR_ARG);
     pray_vec ro, rd;
     CHECK(pray_camera_ray(nullptr, 0.5, 0.5, &ro, &rd) == PRAY_ERR_ARG);
@@ -300,10 +300,10 @@ TEST_CASE("api: handles, scenes and images of another context are refused") {
         {"error: pray_render: the light belongs to another context",
          [&] { pray_image x; return pray_render(a, oa, l, &x) == PRAY_ERR_ARG && !x.pixels; }},
         {"error: pray_render_into: the object belongs to another context",
-         [&] { float px[3]; pray_buffers x = {px, nullptr, nullptr, nullptr, 0}; pray_rect r = {0, 0, 1, 1};
+         [&] { float px[3]; pray_buffers x = {px, nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0}; pray_rect r = {0, 0, 1, 1};
                return pray_render_into(a, o, la, &r, &x) == PRAY_ERR_ARG; }},
         {"error: pray_render_into: the light belongs to another context",
-         [&] { float px[3]; pray_buffers x = {px, nullptr, nullptr, nullptr, 0}; pray_rect r = {0, 0, 1, 1};
+         [&] { float px[3]; pray_buffers x = {px, nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0}; pray_rect r = {0, 0, 1, 1};
                return pray_render_into(a, oa, l, &r, &x) == PRAY_ERR_ARG; }},
         {"error: pray_intersect: the scene belongs to another context",
          [&] { return pray_intersect(a, sc, ONE, UP, HUGE_VAL, nullptr, 0) == -1; }},
@@ -857,7 +857,7 @@ std::vector<float> render_rect(pray_ctx *c, pray_object *o, pray_light *l, int b
     std::vector<float> px((size_t)40 * 30 * 3);
     for (int b = 0; b < bands; b++) {
         pray_rect r = {0, 30 * b / bands, 40, 30 * (b + 1) / bands - 30 * b / bands};
-        pray_buffers out = {px.data() + (size_t)3 * 40 * r.y, nullptr, nullptr, nullptr, 40};
+        pray_buffers out = {px.data() + (size_t)3 * 40 * r.y, nullptr, nullptr, nullptr, 40, nullptr, nullptr, 0};
         REQUIRE(pray_render_into(c, o, l, &r, &out) == PRAY_OK);
     }
     return px;
@@ -938,7 +938,7 @@ TEST_CASE("api: a scene prepared for rendering is rendered by other contexts on 
             pray_option(d, "antialias", 1);
             pray_option(d, "threads", 1 + k % 2);
             pray_rect r = {0, 30 * k / 4, 40, 30 * (k + 1) / 4 - 30 * k / 4};
-            pray_buffers out = {bands.data() + (size_t)3 * 40 * r.y, nullptr, nullptr, nullptr, 40};
+            pray_buffers out = {bands.data() + (size_t)3 * 40 * r.y, nullptr, nullptr, nullptr, 40, nullptr, nullptr, 0};
             if (pray_render_prepared(d, q, &r, &out) != PRAY_OK) failed++;
             pray_free(d);
         });
@@ -951,7 +951,8 @@ TEST_CASE("api: a scene prepared for rendering is rendered by other contexts on 
     CHECK(pray_intersect(c, q, from, towards, HUGE_VAL, &h, 1) >= 1);
     // what it refuses
     pray_ctx *d = pray_new();
-    pray_buffers none = {nullptr, nullptr, nullptr, nullptr, 0}, one = {bands.data(), nullptr, nullptr, nullptr, 0};
+    pray_buffers none = {nullptr, nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0};
+    pray_buffers one = {bands.data(), nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0};
     pray_rect outside = {0, 20, 40, 11};
     CHECK(pray_render_prepared(d, nullptr, nullptr, &one) == PRAY_ERR_ARG);
     CHECK(std::string(pray_error(d)) == "error: pray_render_prepared: no scene");
