@@ -9350,10 +9350,7 @@ pray_status write_tiff(pray_ctx *c, const pray_image *img, int bits, Sink &out, 
     out.put(h, desc);
     if (note) out.put(note, nlen);  // with its NUL, as ASCII fields end
     for (unsigned long y = 0; y < H; y++) {
-        if (cancelled(c)) {
-            mem_free(c, row);
-            return fail_cancelled(c);
-        }
+        if (cancelled(c)) return mem_free(c, row), fail_cancelled(c);
         const float *px = img->pixels + (size_t)y * W * 3;
         for (size_t i = 0; i < (size_t)W * 3; i++) {
             if (bits == 8) row[i] = (unsigned char)quantize(px[i], 255);
@@ -9382,10 +9379,7 @@ pray_status write_ppm(pray_ctx *c, const pray_image *img, int bits, Sink &out, c
     }
     out.put(head, (size_t)n);
     for (int y = 0; y < img->height; y++) {
-        if (cancelled(c)) {
-            mem_free(c, row);
-            return fail_cancelled(c);
-        }
+        if (cancelled(c)) return mem_free(c, row), fail_cancelled(c);
         const float *px = img->pixels + (size_t)y * img->width * 3;
         for (size_t i = 0; i < (size_t)img->width * 3; i++) {
             if (bits == 8) row[i] = (unsigned char)quantize(px[i], 255);
@@ -9435,10 +9429,7 @@ pray_status write_png(pray_ctx *c, const pray_image *img, Sink &out) {
     unsigned char *buf = (unsigned char *)mem_alloc(c, n);
     if (!buf) return c->status;
     for (size_t i = 0; i < n; i++) buf[i] = (unsigned char)quantize(img->pixels[i], 255);
-    if (cancelled(c)) {
-        mem_free(c, buf);
-        return fail_cancelled(c);
-    }
+    if (cancelled(c)) return mem_free(c, buf), fail_cancelled(c);
     PngEncoding e;
     e.c = c;
     e.held.next = e.held.prev = &e.held;
@@ -10474,14 +10465,31 @@ void prepared_drop(pray_ctx *c) {
     mem_free(c, p);
 }
 
+// A kept scene whose setup differs from the context's in the camera alone takes the new camera:
+// of its preparation only the eye's buffer depends on the camera (on the eye's place and on the
+// kind of camera, not on where it looks), so it stays unless those changed.
+void recamera(pray_ctx *c, Prepared *p) {
+    Setup t;
+    const Setup &n = c->cur;
+    memcpy(&t, &p->setup, sizeof t);
+    t.parallel = n.parallel, t.cam_x = n.cam_x, t.cam_y = n.cam_y, t.cam_eye = n.cam_eye, t.cam_point = n.cam_point;
+    t.lookat = n.lookat, t.cam_up = n.cam_up, t.cam_angle = n.cam_angle;
+    bool eye = p->s.accel && p->s.accel->eye && memcmp(&n.cam_eye, &p->setup.cam_eye, sizeof n.cam_eye) != 0;
+    if (memcmp(&t, &n, sizeof t) != 0 || n.parallel != p->setup.parallel || eye) return;
+    scene_camera(c, &p->s);
+    memcpy(&p->setup, &n, sizeof t);
+}
+
 // The one way to render: rectangle r of the image into the buffers (stride set), both checked;
-// with the scene kept from the render before when it is the same (Prepared).
+// with the scene kept from the render before when it is the same (Prepared), or differs in the
+// camera alone (recamera).
 pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, const pray_rect &r,
                         const pray_buffers &out) {
     double t0 = clock_seconds();
     mem_phase(c, MEM_RUN);
     Prepared *p = c->prep;
     bool keep = (!c->running || c->in_render_fn) && c->drop != root;
+    if (p && keep && p->root == root && p->lights == lights) recamera(c, p);
     if (p && !(keep && p->root == root && p->lights == lights && memcmp(&p->setup, &c->cur, sizeof(Setup)) == 0)) {
         prepared_drop(c);  // (before another is built: the two need not fit at once)
         p = NULL;
@@ -10937,10 +10945,7 @@ pray_status pray_image_new(pray_ctx *c, int width, int height, pray_image *out) 
 
 pray_status pray_set_error(pray_ctx *c, int code, const char *message) {
     if (!c) return PRAY_ERR_ARG;
-    if (code == PRAY_OK) {
-        pray_clear_error(c);
-        return PRAY_OK;
-    }
+    if (code == PRAY_OK) return pray_clear_error(c), PRAY_OK;
     // (an int: in C++ a value outside the enumeration cannot be a pray_status)
     pray_status status = code >= PRAY_ERR_NOMEM && code <= PRAY_ERR_CANCELLED ? (pray_status)code : PRAY_ERR_ARG;
     return fail(c, status, "%s", message ? message : pray_status_text(status));

@@ -593,10 +593,14 @@ typedef struct pray_buffers {
    context keeps the scene pray_render_into and pray_render prepared (flattened, simplified, with
    its grid), and the next render of the same root and lights with the same options, camera and
    background uses it again, so that bands, tiles and passes cost what the whole image costs. It
-   holds a reference to root and lights meanwhile (releasing yours is safe). Rendering another
-   scene or lights, changing an option, the camera or the background, the start or the end of a
-   program's run, or pray_free drops it. To render one scene from several threads at once, see
-   pray_prepare_render. */
+   holds a reference to root and lights meanwhile (releasing yours is safe). Of the preparation
+   only the eye's buffer depends on the camera, so a new camera of the same kind (parallel or
+   perspective) keeps it, taking the new camera, when the eye stays where it was (the camera
+   turned about its eye) or the scene has no eye's buffer (option eyebuffer 0, a parallel
+   camera, or too few samples for one: pray_stats.eyebuf_voxels 0). Rendering another scene or
+   lights, changing an option or the background, any other new camera, setting an id
+   (pray_object_set_id), the start or the end of a program's run, or pray_free drops it. To
+   render one scene from several threads at once, see pray_prepare_render. */
 pray_status pray_render_into(pray_ctx *ctx, pray_object *root, pray_light *lights, const pray_rect *rect,
                              const pray_buffers *out);
 /* A scene prepared for rendering, with the context's options, camera and background as they are
