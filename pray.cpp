@@ -10051,8 +10051,10 @@ pray_texture *pray_texture_tiff(pray_ctx *c, const void *data, size_t n, const c
 pray_texture *pray_texture_rgb(pray_ctx *c, int w, int h, const float *rgb, const char *name) {
     if (!c) return NULL;
     if (!rgb) return fail(c, PRAY_ERR_ARG, "pray_texture_rgb: no pixels"), (pray_texture *)NULL;
-    if (w < 1 || h < 1 || w > 65536 || h > 65536)
-        return fail(c, PRAY_ERR_ARG, "pray_texture_rgb: image size %d x %d is out of range (1 to 65536 a side)", w, h), (pray_texture *)NULL;
+    if (w < 1 || h < 1 || w > 65536 || h > 65536) {
+        fail(c, PRAY_ERR_ARG, "pray_texture_rgb: image size %d x %d is out of range (1 to 65536 a side)", w, h);
+        return NULL;
+    }
     size_t n = (size_t)w * (size_t)h * 3;
     if ((double)n * sizeof(float) > c->cur.opt.v[OPT_TEXMEM] * 1048576.0) {
         fail(c, PRAY_ERR_LIMIT, "pray_texture_rgb: a %d x %d texture is over the texture memory limit (option texmem)",
