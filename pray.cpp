@@ -13225,14 +13225,10 @@ FILE *include_file(Interp &I, const Expr *f, char **path, FileId *id, Text *t) {
     return NULL;
 #else
     pray_ctx *c = I.c;
-    const char *why = c->untrusted ? untrusted_path_problem(f->s) : NULL;
-    if (why) {
-        rerr(I, f, PRAY_ERR_RUNTIME, "untrusted program: '%s' is %s; files are read from the program's "
-             "directory only", *Shown(f->s), why);
-        return NULL;
-    }
-    // the name beside the including file; an untrusted program's, from the program's directory
-    size_t dlen = 0, from = c->untrusted ? c->run_dir_len : 0;
+    // the name beside the including file; an untrusted program's, from the program's directory (a
+    // text the host registered is beside its name, which must then obey the same rules)
+    bool in_dir = c->untrusted && c->run_dir && strncmp(I.name, c->run_dir, c->run_dir_len) == 0;
+    size_t dlen = 0, from = in_dir ? c->run_dir_len : 0;
     for (size_t i = 0; I.name[i]; i++)
         if (I.name[i] == '/' || I.name[i] == '\\' || I.name[i] == ':') dlen = i + 1;
     bool relative = f->s[0] && f->s[0] != '/' && f->s[0] != '\\' && f->s[1] != ':';
@@ -13242,6 +13238,12 @@ FILE *include_file(Interp &I, const Expr *f, char **path, FileId *id, Text *t) {
     if (!rel) return NULL;
     memcpy(rel, I.name + from, dlen - from);
     memcpy(rel + dlen - from, f->s, n + 1);
+    const char *named = untrusted_path_problem(f->s) ? f->s : rel, *why = c->untrusted ? untrusted_path_problem(named) : NULL;
+    if (why) {
+        rerr(I, f, PRAY_ERR_RUNTIME, "untrusted program: '%s' is %s; files are read from the program's "
+             "directory only", *Shown(named), why);
+        return mem_free(c, rel), (FILE *)NULL;
+    }
     FILE *in = c->untrusted ? open_read(c, c->run_dir, c->run_dir_len, rel, FIND_CONFINED, path, id)
                             : open_read(c, "", 0, rel, FIND_AS_NAMED, path, id);
     mem_free(c, rel);

@@ -760,6 +760,15 @@ TEST_CASE("pray_include_register: an include of a registered text renders as the
     testkit::Result up = run_in(c, main_program("include \"../up/ball.ray\"\n"));
     REQUIRE_MESSAGE(up.status == PRAY_OK, up.error);
     CHECK(up.frames[0].pixels == inlined.frames[0].pixels);
+    // a file it includes is beside its name, which must then keep to the program's directory
+    REQUIRE(reg(c, "../up/more.ray", "include \"next.ray\"\n"));
+    testkit::Result out = run_in(c, "include \"../up/more.ray\"\n");
+    CHECK(out.status == PRAY_ERR_RUNTIME);
+#ifdef PRAY_NO_STDIO
+    CHECK(contains(out.error, "include: this build has no file access"));
+#else
+    CHECK(contains(out.error, "untrusted program: '../up/next.ray' is a name with '..'"));
+#endif
     // removed: include looks for a file (none here; without file access, none at all)
     REQUIRE(pray_include_register(c, "parts/ball.ray", nullptr, 0) == PRAY_OK);
     REQUIRE(pray_include_register(c, "never registered", nullptr, 0) == PRAY_OK);
