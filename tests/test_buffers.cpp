@@ -442,6 +442,15 @@ TEST_CASE("pray_object_set_id: the innermost id around a primitive, in pray_hit 
     }
     CHECK(bad == 0);
     CHECK(changed > 50);
+    // a scene prepared for rendering gives the same ids, and keeps them when an id changes after
+    pray_scene *qr = pray_prepare_render(c, root, nullptr);
+    REQUIRE(qr);
+    REQUIRE(pray_object_set_id(c, floor, 11) == PRAY_OK);
+    std::vector<int> id3((size_t)W * H);
+    b.id = id3.data();
+    REQUIRE(pray_render_prepared(c, qr, nullptr, &b) == PRAY_OK);
+    CHECK(id3 == id2);
+    pray_scene_free(c, qr);
     for (void *h : {(void *)red, (void *)floor, (void *)ball, (void *)cut, (void *)solid, (void *)mball, (void *)root})
         pray_release(c, h);
 }
