@@ -278,7 +278,7 @@ fuzz-join: build/fuzz/fuzz_join
 # The textures of the examples, made by pray itself.
 textures: $(PRAY)
 	@mkdir -p examples/tex
-	$(RUN) ./$(PRAY) --quiet examples/maketex.ray
+	cd examples/tex && $(RUN) ../../$(PRAY) --quiet ../maketex.ray
 
 # The gallery: every example rendered at 256 x 256 with its statistics (docs/gallery.md).
 gallery: $(PRAY) textures

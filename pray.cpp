@@ -20,7 +20,7 @@
                           list evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver
    [SECTION] 9c    950  Reading files (programs, textures, fonts), TIFF reader and textures, the
                           built-in font
-   [SECTION] 10   1200  Whitted shading, textured surfaces, the render driver (threads, undersampling)
+   [SECTION] 10   1250  Whitted shading, textured surfaces, the render driver (threads, undersampling)
    [SECTION] 10b   600  Image sequences (3.7): the regions a ray crosses, comparing a frame's scene
                           with the one before, records
    [SECTION] 11   1800  Image writers: TIFF, PPM, PNG; writing files safely; public functions
@@ -540,11 +540,13 @@ struct ReadFile {
     char *name;
 };
 
-// A texture the host registered under a name (pray_texture_register).
+// A texture or a program text the host registered under a name (pray_texture_register,
+// pray_include_register).
 struct TexName {
     TexName *next;
     pray_texture *tex;
-    char *name;
+    char *name, *text;
+    size_t len;
 };
 
 } // namespace
@@ -608,6 +610,7 @@ struct pray_ctx {
     int frames;
     pray_texture *textures;  // files decoded in this run
     TexName *tex_names;      // textures registered by the host, looked up before files
+    TexName *inc_names;      // and texts for include
     const char *run_dir;     // directory of the running program: the start of its name
     size_t run_dir_len;      // (0: the current directory), for texture files
     FileId prog_id;          // the program file being run, which no image may replace
@@ -1200,6 +1203,7 @@ struct pray_object {
     int nkids, k0;
     long nprims;
     int depth;
+    int uid;  // the host's id (pray_object_set_id), or PRAY_NO_ID
 };
 
 namespace {
@@ -1291,6 +1295,7 @@ pray_object *obj_new(pray_ctx *c, int kind, pray_model *m) {
     retain(m);
     o->nprims = is_prim(kind) ? 1 : 0;
     o->depth = 1;
+    o->uid = PRAY_NO_ID;
     return o;
 }
 
@@ -1333,8 +1338,8 @@ bool is_node(int kind) { return kind >= O_UNION; }
 // (for difference only the left side chains), else a itself; likewise b for union and
 // intersection.
 pray_object *csg_make(pray_ctx *c, int op, pray_object *a, pray_object *b) {
-    bool sa = a->kind == op;
-    bool sb = b->kind == op && op != O_DIFF;
+    bool sa = a->kind == op && a->uid == PRAY_NO_ID;  // (a chain with an id stays a part: its id is its parts')
+    bool sb = b->kind == op && op != O_DIFF && b->uid == PRAY_NO_ID;
     int na = sa ? a->nkids : 1, nb = sb ? b->nkids : 1;
     int depth = (sa ? a->depth : a->depth + 1);
     int db = sb ? b->depth : b->depth + 1;
@@ -1994,6 +1999,7 @@ struct Prim {
     const PrimMap *tm;
     const PrimFrame *fr;  // framed kinds: p, n, r are local (NULL for the others)
     int id;             // position among the declared primitives, left to right
+    int uid;            // the host's id of the innermost object with one around it (PRAY_NO_ID)
     int surf;           // the same number for primitives snapped to exactly one surface (twins)
     int parent;         // node index, -1 for the root
     unsigned char first;  // first child of a difference
@@ -2030,6 +2036,7 @@ struct Scene {
     int root;
     int prune;        // drop parts that bounds show cannot matter
     int leaves;       // primitives met so far while flattening
+    int uid;          // the id of the innermost object with one, around what is flattened
     int tori;         // tori among the primitives (each may cross a ray four times)
     int iface;        // two different materials may meet inside the solid (scene_interfaces)
     Accel *accel;     // NULL: the brute-force reference
@@ -2441,7 +2448,15 @@ Axis plane_axis(R3 n) {
 // `one` and `nothing` away and merging chains; with s->prune, also dropping what bounds prove
 // cannot matter. Parts left out stay in the arrays without a parent until scene_compact.
 // Returns the element code, or -3 when out of memory.
-int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
+int flatten_in(pray_ctx *c, Scene *s, const pray_object *o);
+int flatten(pray_ctx *c, Scene *s, const pray_object *o) {  // (with the id around each part)
+    int outer = s->uid;
+    s->uid = o->uid != PRAY_NO_ID ? o->uid : outer;
+    int e = flatten_in(c, s, o);
+    s->uid = outer;
+    return e;
+}
+int flatten_in(pray_ctx *c, Scene *s, const pray_object *o) {
     switch (o->kind) {
     case O_ONE: return E_ALL;
     case O_NOTHING: return E_NONE;
@@ -2458,6 +2473,7 @@ int flatten(pray_ctx *c, Scene *s, const pray_object *o) {
         q.mat = o->mat;
         q.parent = -1;
         q.id = s->leaves++;
+        q.uid = s->uid;
         if (o->map || o->mat->checks) {
             PrimMap *m = (PrimMap *)mem_zalloc(c, sizeof(PrimMap));
             if (!m || !s->maps.push(c, m)) {
@@ -7310,12 +7326,24 @@ void texture_cache_clear(pray_ctx *c) {
 #endif
 }
 
-// Where the host's registration of exactly `name` is kept (pray_texture_register), else where
-// a new one would go: the end of the list.
-TexName **texture_name_at(pray_ctx *c, const char *name) {
-    TexName **at = &c->tex_names;
+// Where the host's registration of exactly `name` is kept in the list `at` (c->tex_names,
+// c->inc_names), else where a new one would go: the end of the list.
+TexName **name_at(TexName **at, const char *name) {
     while (*at && strcmp((*at)->name, name) != 0) at = &(*at)->next;
     return at;
+}
+// A new registration of `name` put at *at (the end of its list), or NULL when out of memory.
+TexName *name_add(pray_ctx *c, TexName **at, const char *name) {
+    TexName *e = (TexName *)mem_zalloc(c, sizeof(TexName));
+    if (e && !(e->name = mem_strdup(c, name, strlen(name)))) mem_free(c, e), e = NULL;
+    return e ? *at = e : NULL;
+}
+void name_drop(pray_ctx *c, TexName **at) {  // (the texture released)
+    TexName *e = *at;
+    *at = e->next;
+    mem_free(c, e->text);
+    mem_free(c, e->name);
+    mem_free(c, e);
 }
 
 // The place of coordinate u within the repeating image, in [0, 1); 0 for a coordinate that is
@@ -8073,6 +8101,7 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     s->kids.init();
     s->prune = opt_int(c, OPT_BOUNDS) && !opt_int(c, OPT_BRUTE);
     s->models_held = 1;  // each primitive flattened holds its model
+    s->uid = PRAY_NO_ID;
     // room for every primitive the tree stands for, and no more (folding may leave some out)
     if (root->nprims > 0 && !s->prims.reserve_exact(c, (int)root->nprims)) return c->status;
     s->root = flatten(c, s, root);
@@ -8249,11 +8278,12 @@ pray_rgb pixel(Worker &k, int i, int j) {
     return cscale(sum, 1.0 / ((double)A * A));
 }
 
-// A hit as pray_intersect reports it.
-void public_hit(const Scene *s, const Ray &ray, const Hit &h, pray_hit *o) {
+// A hit as pray_intersect reports it; *albedo (may be NULL): pray_buffers.albedo's colour there.
+void public_hit(const Scene *s, const Ray &ray, const Hit &h, pray_hit *o, pray_rgb *albedo = NULL) {
     const Prim &q = s->prims[h.prim];
     o->t = (double)h.t;
     o->primitive = q.id;
+    o->id = q.uid;
     o->entering = h.from >= 0 ? 2 : h.root_enter;
     R3 x = ray.o + ray.d * h.t, ng = prim_normal(q, x);
     R3 nn = h.prim_enter == h.root_enter ? ng : ng * (real)-1;
@@ -8263,6 +8293,8 @@ void public_hit(const Scene *s, const Ray &ray, const Hit &h, pray_hit *o) {
     double ts, tt;
     R3 ds, dt, rd = r3(0, 0, 0);
     shade_at(s->prims[h.mat], x, &sh, &ts, &tt, &ds, &dt, q, ray.d, h.root_enter || h.from >= 0);
+    pray_rgb a = cadd(cadd(sh.diffuse, sh.emit), cadd(sh.reflect, sh.transmit));
+    if (albedo) *albedo = cmake(a.r < 1 ? a.r : 1, a.g < 1 ? a.g : 1, a.b < 1 ? a.b : 1);
     if (!czero(sh.transmit)) {
         R3 n = shading_normal(q, x, sh, ds, dt, h.prim_enter == h.root_enter, ray.d);
         if (!refract_dir(ray.d, n, hit_eta(s, h, x, ray.d, sh), &rd)) rd = r3(0, 0, 0);
@@ -8288,29 +8320,53 @@ void put_kept(const Job *job, int i0, int i1, int j) {
            sizeof(float) * 3 * (size_t)(i1 - i0));
 }
 
-// The per-pixel outputs of pixel (i, j): pray_intersect's first hit on the ray through its centre
-// (pray_camera_ray's ray, its direction made unit again as pray_intersect does).
-void put_first_hit(Worker &k, int i, int j) {
-    const Job *job = k.job;
-    Ray ray = image_ray(job->s, i + 0.5, j + 0.5);
+// pray_intersect's first hit on ray (its direction made unit again as pray_intersect does) into
+// *h, and its albedo; the background's: primitive and id -1, t infinite, normal and albedo 0.
+void first_hit(Worker &k, Ray ray, pray_hit *h, pray_rgb *albedo) {
     ray.d = unit(ray.d);
     FirstHit fh;
     fh.found = false;
-    if (job->s->iface) across(job->s, &k.w, ray, REAL_INF, -1, fh, -1, false);
-    else find_hits(job->s, &k.w, ray, REAL_INF, -1, fh);
-    pray_hit h;
-    h.primitive = -1;
-    h.t = HUGE_VAL;
-    h.normal = vmake(0, 0, 0);
-    if (fh.found) public_hit(job->s, ray, fh.h, &h);
+    if (k.job->s->iface) across(k.job->s, &k.w, ray, REAL_INF, -1, fh, -1, false);
+    else find_hits(k.job->s, &k.w, ray, REAL_INF, -1, fh);
+    h->primitive = h->id = -1;
+    h->t = HUGE_VAL;
+    h->normal = vmake(0, 0, 0);
+    *albedo = cmake(0, 0, 0);
+    if (fh.found) public_hit(k.job->s, ray, fh.h, h, albedo);
+}
+
+bool extra_outputs(const pray_buffers &b) { return b.primitive || b.depth || b.normal || b.id || b.albedo; }
+
+void put_float3(float *buf, size_t at, double x, double y, double z) {
+    if (buf) buf[at * 3] = (float)x, buf[at * 3 + 1] = (float)y, buf[at * 3 + 2] = (float)z;
+}
+
+// The per-pixel outputs of pixel (i, j): the first hit on the ray through its centre
+// (pray_camera_ray's); with PRAY_BUFFERS_SAMPLES, normal and albedo are the means over its samples.
+void put_first_hit(Worker &k, int i, int j) {
+    const Job *job = k.job;
+    pray_hit h, e;
+    pray_rgb al, ea;
+    first_hit(k, image_ray(job->s, i + 0.5, j + 0.5), &h, &al);
+    int A = job->out.flags & PRAY_BUFFERS_SAMPLES ? job->s->antialias : 1;
+    if (A > 1 && (job->out.normal || job->out.albedo)) {
+        h.normal = vmake(0, 0, 0);
+        al = cmake(0, 0, 0);
+        for (int b = 0; b < A; b++)
+            for (int a = 0; a < A; a++) {
+                first_hit(k, sample_ray(job->s, i, j, a, b), &e, &ea);
+                h.normal = vadd(h.normal, e.normal);
+                al = cadd(al, ea);
+            }
+        h.normal = vmul(h.normal, 1.0 / ((double)A * A));
+        al = cscale(al, 1.0 / ((double)A * A));
+    }
     size_t at = out_index(job, i, j);
     if (job->out.primitive) job->out.primitive[at] = h.primitive;
+    if (job->out.id) job->out.id[at] = h.id;
     if (job->out.depth) job->out.depth[at] = (float)h.t;
-    if (job->out.normal) {
-        job->out.normal[at * 3] = (float)h.normal.x;
-        job->out.normal[at * 3 + 1] = (float)h.normal.y;
-        job->out.normal[at * 3 + 2] = (float)h.normal.z;
-    }
+    put_float3(job->out.normal, at, h.normal.x, h.normal.y, h.normal.z);
+    put_float3(job->out.albedo, at, al.r, al.g, al.b);
 }
 
 void set_row_background(Worker &k, int j) {
@@ -8519,7 +8575,7 @@ void render_band(Worker &k, int band) {
     int x0 = job->r.x, x1 = job->r.x + job->r.width, y0, y1;
     band_rows_in(job, band, &y0, &y1);
     shadow_cache_clear(s, k.tr.w);
-    if (job->out.primitive || job->out.depth || job->out.normal)
+    if (extra_outputs(job->out))
         for (int j = y0; j < y1; j++)
             for (int i = x0; i < x1; i++) put_first_hit(k, i, j);
     if (!job->out.rgb) return;
@@ -9406,10 +9462,7 @@ pray_status write_tiff(pray_ctx *c, const pray_image *img, int bits, Sink &out, 
     out.put(h, desc);
     if (note) out.put(note, nlen);  // with its NUL, as ASCII fields end
     for (unsigned long y = 0; y < H; y++) {
-        if (cancelled(c)) {
-            mem_free(c, row);
-            return fail_cancelled(c);
-        }
+        if (cancelled(c)) return mem_free(c, row), fail_cancelled(c);
         const float *px = img->pixels + (size_t)y * W * 3;
         for (size_t i = 0; i < (size_t)W * 3; i++) {
             if (bits == 8) row[i] = (unsigned char)quantize(px[i], 255);
@@ -9438,10 +9491,7 @@ pray_status write_ppm(pray_ctx *c, const pray_image *img, int bits, Sink &out, c
     }
     out.put(head, (size_t)n);
     for (int y = 0; y < img->height; y++) {
-        if (cancelled(c)) {
-            mem_free(c, row);
-            return fail_cancelled(c);
-        }
+        if (cancelled(c)) return mem_free(c, row), fail_cancelled(c);
         const float *px = img->pixels + (size_t)y * img->width * 3;
         for (size_t i = 0; i < (size_t)img->width * 3; i++) {
             if (bits == 8) row[i] = (unsigned char)quantize(px[i], 255);
@@ -9491,10 +9541,7 @@ pray_status write_png(pray_ctx *c, const pray_image *img, Sink &out) {
     unsigned char *buf = (unsigned char *)mem_alloc(c, n);
     if (!buf) return c->status;
     for (size_t i = 0; i < n; i++) buf[i] = (unsigned char)quantize(img->pixels[i], 255);
-    if (cancelled(c)) {
-        mem_free(c, buf);
-        return fail_cancelled(c);
-    }
+    if (cancelled(c)) return mem_free(c, buf), fail_cancelled(c);
     PngEncoding e;
     e.c = c;
     e.held.next = e.held.prev = &e.held;
@@ -9896,14 +9943,8 @@ bool bad_rgb(pray_ctx *c, pray_rgb v, const char *what) {
     return true;
 }
 bool bad_vec(pray_ctx *c, pray_vec v, const char *what, bool nonzero) {
-    if (!vfinite(v)) {
-        fail(c, PRAY_ERR_ARG, "%s: coordinates are not finite", what);
-        return true;
-    }
-    if (nonzero && v.x == 0 && v.y == 0 && v.z == 0) {
-        fail(c, PRAY_ERR_ARG, "%s: zero-length vector", what);
-        return true;
-    }
+    if (!vfinite(v)) return fail(c, PRAY_ERR_ARG, "%s: coordinates are not finite", what), true;
+    if (nonzero && v.x == 0 && v.y == 0 && v.z == 0) return fail(c, PRAY_ERR_ARG, "%s: zero-length vector", what), true;
     return false;
 }
 bool bad_radius(pray_ctx *c, double r, const char *what) {
@@ -9914,12 +9955,9 @@ bool bad_radius(pray_ctx *c, double r, const char *what) {
 } // namespace
 
 pray_model *pray_phong(pray_ctx *c, pray_rgb d, pray_rgb s, pray_rgb a, double e) {
-    if (!c) return NULL;
-    if (bad_rgb(c, d, "phong") || bad_rgb(c, s, "phong") || bad_rgb(c, a, "phong")) return NULL;
-    if (!finite_num(e) || e < 0) {
-        fail(c, PRAY_ERR_ARG, "phong: exponent must be a number >= 0, not %g", e);
-        return NULL;
-    }
+    if (!c || bad_rgb(c, d, "phong") || bad_rgb(c, s, "phong") || bad_rgb(c, a, "phong")) return NULL;
+    if (!finite_num(e) || e < 0)
+        return fail(c, PRAY_ERR_ARG, "phong: exponent must be a number >= 0, not %g", e), (pray_model *)NULL;
     pray_model *m = model_new(c);
     if (!m) return NULL;
     m->diffuse = d;
@@ -9931,20 +9969,16 @@ pray_model *pray_phong(pray_ctx *c, pray_rgb d, pray_rgb s, pray_rgb a, double e
 }
 
 pray_model *pray_mirror(pray_ctx *c, pray_rgb w) {
-    if (!c) return NULL;
-    if (bad_rgb(c, w, "mirror")) return NULL;
+    if (!c || bad_rgb(c, w, "mirror")) return NULL;
     pray_model *m = model_new(c);
     if (m) m->reflect = w;
     return m;
 }
 
 pray_model *pray_transparent(pray_ctx *c, pray_rgb w, double index) {
-    if (!c) return NULL;
-    if (bad_rgb(c, w, "transparent")) return NULL;
-    if (!finite_num(index) || index <= 0) {
-        fail(c, PRAY_ERR_ARG, "transparent: refraction index must be > 0, not %g", index);
-        return NULL;
-    }
+    if (!c || bad_rgb(c, w, "transparent")) return NULL;
+    if (!finite_num(index) || index <= 0)
+        return fail(c, PRAY_ERR_ARG, "transparent: refraction index must be > 0, not %g", index), (pray_model *)NULL;
     pray_model *m = model_new(c);
     if (!m) return NULL;
     m->transmit = w;
@@ -9954,8 +9988,7 @@ pray_model *pray_transparent(pray_ctx *c, pray_rgb w, double index) {
 }
 
 pray_model *pray_color(pray_ctx *c, pray_rgb col) {
-    if (!c) return NULL;
-    if (bad_rgb(c, col, "color")) return NULL;
+    if (!c || bad_rgb(c, col, "color")) return NULL;
     pray_model *m = model_new(c);
     if (m) m->emit = col;
     return m;
@@ -10027,14 +10060,9 @@ pray_object *framed_new(pray_ctx *c, int kind, pray_model *m, pray_vec p, pray_v
 bool bad_axis(pray_ctx *c, pray_vec p1, pray_vec p2, const char *what) {
     if (bad_vec(c, p1, what, false) || bad_vec(c, p2, what, false)) return true;
     pray_vec a = vsub(p2, p1);
-    if (!vfinite(a)) {
-        fail(c, PRAY_ERR_ARG, "%s: the axis is longer than the range of numbers", what);
-        return true;
-    }
-    if (vmaxabs(a) <= 1e-12 * (vmaxabs(p1) + vmaxabs(p2))) {
-        fail(c, PRAY_ERR_ARG, "%s: the two points must be distinct", what);
-        return true;
-    }
+    if (!vfinite(a)) return fail(c, PRAY_ERR_ARG, "%s: the axis is longer than the range of numbers", what), true;
+    if (vmaxabs(a) <= 1e-12 * (vmaxabs(p1) + vmaxabs(p2)))
+        return fail(c, PRAY_ERR_ARG, "%s: the two points must be distinct", what), true;
     return false;
 }
 } // namespace
@@ -10078,10 +10106,8 @@ pray_object *pray_torus(pray_ctx *c, pray_model *m, pray_vec centre, pray_vec ax
              nan_clean(r));
         return NULL;
     }
-    if (!finite_num(R + r)) {
-        fail(c, PRAY_ERR_ARG, "torus: R + r is beyond the range of numbers");
-        return NULL;
-    }
+    if (!finite_num(R + r))
+        return fail(c, PRAY_ERR_ARG, "torus: R + r is beyond the range of numbers"), (pray_object *)NULL;
     return framed_new(c, O_TORUS, m, centre, vunit(axis), R, r);
 }
 
@@ -10092,14 +10118,10 @@ pray_object *pray_one(pray_ctx *c, pray_model *m) {
 namespace {
 bool bad_pair(pray_ctx *c, pray_vec u, pray_vec v, const char *what) {
     if (bad_vec(c, u, what, true) || bad_vec(c, v, what, true)) return true;
-    if (!map_len_ok(u) || !map_len_ok(v)) {
-        fail(c, PRAY_ERR_ARG, "%s: the vectors' lengths must lie between %g and %g", what, MAP_LEN_MIN, MAP_LEN_MAX);
-        return true;
-    }
-    if (vlen(vcross(vunit(u), vunit(v))) <= 1e-12) {
-        fail(c, PRAY_ERR_ARG, "%s: the two vectors must not be parallel", what);
-        return true;
-    }
+    if (!map_len_ok(u) || !map_len_ok(v))
+        return fail(c, PRAY_ERR_ARG, "%s: the vectors' lengths must lie between %g and %g", what, MAP_LEN_MIN, MAP_LEN_MAX), true;
+    if (vlen(vcross(vunit(u), vunit(v))) <= 1e-12)
+        return fail(c, PRAY_ERR_ARG, "%s: the two vectors must not be parallel", what), true;
     return false;
 }
 } // namespace
@@ -10140,10 +10162,7 @@ pray_texture *pray_texture_tiff(pray_ctx *c, const void *data, size_t n, const c
 
 pray_texture *pray_texture_rgb(pray_ctx *c, int w, int h, const float *rgb, const char *name) {
     if (!c) return NULL;
-    if (!rgb) {
-        fail(c, PRAY_ERR_ARG, "pray_texture_rgb: no pixels");
-        return NULL;
-    }
+    if (!rgb) return fail(c, PRAY_ERR_ARG, "pray_texture_rgb: no pixels"), (pray_texture *)NULL;
     if (w < 1 || h < 1 || w > 65536 || h > 65536) {
         fail(c, PRAY_ERR_ARG, "pray_texture_rgb: image size %d x %d is out of range (1 to 65536 a side)", w, h);
         return NULL;
@@ -10182,26 +10201,27 @@ pray_status pray_texture_register(pray_ctx *c, const char *name, pray_texture *t
     if (!c) return PRAY_ERR_ARG;
     if (!name || !*name) return fail(c, PRAY_ERR_ARG, "pray_texture_register: no name");
     if (t && !handle_ok(c, t, H_TEXTURE, "pray_texture_register", "texture")) return c->status;
-    TexName **at = texture_name_at(c, name), *e = *at;
-    if (!e && t) {
-        e = (TexName *)mem_zalloc(c, sizeof(TexName));
-        char *nm = e ? mem_strdup(c, name, strlen(name)) : NULL;
-        if (!nm) {
-            mem_free(c, e);
-            return c->status;
-        }
-        e->name = nm;
-        *at = e;
-    }
+    TexName **at = name_at(&c->tex_names, name), *e = *at;
+    if (!e && t && !(e = name_add(c, at, name))) return c->status;
     if (!e) return PRAY_OK;  // removing a name that is not registered
     retain(t);
     release_handle(c, e->tex);
     e->tex = t;
-    if (!t) {  // removed
-        *at = e->next;
-        mem_free(c, e->name);
-        mem_free(c, e);
-    }
+    if (!t) name_drop(c, at);
+    return PRAY_OK;
+}
+
+pray_status pray_include_register(pray_ctx *c, const char *name, const char *text, size_t len) {
+    if (!c) return PRAY_ERR_ARG;
+    if (!name || !*name) return fail(c, PRAY_ERR_ARG, "pray_include_register: no name");
+    TexName **at = name_at(&c->inc_names, name), *e = *at;
+    char *copy = text ? mem_strdup(c, text, len) : NULL;
+    if ((text && !copy) || (!e && text && !(e = name_add(c, at, name)))) return mem_free(c, copy), c->status;
+    if (!e) return PRAY_OK;
+    mem_free(c, e->text);
+    e->text = copy;
+    e->len = len;
+    if (!text) name_drop(c, at);
     return PRAY_OK;
 }
 
@@ -10230,10 +10250,7 @@ pray_model *pray_tiff(pray_ctx *c, pray_model *m0, pray_model *m1, pray_texture 
 
 pray_model *pray_tiffbump(pray_ctx *c, pray_model *a, double amount, pray_texture *t) {
     if (!c || !model_ok(c, a, "pray_tiffbump") || !handle_ok(c, t, H_TEXTURE, "pray_tiffbump", "texture")) return NULL;
-    if (!finite_num(amount)) {
-        fail(c, PRAY_ERR_ARG, "tiffbump: the amount is not finite");
-        return NULL;
-    }
+    if (!finite_num(amount)) return fail(c, PRAY_ERR_ARG, "tiffbump: the amount is not finite"), (pray_model *)NULL;
     pray_model *m = model_node(c, M_BUMP, a, NULL);
     if (m) {
         m->tex = t;
@@ -10245,10 +10262,8 @@ pray_model *pray_tiffbump(pray_ctx *c, pray_model *a, double amount, pray_textur
 
 pray_model *pray_move(pray_ctx *c, pray_model *a, double x, double y) {
     if (!c || !model_ok(c, a, "pray_move")) return NULL;
-    if (!finite_num(x) || !finite_num(y)) {
-        fail(c, PRAY_ERR_ARG, "move: the shift is not finite");
-        return NULL;
-    }
+    if (!finite_num(x) || !finite_num(y))
+        return fail(c, PRAY_ERR_ARG, "move: the shift is not finite"), (pray_model *)NULL;
     if (a->kind == M_FLAT) return retain(a), a;  // no texture to move
     pray_model *m = model_node(c, M_MOVE, a, NULL, fabs(x) > fabs(y) ? fabs(x) : fabs(y));
     if (m) {
@@ -10277,27 +10292,19 @@ pray_object *pray_text(pray_ctx *c, pray_model *m, const char *text, pray_vec P,
         return NULL;
     if (!text) return fail(c, PRAY_ERR_ARG, "pray_text: no text"), (pray_object *)NULL;
     if (bad_vec(c, P, "text", false) || bad_pair(c, X, Y, "text")) return NULL;
-    if (!finite_num(h) || h <= 0) {
-        fail(c, PRAY_ERR_ARG, "text: the thickness must be a positive number, not %g", h);
-        return NULL;
-    }
-    if (!finite_num(spacing) || spacing <= 0) {
-        fail(c, PRAY_ERR_ARG, "text: the spacing must be a positive number, not %g", spacing);
-        return NULL;
-    }
+    if (!finite_num(h) || h <= 0)
+        return fail(c, PRAY_ERR_ARG, "text: the thickness must be a positive number, not %g", h), (pray_object *)NULL;
+    if (!finite_num(spacing) || spacing <= 0)
+        return fail(c, PRAY_ERR_ARG, "text: the spacing must be a positive number, not %g", spacing), (pray_object *)NULL;
     int cw = 6, ch = 9, ref = 7;  // cell columns and rows; rows of the glyph height Y
     if (font) {
         cw = font->w / 16;
         ch = font->hgt / 16;
         ref = ch;
-        if (cw < 1 || ch < 1) {
-            fail(c, PRAY_ERR_ARG, "text: the font image %s is smaller than 16 x 16 cells", font->name);
-            return NULL;
-        }
-        if (cw > 64 || ch > 64) {
-            fail(c, PRAY_ERR_LIMIT, "text: the font's cells are over 64 pixels");
-            return NULL;
-        }
+        if (cw < 1 || ch < 1)
+            return fail(c, PRAY_ERR_ARG, "text: the font image %s is smaller than 16 x 16 cells", font->name), (pray_object *)NULL;
+        if (cw > 64 || ch > 64)
+            return fail(c, PRAY_ERR_LIMIT, "text: the font's cells are over 64 pixels"), (pray_object *)NULL;
     }
     pray_vec n = vunit(vcross(vunit(X), vunit(Y)));
     pray_vec nx = vunit(vcross(vunit(Y), n)), ny = vunit(vcross(n, vunit(X)));
@@ -10371,10 +10378,7 @@ pray_object *pray_nothing(pray_ctx *c) { return c ? obj_new(c, O_NOTHING, NULL) 
 pray_object *pray_csg(pray_ctx *c, pray_op op, pray_object *a, pray_object *b) {
     if (!c || !object_ok(c, a, "pray_csg", "object a") || !object_ok(c, b, "pray_csg", "object b")) return NULL;
     int k = op == PRAY_UNION ? O_UNION : op == PRAY_INTERSECTION ? O_INTER : op == PRAY_DIFFERENCE ? O_DIFF : -1;
-    if (k < 0) {
-        fail(c, PRAY_ERR_ARG, "unknown CSG operation %d", (int)op);
-        return NULL;
-    }
+    if (k < 0) return fail(c, PRAY_ERR_ARG, "unknown CSG operation %d", (int)op), (pray_object *)NULL;
     return csg_op(c, k, a, b);
 }
 
@@ -10384,10 +10388,8 @@ pray_object *pray_complement(pray_ctx *c, pray_object *a) {
 
 pray_object *pray_scale(pray_ctx *c, pray_object *a, double s) {
     if (!c || !object_ok(c, a, "pray_scale")) return NULL;
-    if (!finite_num(s) || s == 0) {
-        fail(c, PRAY_ERR_ARG, "scale factor must be a finite number other than 0, not %g", s);
-        return NULL;
-    }
+    if (!finite_num(s) || s == 0)
+        return fail(c, PRAY_ERR_ARG, "scale factor must be a finite number other than 0, not %g", s), (pray_object *)NULL;
     return obj_transform(c, a, xf_scale(s));
 }
 pray_object *pray_translate(pray_ctx *c, pray_object *a, pray_vec v) {
@@ -10400,10 +10402,8 @@ pray_object *pray_rotate(pray_ctx *c, pray_object *a, pray_vec deg) {
 }
 pray_object *pray_stretch(pray_ctx *c, pray_object *a, pray_vec v) {
     if (!c || !object_ok(c, a, "pray_stretch") || bad_vec(c, v, "stretch", false)) return NULL;
-    if (v.x == 0 || v.y == 0 || v.z == 0) {
-        fail(c, PRAY_ERR_ARG, "stretch: the factors must not be 0, not <%g, %g, %g>", v.x, v.y, v.z);
-        return NULL;
-    }
+    if (v.x == 0 || v.y == 0 || v.z == 0)
+        return fail(c, PRAY_ERR_ARG, "stretch: the factors must not be 0, not <%g, %g, %g>", v.x, v.y, v.z), (pray_object *)NULL;
     return obj_stretch(c, a, v);
 }
 pray_object *pray_paint(pray_ctx *c, pray_object *a, pray_model *m) {
@@ -10425,8 +10425,7 @@ int pray_object_primitives(const pray_object *a) {
 }
 
 pray_light *pray_dirlight(pray_ctx *c, pray_rgb i, pray_vec d) {
-    if (!c) return NULL;
-    if (bad_rgb(c, i, "dirlight") || bad_vec(c, d, "dirlight direction", true)) return NULL;
+    if (!c || bad_rgb(c, i, "dirlight") || bad_vec(c, d, "dirlight direction", true)) return NULL;
     pray_light *l = light_new(c, 1);
     if (!l) return NULL;
     l->src[0].point = 0;
@@ -10435,8 +10434,7 @@ pray_light *pray_dirlight(pray_ctx *c, pray_rgb i, pray_vec d) {
     return l;
 }
 pray_light *pray_pointlight(pray_ctx *c, pray_rgb i, pray_vec p) {
-    if (!c) return NULL;
-    if (bad_rgb(c, i, "pointlight") || bad_vec(c, p, "pointlight", false)) return NULL;
+    if (!c || bad_rgb(c, i, "pointlight") || bad_vec(c, p, "pointlight", false)) return NULL;
     pray_light *l = light_new(c, 1);
     if (!l) return NULL;
     l->src[0].point = 1;
@@ -10467,10 +10465,8 @@ pray_light *pray_light_add(pray_ctx *c, pray_light *a, pray_light *b) {
 }
 pray_light *pray_light_scale(pray_ctx *c, pray_light *l, double s) {
     if (!c || !light_ok(c, l, "pray_light_scale")) return NULL;
-    if (!finite_num(s) || s == 0) {
-        fail(c, PRAY_ERR_ARG, "scale factor must be a finite number other than 0, not %g", s);
-        return NULL;
-    }
+    if (!finite_num(s) || s == 0)
+        return fail(c, PRAY_ERR_ARG, "scale factor must be a finite number other than 0, not %g", s), (pray_light *)NULL;
     return light_transform(c, l, xf_scale(s));
 }
 pray_light *pray_light_translate(pray_ctx *c, pray_light *l, pray_vec v) {
@@ -10614,14 +10610,31 @@ void prepared_drop(pray_ctx *c) {
     mem_free(c, p);
 }
 
+// A kept scene whose setup differs from the context's in the camera alone takes the new camera:
+// of its preparation only the eye's buffer depends on the camera (on the eye's place and on the
+// kind of camera, not on where it looks), so it stays unless those changed.
+void recamera(pray_ctx *c, Prepared *p) {
+    Setup t;
+    const Setup &n = c->cur;
+    memcpy(&t, &p->setup, sizeof t);
+    t.parallel = n.parallel, t.cam_x = n.cam_x, t.cam_y = n.cam_y, t.cam_eye = n.cam_eye, t.cam_point = n.cam_point;
+    t.lookat = n.lookat, t.cam_up = n.cam_up, t.cam_angle = n.cam_angle;
+    bool eye = p->s.accel && p->s.accel->eye && memcmp(&n.cam_eye, &p->setup.cam_eye, sizeof n.cam_eye) != 0;
+    if (memcmp(&t, &n, sizeof t) != 0 || n.parallel != p->setup.parallel || eye) return;
+    scene_camera(c, &p->s);
+    memcpy(&p->setup, &n, sizeof t);
+}
+
 // The one way to render: rectangle r of the image into the buffers (stride set), both checked;
-// with the scene kept from the render before when it is the same (Prepared).
+// with the scene kept from the render before when it is the same (Prepared), or differs in the
+// camera alone (recamera).
 pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, const pray_rect &r,
                         const pray_buffers &out) {
     double t0 = clock_seconds();
     mem_phase(c, MEM_RUN);
     Prepared *p = c->prep;
     bool keep = (!c->running || c->in_render_fn) && c->drop != root;
+    if (p && keep && p->root == root && p->lights == lights) recamera(c, p);
     if (p && !(keep && p->root == root && p->lights == lights && memcmp(&p->setup, &c->cur, sizeof(Setup)) == 0)) {
         prepared_drop(c);  // (before another is built: the two need not fit at once)
         p = NULL;
@@ -10652,8 +10665,8 @@ pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, cons
         CohPlan plan;
         memset(&plan, 0, sizeof plan);
 #ifndef PRAY_NO_SEQUENCES
-        bool coh = !p && opt_int(c, OPT_COHERENCE) && c->running && s.accel && out.rgb && !out.primitive && !out.depth &&
-                   !out.normal && r.x == 0 && r.y == 0 && r.width == s.width && r.height == s.height &&
+        bool coh = !p && opt_int(c, OPT_COHERENCE) && c->running && s.accel && out.rgb && !extra_outputs(out) &&
+                   r.x == 0 && r.y == 0 && r.width == s.width && r.height == s.height &&
                    out.stride == (size_t)s.width;
         if (coh) st = coh_plan(c, &s, &plan);
         else coh_release(c);
@@ -10708,7 +10721,7 @@ static pray_status render_call(pray_ctx *c, pray_object *root, pray_light *light
     if (!scene_ok(c, root, lights, "pray_render") || image_limits(c)) return c->status;
     int W = opt_int(c, OPT_WIDTH), H = opt_int(c, OPT_HEIGHT);
     pray_rect r = {0, 0, W, H};
-    pray_buffers b = {NULL, NULL, NULL, NULL, (size_t)W};
+    pray_buffers b = {NULL, NULL, NULL, NULL, (size_t)W, NULL, NULL, 0};
     b.rgb = (float *)mem_alloc(c, sizeof(float) * 3 * (size_t)W * (size_t)H);  // (every pixel is written)
     if (!b.rgb) return c->status;
     out->pixels = b.rgb;
@@ -10741,6 +10754,7 @@ static pray_status render_target(pray_ctx *c, const char *fn, int W, int H, cons
         return fail(c, PRAY_ERR_ARG, "%s: the rectangle of %d x %d pixels at (%d, %d) is not inside the image of %d x %d",
                     fn, r->width, r->height, r->x, r->y, W, H);
     *b = *out;
+    if (b->flags & ~PRAY_BUFFERS_SAMPLES) return fail(c, PRAY_ERR_ARG, "%s: unknown flags %#x", fn, (unsigned)b->flags);
     if (b->stride == 0) b->stride = (size_t)r->width;
     if (b->stride < (size_t)r->width)
         return fail(c, PRAY_ERR_ARG, "%s: the stride %lu is less than the rectangle's width %d", fn,
@@ -10754,8 +10768,7 @@ static pray_status render_target(pray_ctx *c, const char *fn, int W, int H, cons
 static pray_status render_into_call(pray_ctx *c, pray_object *root, pray_light *lights, const pray_rect *rect,
                                     const pray_buffers *out) {
     if (!out) return fail(c, PRAY_ERR_ARG, "pray_render_into: no buffers");
-    if (!out->rgb && !out->primitive && !out->depth && !out->normal)
-        return fail(c, PRAY_ERR_ARG, "pray_render_into: every buffer is NULL");
+    if (!out->rgb && !extra_outputs(*out)) return fail(c, PRAY_ERR_ARG, "pray_render_into: every buffer is NULL");
     if (!scene_ok(c, root, lights, "pray_render_into") || image_limits(c)) return c->status;
     pray_rect r;
     pray_buffers b;
@@ -10794,6 +10807,15 @@ void pray_stats_get(const pray_ctx *c, pray_stats *out) {
 void pray_stats_reset(pray_ctx *c) {
     if (c) memset(&c->stats, 0, sizeof c->stats);
 }
+pray_status pray_object_set_id(pray_ctx *c, pray_object *o, int id) {
+    if (!c || !object_ok(c, o, "pray_object_set_id")) return c ? c->status : PRAY_ERR_ARG;
+    if (id < 0 && id != PRAY_NO_ID)
+        return fail(c, PRAY_ERR_ARG, "pray_object_set_id: an id must be >= 0 or PRAY_NO_ID, not %d", id);
+    o->uid = id;
+    prepared_drop(c);  // (the scene kept holds the ids it was prepared with)
+    return PRAY_OK;
+}
+int pray_object_id(const pray_object *o) { return o ? o->uid : PRAY_NO_ID; }
 
 struct pray_scene {
     Scene s;
@@ -10827,8 +10849,7 @@ static pray_status render_prepared_call(pray_ctx *c, const pray_scene *q, const 
     if (!q) return c->status != PRAY_OK ? c->status : fail(c, PRAY_ERR_ARG, "pray_render_prepared: no scene");
     if (!q->render)
         return fail(c, PRAY_ERR_ARG, "pray_render_prepared: the scene was prepared for ray queries (pray_prepare)");
-    if (!out || (!out->rgb && !out->primitive && !out->depth && !out->normal))
-        return fail(c, PRAY_ERR_ARG, "pray_render_prepared: no buffers");
+    if (!out || (!out->rgb && !extra_outputs(*out))) return fail(c, PRAY_ERR_ARG, "pray_render_prepared: no buffers");
     pray_rect r;
     pray_buffers b;
     if (render_target(c, "pray_render_prepared", q->s.width, q->s.height, rect, out, &r, &b)) return c->status;
@@ -10885,10 +10906,8 @@ int pray_intersect(pray_ctx *c, pray_scene *q, pray_vec origin, pray_vec dir, do
     // the direction brought to the size of 1: a tiny or a huge one is a direction too
     double m = fabs(dir.x) > fabs(dir.y) ? fabs(dir.x) : fabs(dir.y);
     m = fabs(dir.z) > m ? fabs(dir.z) : m;
-    if (!vfinite(origin) || !vfinite(dir) || m == 0 || tmax != tmax) {
-        fail(c, PRAY_ERR_ARG, "pray_intersect: the ray must have a finite origin and a finite, non-zero direction");
-        return -1;
-    }
+    if (!vfinite(origin) || !vfinite(dir) || m == 0 || tmax != tmax)
+        return fail(c, PRAY_ERR_ARG, "pray_intersect: the ray must have a finite origin and a finite, non-zero direction"), -1;
     int e = 0;  // (a direction of ordinary size is left as it is, bit for bit)
     if (m < 1e-18 || m > 1e18) frexp(m, &e);
     pray_vec d = {ldexp(dir.x, -e), ldexp(dir.y, -e), ldexp(dir.z, -e)};
@@ -11071,10 +11090,7 @@ pray_status pray_image_new(pray_ctx *c, int width, int height, pray_image *out) 
 
 pray_status pray_set_error(pray_ctx *c, int code, const char *message) {
     if (!c) return PRAY_ERR_ARG;
-    if (code == PRAY_OK) {
-        pray_clear_error(c);
-        return PRAY_OK;
-    }
+    if (code == PRAY_OK) return pray_clear_error(c), PRAY_OK;
     // (an int: in C++ a value outside the enumeration cannot be a pray_status)
     pray_status status = code >= PRAY_ERR_NOMEM && code <= PRAY_ERR_CANCELLED ? (pray_status)code : PRAY_ERR_ARG;
     return fail(c, status, "%s", message ? message : pray_status_text(status));
@@ -13013,7 +13029,7 @@ pray_status bi_spheremap(Interp &I, const Expr *call, Value *a, Value *out) {
 pray_texture *program_texture(Interp &I, const Expr *call, const Value &name) {
     pray_ctx *c = I.c;
     const char *path = ((const Str *)name.ref)->s;
-    TexName *reg = *texture_name_at(c, path);
+    TexName *reg = *name_at(&c->tex_names, path);
     if (reg) {
         retain(reg->tex);
         return reg->tex;
@@ -13718,16 +13734,13 @@ PRAY_NOINLINE void include_chain(Interp &I) {
                               *ShownPath(I.files[i].name), I.files[i].line, i == 0 ? ")" : "");
 }
 
-#if PRAY_HAS_STDIO
 // File `path` is being read already, as I.files[loop]: a file that includes itself.
 PRAY_NOINLINE pray_status include_loop(Interp &I, const char *path, int loop) {
     bool through = loop < I.files.n - 1;
     return fail(I.c, PRAY_ERR_RUNTIME, "'%s' includes itself%s%s%s", *ShownPath(path), through ? " through '" : "",
                 through ? *ShownPath(I.files[loop + 1].name) : "", through ? "'" : "");
 }
-#endif
 
-#if PRAY_HAS_STDIO
 // Reading a file costs the run a statement (option maxsteps) for each of its lines, however few
 // statements they hold: an include of a long file in a loop is bounded as its statements are.
 pray_status include_steps(Interp &I, const char *text, size_t n) {
@@ -13740,65 +13753,82 @@ pray_status include_steps(Interp &I, const char *text, size_t n) {
                     "an include reads counts as one)", lim, lim == 1 ? "" : "s");
     return PRAY_OK;
 }
+
+#if !PRAY_HAS_STDIO
+inline bool same_id(const FileId &, const FileId &) { return false; }  // (includes are the host's texts)
 #endif
 
-// include "F": the statements of file F, read beside the file that names it, run here as the
-// program's own are (checked whole first, then read and run a statement at a time).
-PRAY_NOINLINE pray_status exec_include(Interp &I, const Stmt *s) {
-    pray_ctx *c = I.c;
-    const Expr *f = s->args[0];
+// The file include "F" names, opened beside the file naming it: *path its name as opened, *id its
+// identity, its text into *t (NULL: the file is not open, c->status says why).
+FILE *include_file(Interp &I, const Expr *f, char **path, FileId *id, Text *t) {
 #if !PRAY_HAS_STDIO
-    (void)c;
-    return rerr(I, f, PRAY_ERR_RUNTIME, "include: this build has no file access");
+    (void)path, (void)id, (void)t;
+    rerr(I, f, PRAY_ERR_RUNTIME, "include: this build has no file access");
+    return NULL;
 #else
-    if (I.depth + 1 > I.parser->maxnest) {
-        char msg[160];
-        return perr(c, I.name, s->line, s->col, PRAY_ERR_LIMIT, "%s",
-                    nest_message(msg, sizeof msg, "includes", I.parser->maxnest, I.depth - (I.files.n - 1)));
-    }
-    const char *why = c->untrusted ? untrusted_path_problem(f->s) : NULL;
-    if (why)
-        return rerr(I, f, PRAY_ERR_RUNTIME, "untrusted program: '%s' is %s; files are read from the program's "
-                    "directory only", *Shown(f->s), why);
-    // the name beside the including file; an untrusted program's, from the program's directory
-    size_t dlen = 0, from = c->untrusted ? c->run_dir_len : 0;
+    pray_ctx *c = I.c;
+    // the name beside the including file; an untrusted program's, from the program's directory (a
+    // text the host registered is beside its name, which must then obey the same rules)
+    bool in_dir = c->untrusted && c->run_dir && strncmp(I.name, c->run_dir, c->run_dir_len) == 0;
+    size_t dlen = 0, from = in_dir ? c->run_dir_len : 0;
     for (size_t i = 0; I.name[i]; i++)
         if (I.name[i] == '/' || I.name[i] == '\\' || I.name[i] == ':') dlen = i + 1;
     bool relative = f->s[0] && f->s[0] != '/' && f->s[0] != '\\' && f->s[1] != ':';
     if (!relative || from > dlen) dlen = from = 0;
     size_t n = strlen(f->s);
     char *rel = (char *)mem_alloc(c, dlen - from + n + 1);
-    if (!rel) return api_err(I, f->line, f->col);
+    if (!rel) return NULL;
     memcpy(rel, I.name + from, dlen - from);
     memcpy(rel + dlen - from, f->s, n + 1);
+    const char *named = untrusted_path_problem(f->s) ? f->s : rel, *why = c->untrusted ? untrusted_path_problem(named) : NULL;
+    if (why) {
+        rerr(I, f, PRAY_ERR_RUNTIME, "untrusted program: '%s' is %s; files are read from the program's "
+             "directory only", *Shown(named), why);
+        return mem_free(c, rel), (FILE *)NULL;
+    }
+    FILE *in = c->untrusted ? open_read(c, c->run_dir, c->run_dir_len, rel, FIND_CONFINED, path, id)
+                            : open_read(c, "", 0, rel, FIND_AS_NAMED, path, id);
+    mem_free(c, rel);
+    if (in && (!read_program(c, in, t) || (ferror(in) && fail(c, PRAY_ERR_IO, "cannot read '%s'", *ShownPath(*path)))))
+        fclose(in), in = NULL;
+    return in;
+#endif
+}
+
+// include "F": the statements of the text the host registered as F, else of file F read beside
+// the file that names it, run here as the program's own are (checked whole first, then read and
+// run a statement at a time).
+PRAY_NOINLINE pray_status exec_include(Interp &I, const Stmt *s) {
+    pray_ctx *c = I.c;
+    const Expr *f = s->args[0];
+    if (I.depth + 1 > I.parser->maxnest) {
+        char msg[160];
+        return perr(c, I.name, s->line, s->col, PRAY_ERR_LIMIT, "%s",
+                    nest_message(msg, sizeof msg, "includes", I.parser->maxnest, I.depth - (I.files.n - 1)));
+    }
+    TexName *reg = *name_at(&c->inc_names, f->s);
     char *path = NULL;
     FileId id;
-    id.valid = 0;
-    FILE *in = c->untrusted ? open_read(c, c->run_dir, c->run_dir_len, rel, FIND_CONFINED, &path, &id)
-                            : open_read(c, "", 0, rel, FIND_AS_NAMED, &path, &id);
-    mem_free(c, rel);
-    int loop = -1;
-    for (int i = 0; in && i < I.files.n && loop < 0; i++)
-        if (same_id(id, I.files[i].id) || strcmp(path, I.files[i].name) == 0) loop = i;
+    memset(&id, 0, sizeof id);
     Text t;
     t.init();
-    pray_status st = PRAY_OK;
-    if (!in) st = c->status;
-    else if (loop >= 0)
-        st = include_loop(I, path, loop);
-    else if (!read_program(c, in, &t)) st = c->status;
-    else if (ferror(in)) st = fail(c, PRAY_ERR_IO, "cannot read '%s'", *ShownPath(path));
-    else st = include_steps(I, t.str(), (size_t)t.a.n);
+    FILE *in = NULL;
+    bool ok = reg ? (path = mem_strdup(c, f->s, strlen(f->s))) && t.add(c, reg->text, reg->len)
+                  : (in = include_file(I, f, &path, &id, &t)) != NULL;
     if (in) fclose(in);
+    int loop = -1;
+    for (int i = 0; ok && i < I.files.n && loop < 0; i++)
+        if (same_id(id, I.files[i].id) || strcmp(path, I.files[i].name) == 0) loop = i;
+    pray_status st = !ok ? c->status : loop >= 0 ? include_loop(I, path, loop) : include_steps(I, t.str(), (size_t)t.a.n);
     IncFile nf;
     nf.name = path;
     nf.id = id;
     nf.line = 0;
     if (st == PRAY_OK && !I.files.push(c, nf)) st = c->status;
-    if (st) {
+    if (st) {  // (a message without a place gets the include's)
         mem_free(c, path);
         t.a.release(c);
-        if (api_err(I, f->line, f->col) == PRAY_ERR_IO) c->status = PRAY_ERR_RUNTIME;
+        if (strncmp(c->msg, "error: ", 7) == 0 && api_err(I, f->line, f->col) == PRAY_ERR_IO) c->status = PRAY_ERR_RUNTIME;
         return c->status;
     }
     I.files[I.files.n - 2].line = s->line;
@@ -13844,7 +13874,6 @@ PRAY_NOINLINE pray_status exec_include(Interp &I, const Stmt *s) {
     mem_free(c, path);
     t.a.release(c);
     return st;
-#endif
 }
 
 pray_status exec(Interp &I, const Stmt *s) {
@@ -14585,7 +14614,7 @@ pray_status render_part(void *ud, pray_ctx *c, pray_object *root, pray_light *li
     pray_rect r = {0, sp->y0, W, sp->y1 - sp->y0};
     pray_status st = pray_image_new(c, W, r.height, out);
     if (st != PRAY_OK) return st;
-    pray_buffers b = {NULL, NULL, NULL, NULL, 0};
+    pray_buffers b = {NULL, NULL, NULL, NULL, 0, NULL, NULL, 0};
     b.rgb = out->pixels;
     return pray_render_into(c, root, lights, &r, &b);
 }

@@ -247,8 +247,9 @@ double pray_option_get(const pray_ctx *ctx, const char *name);
    of `include` are looked for (its directory). `text` need not be NUL-terminated. The whole
    program is checked before its first statement runs, so a malformed one runs none; it is then
    read again and run a statement at a time, holding only the current line's tokens and the
-   current statement's tree. A file that `include` names is read whole when the statement runs,
-   checked, and run the same way; without file access (PRAY_NO_STDIO) `include` is an error. */
+   current statement's tree. A file that `include` names (or the text registered under its name,
+   pray_include_register) is read whole when the statement runs, checked, and run the same way;
+   without file access (PRAY_NO_STDIO) including a name not registered is an error. */
 pray_status pray_run_string(pray_ctx *ctx, const char *name, const char *text, size_t len);
 /* Run a program file (a regular file; a FIFO, directory or device is refused); "-" reads
    standard input (named "stdin.ray" in messages). Reading stops at the first line longer than
@@ -350,6 +351,21 @@ pray_object *pray_stretch(pray_ctx *ctx, pray_object *a, pray_vec factors);
 pray_object *pray_paint(pray_ctx *ctx, pray_object *a, pray_model *m);
 /* Primitives in the tree (what `print` shows as "object (N primitives)"); 0 for NULL. */
 int pray_object_primitives(const pray_object *a);
+/* The host's id of an object, as Embree's geometry ids and OSPRay's ids are: an int, not a
+   pointer, so that it indexes the host's own table (of pointers, if it likes), fits an int buffer
+   (pray_buffers.id) and means the same in another process (the parts of a distributed render).
+   A primitive carries the id of the innermost object with an id that contains it: an id on a
+   union is its parts' unless one has its own. pray_hit.id and pray_buffers.id report it, or
+   PRAY_NO_ID where no object around the primitive has one. id >= 0 sets it, PRAY_NO_ID removes
+   it; other negative ids are refused (PRAY_ERR_ARG). The id belongs to this handle: the `.`
+   transformations and stretch make new objects without it, and a union (intersection) made of
+   a union (intersection) without an id takes its parts instead of it, so set an id on a chain
+   before making more of it. Scenes prepared before (pray_prepare, pray_prepare_render) keep the
+   ids they were prepared with; the scene pray_render_into keeps is prepared again. */
+#define PRAY_NO_ID (-2)
+pray_status pray_object_set_id(pray_ctx *ctx, pray_object *obj, int id);
+/* The id of an object (PRAY_NO_ID for none, or NULL). */
+int pray_object_id(const pray_object *obj);
 
 /* Lights. */
 pray_light *pray_dirlight(pray_ctx *ctx, pray_rgb intensity, pray_vec direction);
@@ -458,6 +474,8 @@ typedef struct pray_hit {
                           law, as the renderer traces it: the ratio of the indices of the
                           material left and the one entered (empty space: 1); zero where the
                           surface lets no light through or reflects it all */
+    int id;            /* the id of the innermost object with one around the primitive
+                          (pray_object_set_id), else PRAY_NO_ID */
 } pray_hit;
 /* A prepared scene, or NULL. It keeps no reference to root: release root when you like. It
    belongs to the context (pray_scene_free frees it early). */
@@ -550,13 +568,20 @@ void pray_set_render(pray_ctx *ctx, pray_render_fn fn, void *ud);
 /* A rectangle of the image in pixels: columns x .. x+width-1, rows y .. y+height-1, row 0 at
    the top. */
 typedef struct pray_rect { int x, y, width, height; } pray_rect;
-/* Where pray_render_into writes: any of the four may be NULL (not wanted), not all of them.
-   Pixel (x, y) of the rectangle is at element y*stride + x of every buffer (times 3 for rgb and
-   normal); nothing between rows is written. The caller owns the buffers.
-   The per-pixel outputs (primitive, depth, normal) are those of the first surface met by the
-   primary ray through the pixel's centre, pray_camera_ray(ctx, x + 0.5, y + 0.5, ...) in image
-   pixels: exactly pray_intersect's first hit for that ray on a scene prepared with the same
-   options, whatever antialias and adaptive do for the colour. */
+/* Where pray_render_into writes: any of the six buffers may be NULL (not wanted), not all of
+   them. Pixel (x, y) of the rectangle is at element y*stride + x of every buffer (times 3 for
+   rgb, normal and albedo); nothing between rows is written. The caller owns the buffers. Zero
+   the struct (or give every member) and set what you want.
+   The per-pixel outputs (primitive, id, depth, normal, albedo) are those of the first surface
+   met by the primary ray through the pixel's centre, pray_camera_ray(ctx, x + 0.5, y + 0.5, ...)
+   in image pixels: exactly pray_intersect's first hit for that ray on a scene prepared with the
+   same options, whatever antialias and adaptive do for the colour. With flags
+   PRAY_BUFFERS_SAMPLES, normal and albedo are instead the means over the antialias x antialias
+   sample rays of the pixel (pray_camera_ray's rays, as the colour's: with option adaptive, those
+   its colour is traced or interpolated from), the background's counting as 0, 0, 0, so that a
+   denoiser gets them averaged as the colour is; primitive, id and depth stay the centre's (they
+   cannot be averaged). With antialias 1 both ways are the same. */
+#define PRAY_BUFFERS_SAMPLES 1
 typedef struct pray_buffers {
     float *rgb;       /* 3 floats per pixel: the colour, as pray_render's */
     int *primitive;   /* the primitive seen (as pray_hit.primitive: declared order); -1: background */
@@ -564,6 +589,12 @@ typedef struct pray_buffers {
     float *normal;    /* 3 floats per pixel: its pray_hit.normal; 0, 0, 0 for the background */
     size_t stride;    /* pixels from one row to the next in every buffer: 0 = the rectangle's
                          width, else at least that */
+    int *id;          /* its pray_hit.id (pray_object_set_id; PRAY_NO_ID: none); -1: background */
+    float *albedo;    /* 3 floats per pixel: the colour of the surface as its shading takes it
+                         at that point, textures included: the model's diffuse + flat colour
+                         (color) + mirror weight + transparency weight, each channel at most 1;
+                         0, 0, 0 for the background */
+    int flags;        /* 0, or PRAY_BUFFERS_SAMPLES (above); other bits are refused */
 } pray_buffers;
 /* Render as pray_render does, into the caller's buffers: the image of the context's width and
    height options, or only the rectangle `rect` of it (NULL = the whole image). A rectangle's
@@ -576,10 +607,14 @@ typedef struct pray_buffers {
    context keeps the scene pray_render_into and pray_render prepared (flattened, simplified, with
    its grid), and the next render of the same root and lights with the same options, camera and
    background uses it again, so that bands, tiles and passes cost what the whole image costs. It
-   holds a reference to root and lights meanwhile (releasing yours is safe). Rendering another
-   scene or lights, changing an option, the camera or the background, the start or the end of a
-   program's run, or pray_free drops it. To render one scene from several threads at once, see
-   pray_prepare_render. */
+   holds a reference to root and lights meanwhile (releasing yours is safe). Of the preparation
+   only the eye's buffer depends on the camera, so a new camera of the same kind (parallel or
+   perspective) keeps it, taking the new camera, when the eye stays where it was (the camera
+   turned about its eye) or the scene has no eye's buffer (option eyebuffer 0, a parallel
+   camera, or too few samples for one: pray_stats.eyebuf_voxels 0). Rendering another scene or
+   lights, changing an option or the background, any other new camera, setting an id
+   (pray_object_set_id), the start or the end of a program's run, or pray_free drops it. To
+   render one scene from several threads at once, see pray_prepare_render. */
 pray_status pray_render_into(pray_ctx *ctx, pray_object *root, pray_light *lights, const pray_rect *rect,
                              const pray_buffers *out);
 /* A scene prepared for rendering, with the context's options, camera and background as they are
@@ -620,6 +655,17 @@ pray_texture *pray_texture_rgb(pray_ctx *ctx, int width, int height, const float
    texmem when it was made and is not counted again by runs. PRAY_ERR_ARG for a NULL context, a
    NULL or empty name, or a texture of another context. */
 pray_status pray_texture_register(pray_ctx *ctx, const char *name, pray_texture *tex);
+/* Register program text under `name` for `include`, as textures are: `include "F"` looks F up
+   first among the registered names, by exact string match of F as written, before any path
+   handling, and then as a file beside the including one. So a program that includes needs no
+   file access: it works with PRAY_NO_STDIO and in untrusted mode. The text (len bytes, need not
+   be NUL-terminated) is copied; it is read as a file would be, with the same limits (maxnest,
+   maxline, maxstring, a statement of maxsteps for each line), and its errors name it
+   ("name:line:col: error: ...", "included from ..."); an include in it is looked up the same
+   way, a file beside `name`. Registrations last across runs until the name is registered again
+   (which replaces the text), removed (text NULL; a name not registered is fine) or the context
+   is freed. PRAY_ERR_ARG for a NULL or empty name; PRAY_ERR_NOMEM. */
+pray_status pray_include_register(pray_ctx *ctx, const char *name, const char *text, size_t len);
 
 #ifdef __cplusplus
 }
@@ -671,19 +717,20 @@ pray_status pray_texture_register(pray_ctx *ctx, const char *name, pray_texture 
        }
    Running the same scene as a program: pray_run_string(c, "red.ray", text, strlen(text)).
    A host that keeps the pixels itself renders into its own buffers, here a 4 x 4 rectangle of
-   the image with the primitive seen at each pixel (for picking), and lends a program a texture
-   from memory under a name:
+   the image with the primitive seen at each pixel and the id the host gave its object (for
+   picking), and lends a program a texture from memory and the text of an include under names:
        #include <stdio.h>
        #include <string.h>
        #include "pray.hpp"
        int main(void) {
            static float rgb[4 * 4 * 3], checker[2 * 2 * 3] = {1, 1, 1, 0, 0, 0, 0, 0, 0, 1, 1, 1};
-           static int seen[4 * 4];
+           static int seen[4 * 4], ids[4 * 4];
            pray_rect r = {30, 30, 4, 4};
-           pray_buffers out = {NULL, NULL, NULL, NULL, 0};
+           pray_buffers out = {NULL, NULL, NULL, NULL, 0, NULL, NULL, 0};
            pray_rgb white = {1, 1, 1};
            pray_vec centre = {0, 0, 0};
-           const char *prog = "M = tiff(color({0}), color({1}), \"checker\")\n"
+           const char *part = "M = tiff(color({0}), color({1}), \"checker\")\n";
+           const char *prog = "include \"material.ray\"\n"
                               "rendertiff spheremap(M, [0, 0, 0], 0.5, <0, 0, 1>, <1, 0, 0>), none\n";
            pray_ctx *c = pray_new();
            pray_object *s = pray_sphere(c, pray_color(c, white), centre, 0.5);
@@ -691,11 +738,14 @@ pray_status pray_texture_register(pray_ctx *ctx, const char *name, pray_texture 
            int ok;
            out.rgb = rgb;
            out.primitive = seen;
+           out.id = ids;
            pray_option(c, "width", 64);
            pray_option(c, "height", 64);
-           ok = pray_render_into(c, s, NULL, &r, &out) == PRAY_OK && seen[0] == 0;
+           ok = pray_object_set_id(c, s, 7) == PRAY_OK &&
+                pray_render_into(c, s, NULL, &r, &out) == PRAY_OK && seen[0] == 0 && ids[0] == 7;
            pray_option_string(c, "output", "checker.ppm");
            ok = ok && pray_texture_register(c, "checker", t) == PRAY_OK &&
+                pray_include_register(c, "material.ray", part, strlen(part)) == PRAY_OK &&
                 pray_run_string(c, "checker.ray", prog, strlen(prog)) == PRAY_OK;
            if (!ok) fprintf(stderr, "%s\n", pray_error(c));
            pray_free(c);

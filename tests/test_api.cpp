@@ -97,7 +97,7 @@ TEST_CASE("api: every function takes a NULL context and returns its error value"
     CHECK(pray_write_ppm(nullptr, &img, 8, nullptr, nullptr) == PRAY_ERR_ARG);
     CHECK(pray_write_png(nullptr, &img, nullptr, nullptr) == PRAY_ERR_ARG);
     float rgb[3] = {0, 0, 0};
-    pray_buffers bufs = {rgb, nullptr, nullptr, nullptr, 0};
+    pray_buffers bufs = {rgb, nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0};
     CHECK(pray_render_into(nullptr, nullptr, nullptr, nullptr, &bufs) == PRAY_ERR_ARG);
     pray_vec ro, rd;
     CHECK(pray_camera_ray(nullptr, 0.5, 0.5, &ro, &rd) == PRAY_ERR_ARG);
@@ -310,10 +310,10 @@ TEST_CASE("api: handles, scenes and images of another context are refused") {
         {"error: pray_render: the light belongs to another context",
          [&] { pray_image x; return pray_render(a, oa, l, &x) == PRAY_ERR_ARG && !x.pixels; }},
         {"error: pray_render_into: the object belongs to another context",
-         [&] { float px[3]; pray_buffers x = {px, nullptr, nullptr, nullptr, 0}; pray_rect r = {0, 0, 1, 1};
+         [&] { float px[3]; pray_buffers x = {px, nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0}; pray_rect r = {0, 0, 1, 1};
                return pray_render_into(a, o, la, &r, &x) == PRAY_ERR_ARG; }},
         {"error: pray_render_into: the light belongs to another context",
-         [&] { float px[3]; pray_buffers x = {px, nullptr, nullptr, nullptr, 0}; pray_rect r = {0, 0, 1, 1};
+         [&] { float px[3]; pray_buffers x = {px, nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0}; pray_rect r = {0, 0, 1, 1};
                return pray_render_into(a, oa, l, &r, &x) == PRAY_ERR_ARG; }},
         {"error: pray_intersect: the scene belongs to another context",
          [&] { return pray_intersect(a, sc, ONE, UP, HUGE_VAL, nullptr, 0) == -1; }},
@@ -867,7 +867,7 @@ std::vector<float> render_rect(pray_ctx *c, pray_object *o, pray_light *l, int b
     std::vector<float> px((size_t)40 * 30 * 3);
     for (int b = 0; b < bands; b++) {
         pray_rect r = {0, 30 * b / bands, 40, 30 * (b + 1) / bands - 30 * b / bands};
-        pray_buffers out = {px.data() + (size_t)3 * 40 * r.y, nullptr, nullptr, nullptr, 40};
+        pray_buffers out = {px.data() + (size_t)3 * 40 * r.y, nullptr, nullptr, nullptr, 40, nullptr, nullptr, 0};
         REQUIRE(pray_render_into(c, o, l, &r, &out) == PRAY_OK);
     }
     return px;
@@ -925,6 +925,66 @@ TEST_CASE("api: pray_render_into reuses the scene it prepared only for the same 
     pray_free(c);
 }
 
+namespace {
+// Balls on a floor, and step k of the cameras of the test below (with the settings it needs).
+pray_object *balls_of(pray_ctx *c) {
+    pray_rgb red = {0.8, 0.2, 0.1};
+    pray_model *m = pray_phong(c, red, GREY, GREY, 8);
+    pray_vec at = {0, 0, 0}, up = {0, 0, 1};
+    pray_object *o = pray_plane(c, m, at, up);
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 4; j++) {
+            pray_vec p = {i - 2.0, j - 2.0, 0.4};
+            o = pray_csg(c, PRAY_UNION, o, pray_sphere(c, m, p, 0.4));
+        }
+    pray_release(c, m);
+    return o;
+}
+void camera_of(pray_ctx *c, int k) {
+    pray_option(c, "width", 128);
+    pray_option(c, "height", 96);
+    pray_option(c, "antialias", 4);  // (samples enough for the eye's buffer)
+    pray_option(c, "eyebuffer", k >= 3 ? 0 : 1);
+    pray_vec eye = {k < 2 ? -7.0 : k < 4 ? 3.0 : 8.0, -9, 3}, look = {k == 0 ? 0.0 : 2.0, 1, 0}, up = {0, 0, 1}, y = {0, 0, -4};
+    pray_vec x = {4, 0, 0};
+    if (k == 5) pray_parallel(c, x, y, eye, look);
+    else pray_lookat(c, eye, look, up, 50);
+}
+} // namespace
+
+TEST_CASE("api: pray_render_into keeps its preparation for a camera turned about its eye, or moved without an eye's buffer") {
+    // step: 0 the first view; 1 turned (kept); 2 the eye moved, which its buffer depends on (prepared
+    // again); 3 option eyebuffer 0 (prepared again, the same picture); 4 the eye moved, no eye's
+    // buffer (kept); 5 a parallel camera (prepared again). Each against a fresh context, bit for bit.
+    const bool kept[6] = {false, true, false, false, true, false};
+    pray_ctx *c = pray_new();
+    pray_object *o = balls_of(c);
+    pray_light *l = light_of(c, 1);
+    std::vector<float> before;
+    for (int k = 0; k < 6; k++) {
+        CAPTURE(k);
+        camera_of(c, k);
+        pray_stats_reset(c);
+        std::vector<float> px((size_t)128 * 96 * 3), fresh(px.size());
+        pray_buffers out = {px.data(), nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0};
+        REQUIRE(pray_render_into(c, o, l, nullptr, &out) == PRAY_OK);
+        pray_stats st;
+        pray_stats_get(c, &st);
+        CHECK((st.memory_accel == 0) == kept[k]);  // (no structure built: the kept one was used)
+        if (k == 0) REQUIRE(st.eyebuf_voxels > 0);  // (so that moving the eye matters)
+        pray_ctx *d = pray_new();
+        camera_of(d, k);
+        pray_object *od = balls_of(d);
+        out.rgb = fresh.data();
+        REQUIRE(pray_render_into(d, od, light_of(d, 1), nullptr, &out) == PRAY_OK);
+        CHECK(px == fresh);
+        CHECK((px != before) == (k != 3));
+        before = px;
+        pray_free(d);
+    }
+    pray_free(c);
+}
+
 TEST_CASE("api: a scene prepared for rendering is rendered by other contexts on their threads, to the same bits") {
     pray_ctx *c = pray_new();
     settings_of(c, 4);
@@ -948,7 +1008,7 @@ TEST_CASE("api: a scene prepared for rendering is rendered by other contexts on 
             pray_option(d, "antialias", 1);
             pray_option(d, "threads", 1 + k % 2);
             pray_rect r = {0, 30 * k / 4, 40, 30 * (k + 1) / 4 - 30 * k / 4};
-            pray_buffers out = {bands.data() + (size_t)3 * 40 * r.y, nullptr, nullptr, nullptr, 40};
+            pray_buffers out = {bands.data() + (size_t)3 * 40 * r.y, nullptr, nullptr, nullptr, 40, nullptr, nullptr, 0};
             if (pray_render_prepared(d, q, &r, &out) != PRAY_OK) failed++;
             pray_free(d);
         });
@@ -961,7 +1021,8 @@ TEST_CASE("api: a scene prepared for rendering is rendered by other contexts on 
     CHECK(pray_intersect(c, q, from, towards, HUGE_VAL, &h, 1) >= 1);
     // what it refuses
     pray_ctx *d = pray_new();
-    pray_buffers none = {nullptr, nullptr, nullptr, nullptr, 0}, one = {bands.data(), nullptr, nullptr, nullptr, 0};
+    pray_buffers none = {nullptr, nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0};
+    pray_buffers one = {bands.data(), nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0};
     pray_rect outside = {0, 20, 40, 11};
     CHECK(pray_render_prepared(d, nullptr, nullptr, &one) == PRAY_ERR_ARG);
     CHECK(std::string(pray_error(d)) == "error: pray_render_prepared: no scene");

@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include <sys/stat.h>
+
 namespace {
 
 pray_vec P3(double x, double y, double z) {
@@ -162,7 +164,7 @@ TEST_CASE("pray_render_into: rectangles are bit for bit the pixels of the whole 
             CAPTURE(r.width);
             CAPTURE(r.height);
             std::vector<float> part((size_t)r.width * r.height * 3, -1.0f);
-            pray_buffers b = {part.data(), nullptr, nullptr, nullptr, 0};
+            pray_buffers b = {part.data(), nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0};
             REQUIRE_MESSAGE(pray_render_into(c, s.root, s.lights, &r, &b) == PRAY_OK, pray_error(c));
             int bad = 0;
             for (int y = 0; y < r.height; y++)
@@ -173,7 +175,7 @@ TEST_CASE("pray_render_into: rectangles are bit for bit the pixels of the whole 
         }
         // rect NULL: the whole image
         std::vector<float> all((size_t)W * H * 3);
-        pray_buffers b = {all.data(), nullptr, nullptr, nullptr, 0};
+        pray_buffers b = {all.data(), nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0};
         REQUIRE(pray_render_into(c, s.root, s.lights, nullptr, &b) == PRAY_OK);
         CHECK(std::memcmp(all.data(), full.data(), all.size() * sizeof(float)) == 0);
     }
@@ -195,7 +197,7 @@ TEST_CASE("pray_render_into: a stride leaves the gaps between rows untouched") {
     std::vector<float> rgb(stride * r.height * 3, mark), depth(stride * r.height, mark),
         normal(stride * r.height * 3, mark);
     std::vector<int> prim(stride * r.height, -77);
-    pray_buffers b = {rgb.data(), prim.data(), depth.data(), normal.data(), stride};
+    pray_buffers b = {rgb.data(), prim.data(), depth.data(), normal.data(), stride, nullptr, nullptr, 0};
     Progress p;
     pray_set_progress(c, on_progress, &p);
     REQUIRE_MESSAGE(pray_render_into(c, s.root, s.lights, &r, &b) == PRAY_OK, pray_error(c));
@@ -238,7 +240,7 @@ TEST_CASE("pray_render_into: primitive, depth and normal are pray_intersect's fi
         pray_option(c, "threads", 2);
         std::vector<int> prim((size_t)W * H);
         std::vector<float> depth((size_t)W * H), normal((size_t)W * H * 3);
-        pray_buffers b = {nullptr, prim.data(), depth.data(), normal.data(), 0};
+        pray_buffers b = {nullptr, prim.data(), depth.data(), normal.data(), 0, nullptr, nullptr, 0};
         REQUIRE_MESSAGE(pray_render_into(c, s.root, s.lights, nullptr, &b) == PRAY_OK, pray_error(c));
         pray_scene *q = pray_prepare(c, s.root);
         REQUIRE(q);
@@ -275,7 +277,7 @@ TEST_CASE("pray_render_into: primitive, depth and normal are pray_intersect's fi
         pray_stats st0, st1;
         pray_stats_get(c, &st0);
         std::vector<int> prim2((size_t)W * H);
-        pray_buffers b2 = {nullptr, prim2.data(), nullptr, nullptr, 0};
+        pray_buffers b2 = {nullptr, prim2.data(), nullptr, nullptr, 0, nullptr, nullptr, 0};
         REQUIRE(pray_render_into(c, s.root, s.lights, nullptr, &b2) == PRAY_OK);
         pray_stats_get(c, &st1);
         CHECK(prim2 == prim);
@@ -320,7 +322,7 @@ TEST_CASE("pray_render_into: bad rectangles, strides and buffers are refused wit
     pray_object *o = pray_sphere(c, pray_color(c, C3(1, 0, 0)), P3(0, 0, 0), 1);
     REQUIRE(o);
     std::vector<float> rgb(20 * 10 * 3);
-    pray_buffers b = {rgb.data(), nullptr, nullptr, nullptr, 0};
+    pray_buffers b = {rgb.data(), nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0};
     const pray_rect bad[] = {{-1, 0, 2, 2}, {0, -1, 2, 2}, {0, 0, 0, 2}, {0, 0, 2, 0}, {19, 0, 2, 1},
                              {0, 9, 1, 2},  {0, 0, 21, 10}, {5, 5, -3, 2}, {2147483647, 0, 1, 1}, {1, 1, 2147483647, 1}};
     for (const pray_rect &r : bad) {
@@ -332,10 +334,10 @@ TEST_CASE("pray_render_into: bad rectangles, strides and buffers are refused wit
         CHECK(contains(pray_error(c), "is not inside the image of 20 x 10"));
     }
     pray_rect r = {2, 2, 5, 3};
-    pray_buffers narrow = {rgb.data(), nullptr, nullptr, nullptr, 4};
+    pray_buffers narrow = {rgb.data(), nullptr, nullptr, nullptr, 4, nullptr, nullptr, 0};
     CHECK(pray_render_into(c, o, nullptr, &r, &narrow) == PRAY_ERR_ARG);
     CHECK(std::string(pray_error(c)) == "error: pray_render_into: the stride 4 is less than the rectangle's width 5");
-    pray_buffers none = {nullptr, nullptr, nullptr, nullptr, 0};
+    pray_buffers none = {nullptr, nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0};
     CHECK(pray_render_into(c, o, nullptr, &r, &none) == PRAY_ERR_ARG);
     CHECK(std::string(pray_error(c)) == "error: pray_render_into: every buffer is NULL");
     CHECK(pray_render_into(c, o, nullptr, &r, nullptr) == PRAY_ERR_ARG);
@@ -359,7 +361,244 @@ TEST_CASE("pray_render_into: bad rectangles, strides and buffers are refused wit
     CHECK(pray_render_into(c, o, nullptr, &one, &b) == PRAY_OK);
     CHECK(rgb[0] == 1.0f);
     CHECK(rgb[1] == 0.0f);
+    // flags other than PRAY_BUFFERS_SAMPLES
+    b.flags = 2;
+    CHECK(pray_render_into(c, o, nullptr, &one, &b) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: pray_render_into: unknown flags 0x2");
     pray_release(c, o);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The host's ids of objects, albedo, outputs that follow the samples
+// ---------------------------------------------------------------------------------------------
+TEST_CASE("pray_object_set_id: the innermost id around a primitive, in pray_hit and in the id buffer") {
+    Ctx c;
+    pray_option(c, "width", W);
+    pray_option(c, "height", H);
+    pray_option(c, "antialias", 2);
+    pray_option(c, "threads", 2);
+    // the scene of the other cases, with ids: the floor 10, the cut ball 20 around its hole's 21;
+    // the mirror ball has none
+    pray_model *red = pray_phong(c, C3(0.8, 0.1, 0.1), C3(0.5, 0.5, 0.5), C3(0.1, 0, 0), 20);
+    pray_object *floor = pray_plane(c, red, P3(0, 0, -1), P3(0, 0, 1));
+    pray_object *ball = pray_sphere(c, red, P3(-0.6, 0, -0.3), 0.7);
+    pray_object *cut = pray_cylinder(c, red, P3(-0.6, 0, 0), P3(0, 1, 0), 0.3);
+    pray_object *solid = pray_csg(c, PRAY_DIFFERENCE, ball, cut);
+    pray_object *mball = pray_sphere(c, pray_mirror(c, C3(0.7, 0.7, 0.7)), P3(0.8, 0.5, -0.5), 0.5);
+    pray_object *root = pray_csg(c, PRAY_UNION, floor, pray_csg(c, PRAY_UNION, solid, mball));
+    REQUIRE(root);
+    CHECK(pray_object_id(floor) == PRAY_NO_ID);
+    CHECK(pray_object_id(nullptr) == PRAY_NO_ID);
+    REQUIRE(pray_object_set_id(c, floor, 10) == PRAY_OK);
+    REQUIRE(pray_object_set_id(c, solid, 20) == PRAY_OK);
+    REQUIRE(pray_object_set_id(c, cut, 21) == PRAY_OK);
+    CHECK(pray_object_id(solid) == 20);
+    CHECK(pray_object_set_id(c, cut, -3) == PRAY_ERR_ARG);
+    CHECK(contains(pray_error(c), "pray_object_set_id: an id must be >= 0 or PRAY_NO_ID, not -3"));
+    CHECK(pray_object_id(cut) == 21);
+    CHECK(pray_object_set_id(c, nullptr, 1) == PRAY_ERR_ARG);
+    REQUIRE(pray_perspective(c, P3(1, 0, 0), P3(0, 0, -1), P3(0, -4, 0.5), P3(0, 0, -0.2)) == PRAY_OK);
+    const int expect[4] = {10, 20, 21, PRAY_NO_ID};  // by primitive, in declared order
+    std::vector<int> prim((size_t)W * H), id((size_t)W * H);
+    pray_buffers b = {nullptr, prim.data(), nullptr, nullptr, 0, id.data(), nullptr, 0};
+    REQUIRE_MESSAGE(pray_render_into(c, root, nullptr, nullptr, &b) == PRAY_OK, pray_error(c));
+    pray_scene *q = pray_prepare(c, root);
+    REQUIRE(q);
+    int bad = 0, seen[4] = {0, 0, 0, 0}, background = 0;
+    for (int y = 0; y < H; y++)
+        for (int x = 0; x < W; x++) {
+            pray_vec o, d;
+            REQUIRE(pray_camera_ray(c, x + 0.5, y + 0.5, &o, &d) == PRAY_OK);
+            pray_hit h[1];
+            int n = pray_intersect(c, q, o, d, HUGE_VAL, h, 1);
+            size_t at = (size_t)y * W + x;
+            if (n == 0) {
+                background++;
+                bad += id[at] != -1;
+                continue;
+            }
+            REQUIRE(h[0].primitive >= 0);
+            REQUIRE(h[0].primitive < 4);
+            seen[h[0].primitive]++;
+            bad += h[0].id != expect[h[0].primitive] || id[at] != h[0].id || prim[at] != h[0].primitive;
+        }
+    CHECK(bad == 0);
+    CHECK(background > 100);
+    for (int k = 0; k < 4; k++) CHECK(seen[k] > 0);
+    pray_scene_free(c, q);
+    // an id set later: the kept preparation is made again with it; PRAY_NO_ID removes one
+    REQUIRE(pray_object_set_id(c, mball, 30) == PRAY_OK);
+    REQUIRE(pray_object_set_id(c, cut, PRAY_NO_ID) == PRAY_OK);
+    std::vector<int> id2((size_t)W * H);
+    b.primitive = nullptr;
+    b.id = id2.data();
+    REQUIRE(pray_render_into(c, root, nullptr, nullptr, &b) == PRAY_OK);
+    const int expect2[4] = {10, 20, 20, 30};
+    int changed = 0;
+    bad = 0;
+    for (size_t at = 0; at < id2.size(); at++) {
+        bad += prim[at] < 0 ? id2[at] != -1 : id2[at] != expect2[prim[at]];
+        changed += id2[at] != id[at];
+    }
+    CHECK(bad == 0);
+    CHECK(changed > 50);
+    // a scene prepared for rendering gives the same ids, and keeps them when an id changes after
+    pray_scene *qr = pray_prepare_render(c, root, nullptr);
+    REQUIRE(qr);
+    REQUIRE(pray_object_set_id(c, floor, 11) == PRAY_OK);
+    std::vector<int> id3((size_t)W * H);
+    b.id = id3.data();
+    REQUIRE(pray_render_prepared(c, qr, nullptr, &b) == PRAY_OK);
+    CHECK(id3 == id2);
+    pray_scene_free(c, qr);
+    for (void *h : {(void *)red, (void *)floor, (void *)ball, (void *)cut, (void *)solid, (void *)mball, (void *)root})
+        pray_release(c, h);
+}
+
+TEST_CASE("pray_object_set_id: a union with an id keeps it when more is added; transformations make new objects") {
+    Ctx c;
+    pray_model *m = pray_color(c, C3(1, 1, 1));
+    pray_object *a = pray_sphere(c, m, P3(0, 0, 0), 1), *bb = pray_sphere(c, m, P3(3, 0, 0), 1);
+    pray_object *cc = pray_sphere(c, m, P3(6, 0, 0), 1);
+    pray_object *ab = pray_csg(c, PRAY_UNION, a, bb);
+    REQUIRE(pray_object_set_id(c, ab, 5) == PRAY_OK);
+    pray_object *abc = pray_csg(c, PRAY_UNION, ab, cc);
+    pray_object *moved = pray_translate(c, ab, P3(0, 0, 10));
+    REQUIRE(abc);
+    REQUIRE(moved);
+    CHECK(pray_object_id(moved) == PRAY_NO_ID);
+    pray_scene *q = pray_prepare(c, abc);
+    REQUIRE(q);
+    const int expect[3] = {5, 5, PRAY_NO_ID};
+    for (int k = 0; k < 3; k++) {
+        pray_hit h[1];
+        REQUIRE(pray_intersect(c, q, P3(3.0 * k, -5, 0), P3(0, 1, 0), HUGE_VAL, h, 1) == 2);
+        CHECK(h[0].primitive == k);
+        CHECK(h[0].id == expect[k]);
+    }
+    pray_scene_free(c, q);
+    // ids of a program's objects, set by a render function before it renders them
+    pray_set_render(c, [](void *, pray_ctx *cx, pray_object *root, pray_light *lights, int, pray_image *out) {
+        pray_object_set_id(cx, root, 7);
+        int ids[4];
+        pray_buffers bf = {nullptr, nullptr, nullptr, nullptr, 0, ids, nullptr, 0};
+        pray_rect r = {0, 0, 2, 2};
+        pray_status st = pray_render_into(cx, root, lights, &r, &bf);
+        out->width = out->height = 0;
+        return st == PRAY_OK && ids[0] == 7 ? PRAY_OK : PRAY_ERR_RUNTIME;
+    }, nullptr);
+    const char prog[] = "option \"width\", 4\noption \"height\", 4\nrendertiff sphere(color({1}), [0, 0, 0], 5), none\n";
+    CHECK(pray_run_string(c, "ids.ray", prog, sizeof prog - 1) == PRAY_OK);
+    for (void *h : {(void *)m, (void *)a, (void *)bb, (void *)cc, (void *)ab, (void *)abc, (void *)moved})
+        pray_release(c, h);
+}
+
+TEST_CASE("pray_buffers.albedo: the model's colour, flat or from a texture") {
+    Ctx c;
+    pray_option(c, "width", 40);
+    pray_option(c, "height", 40);
+    // a red Phong ball lit from the front, on a flat-coloured textured wall behind it
+    // 2 x 2 squares of 2 x 2 texels: between the centres of a square's texels its colour is exact
+    std::vector<float> px(4 * 4 * 3);
+    for (int y = 0; y < 4; y++)
+        for (int x = 0; x < 4; x++)
+            for (int k = 0; k < 3; k++) px[(y * 4 + x) * 3 + k] = (x / 2 + y / 2) % 2 ? 0.25f * (k + 1) : 0.9f - 0.3f * k;
+    pray_texture *t = pray_texture_rgb(c, 4, 4, px.data(), "squares");
+    pray_model *wall = pray_tiff(c, pray_color(c, C3(0, 0, 0)), pray_color(c, C3(1, 1, 1)), t);
+    pray_model *red = pray_phong(c, C3(0.8, 0.1, 0.2), C3(0.5, 0.5, 0.5), C3(0.1, 0, 0), 20);
+    pray_object *ball = pray_sphere(c, red, P3(0, 0, 0), 0.5);
+    // the wall y = 2 facing the eye, 4 x 4 texels across its 40 pixels: texels of 10 pixels
+    pray_object *back = pray_planemap(c, wall, P3(-1, 2, -1), P3(0, -1, 0), P3(0.5, 0, 0), P3(0, 0, 0.5));
+    pray_object *root = pray_csg(c, PRAY_UNION, ball, back);
+    REQUIRE(root);
+    REQUIRE(pray_parallel(c, P3(1, 0, 0), P3(0, 0, -1), P3(0, -4, 0), P3(0, 0, 0)) == PRAY_OK);
+    std::vector<float> rgb(40 * 40 * 3), albedo(40 * 40 * 3);
+    std::vector<int> prim(40 * 40);
+    pray_buffers b = {rgb.data(), prim.data(), nullptr, nullptr, 0, nullptr, albedo.data(), 0};
+    REQUIRE_MESSAGE(pray_render_into(c, root, pray_dirlight(c, C3(1, 1, 1), P3(0, 1, 0)), nullptr, &b) == PRAY_OK,
+                    pray_error(c));
+    int on_ball = 0, on_wall = 0, texel = 0, bad = 0;
+    for (size_t at = 0; at < prim.size(); at++) {
+        const float *a = &albedo[at * 3], *col = &rgb[at * 3];
+        if (prim[at] == 0) {  // the ball: its diffuse colour, whatever the light makes of it
+            on_ball++;
+            bad += a[0] != 0.8f || a[1] != 0.1f || a[2] != 0.2f;
+        } else {  // the wall: its colour (unlit: what the image shows), the texture's
+            REQUIRE(prim[at] == 1);
+            on_wall++;
+            bad += a[0] != col[0] || a[1] != col[1] || a[2] != col[2];
+            for (size_t k = 0; k < px.size(); k += 3)
+                if (a[0] == px[k] && a[1] == px[k + 1] && a[2] == px[k + 2]) {
+                    texel++;  // exactly a texel's colour (between texel centres it is a blend)
+                    break;
+                }
+        }
+    }
+    CHECK(bad == 0);
+    CHECK(on_ball > 200);
+    CHECK(on_wall > 200);
+    CHECK(texel > 100);
+    pray_release(c, root);
+}
+
+TEST_CASE("PRAY_BUFFERS_SAMPLES: normal and albedo are the means over the samples of pray_camera_ray") {
+    Ctx c;
+    const int A = 3, N = 24;
+    pray_option(c, "width", N);
+    pray_option(c, "height", N);
+    pray_option(c, "antialias", A);
+    pray_object *ball = pray_sphere(c, pray_phong(c, C3(0.8, 0.1, 0.2), C3(0, 0, 0), C3(0, 0, 0), 1), P3(0, 0, 0), 0.7);
+    pray_object *floor = pray_plane(c, pray_phong(c, C3(0.2, 0.6, 0.3), C3(0, 0, 0), C3(0, 0, 0), 1), P3(0, 0, -0.6), P3(0, 0, 1));
+    pray_object *root = pray_csg(c, PRAY_UNION, ball, floor);
+    REQUIRE(root);
+    REQUIRE(pray_perspective(c, P3(1, 0, 0), P3(0, 0, -1), P3(0, -4, 0.5), P3(0, 0, -0.2)) == PRAY_OK);
+    pray_scene *q = pray_prepare(c, root);
+    REQUIRE(q);
+    for (int adaptive = 0; adaptive < 2; adaptive++) {
+        CAPTURE(adaptive);
+        pray_option(c, "adaptive", adaptive ? 0.05 : 0);
+        std::vector<float> normal(N * N * 3), albedo(N * N * 3), centre(N * N * 3), depth(N * N), depth0(N * N);
+        std::vector<int> id(N * N), id0(N * N);
+        pray_buffers b = {nullptr, nullptr, depth.data(), normal.data(), 0, id.data(), albedo.data(), PRAY_BUFFERS_SAMPLES};
+        REQUIRE_MESSAGE(pray_render_into(c, root, nullptr, nullptr, &b) == PRAY_OK, pray_error(c));
+        pray_buffers b0 = {nullptr, nullptr, depth0.data(), centre.data(), 0, id0.data(), nullptr, 0};
+        REQUIRE(pray_render_into(c, root, nullptr, nullptr, &b0) == PRAY_OK);
+        CHECK(depth == depth0);  // depth and ids stay the centre's
+        CHECK(id == id0);
+        int bad = 0, edges = 0;
+        for (int y = 0; y < N; y++)
+            for (int x = 0; x < N; x++) {
+                double n[3] = {0, 0, 0}, al[3] = {0, 0, 0};
+                int kinds = 0, last = -2;
+                for (int sb = 0; sb < A; sb++)
+                    for (int sa = 0; sa < A; sa++) {
+                        pray_vec o, d;
+                        REQUIRE(pray_camera_ray(c, x + (sa + 0.5) / A, y + (sb + 0.5) / A, &o, &d) == PRAY_OK);
+                        pray_hit h[1];
+                        int hits = pray_intersect(c, q, o, d, HUGE_VAL, h, 1);
+                        int p = hits > 0 ? h[0].primitive : -1;
+                        kinds += p != last && last != -2;
+                        last = p;
+                        if (hits > 0) {
+                            n[0] += h[0].normal.x, n[1] += h[0].normal.y, n[2] += h[0].normal.z;
+                            static const double diffuse[2][3] = {{0.8, 0.1, 0.2}, {0.2, 0.6, 0.3}};
+                            for (int k = 0; k < 3; k++) al[k] += diffuse[p][k];
+                        }
+                    }
+                edges += kinds > 0;
+                size_t at = (size_t)y * N + x;
+                for (int k = 0; k < 3; k++) {
+                    bad += std::fabs(normal[at * 3 + k] - n[k] / (A * A)) > 1e-6;
+                    bad += std::fabs(albedo[at * 3 + k] - al[k] / (A * A)) > 1e-6;
+                }
+                if (bad && bad < 3) FAIL_CHECK("pixel " << x << ", " << y);
+            }
+        CHECK(bad == 0);
+        CHECK(edges > 20);       // pixels whose samples see different things (where the means matter)
+        CHECK(normal != centre); // and there the means are not the centre's normal
+    }
+    pray_scene_free(c, q);
+    pray_release(c, root);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -490,7 +729,140 @@ TEST_CASE("pray_texture_register: programs find registered names first; replace,
     pray_release(c, t2);
 }
 
+// ---------------------------------------------------------------------------------------------
+// Program text from the host for include
+// ---------------------------------------------------------------------------------------------
+namespace {
+const std::string PART = "Ball = sphere(phong({0.8, 0.2, 0.1}, {0.3}, 10), [0, 0, 0.1], 0.5)\n"
+                         "L = dirlight({1}, norm(<1, -1, 1>))\n";
+std::string main_program(const std::string &part) {
+    return "option \"width\", 24\noption \"height\", 16\n" + part + "rendertiff Ball | plane(color({0.2}), "
+           "[0, 0, -0.5], <0, 0, 1>), L\n";
+}
+bool reg(pray_ctx *c, const char *name, const std::string &text) {
+    return pray_include_register(c, name, text.data(), text.size()) == PRAY_OK;
+}
+} // namespace
+
+TEST_CASE("pray_include_register: an include of a registered text renders as the text written in place") {
+    testkit::Result inlined;
+    {
+        Ctx c;
+        inlined = run_in(c, main_program(PART));
+        REQUIRE_MESSAGE(inlined.status == PRAY_OK, inlined.error);
+    }
+    Ctx c;
+    REQUIRE(reg(c, "parts/ball.ray", PART + "junk past the length"));
+    REQUIRE(reg(c, "parts/ball.ray", PART));  // again: replaced
+    testkit::Result r = run_in(c, main_program("include \"parts/ball.ray\"\n"));
+    REQUIRE_MESSAGE(r.status == PRAY_OK, r.error);
+    REQUIRE(r.frames.size() == 1);
+    CHECK(r.frames[0].pixels == inlined.frames[0].pixels);
+    // an include inside a registered text is looked up the same way
+    REQUIRE(reg(c, "outer", "include \"parts/ball.ray\"\n"));
+    testkit::Result nested = run_in(c, main_program("include \"outer\"\n"));
+    REQUIRE_MESSAGE(nested.status == PRAY_OK, nested.error);
+    CHECK(nested.frames[0].pixels == inlined.frames[0].pixels);
+    // untrusted: a registered name needs no file access, whatever its form
+    pray_set_untrusted(c);
+    REQUIRE(reg(c, "../up/ball.ray", PART));
+    testkit::Result up = run_in(c, main_program("include \"../up/ball.ray\"\n"));
+    REQUIRE_MESSAGE(up.status == PRAY_OK, up.error);
+    CHECK(up.frames[0].pixels == inlined.frames[0].pixels);
+    // a file it includes is beside its name, which must then keep to the program's directory
+    REQUIRE(reg(c, "../up/more.ray", "include \"next.ray\"\n"));
+    testkit::Result out = run_in(c, "include \"../up/more.ray\"\n");
+    CHECK(out.status == PRAY_ERR_RUNTIME);
+#ifdef PRAY_NO_STDIO
+    CHECK(contains(out.error, "include: this build has no file access"));
+#else
+    CHECK(contains(out.error, "untrusted program: '../up/next.ray' is a name with '..'"));
+#endif
+    // removed: include looks for a file (none here; without file access, none at all)
+    REQUIRE(pray_include_register(c, "parts/ball.ray", nullptr, 0) == PRAY_OK);
+    REQUIRE(pray_include_register(c, "never registered", nullptr, 0) == PRAY_OK);
+    testkit::Result gone = run_in(c, main_program("include \"parts/ball.ray\"\n"));
+    CHECK(gone.status == PRAY_ERR_RUNTIME);
+    CHECK(contains(gone.error, "scene.ray:3:9: error: "));
+    CHECK(pray_include_register(c, "", "x = 1\n", 6) == PRAY_ERR_ARG);
+    CHECK(pray_include_register(c, nullptr, "x = 1\n", 6) == PRAY_ERR_ARG);
+    CHECK(std::string(pray_error(c)) == "error: pray_include_register: no name");
+    CHECK(pray_include_register(nullptr, "a", "x = 1\n", 6) == PRAY_ERR_ARG);
+}
+
+TEST_CASE("pray_include_register: errors name the text; the limits of include hold") {
+    Ctx c;
+    REQUIRE(reg(c, "bad.ray", "x = 1\ny = x / 0\n"));
+    testkit::Result r = run_in(c, "a = 1\ninclude \"bad.ray\"\n");
+    CHECK(r.status == PRAY_ERR_RUNTIME);
+    CHECK(r.error.rfind("bad.ray:2:", 0) == 0);
+    CHECK(contains(r.error, "(included from scene.ray:2)"));
+    REQUIRE(reg(c, "syntax.ray", "x = (1\n"));
+    testkit::Result syn = run_in(c, "include \"syntax.ray\"\n");
+    CHECK(syn.status == PRAY_ERR_SYNTAX);
+    CHECK(syn.error.rfind("syntax.ray:1:", 0) == 0);
+    REQUIRE(reg(c, "loop.ray", "include \"loop.ray\"\n"));
+    testkit::Result loop = run_in(c, "include \"loop.ray\"\n");
+    CHECK(loop.status == PRAY_ERR_RUNTIME);
+    CHECK(contains(loop.error, "'loop.ray' includes itself"));
+    // each line read costs a statement (maxsteps); nesting counts against maxnest
+    REQUIRE(reg(c, "long.ray", std::string(50, '\n') + "x = 1\n"));
+    pray_option_fix(c, "maxsteps", "40");
+    testkit::Result steps = run_in(c, "include \"long.ray\"\n");
+    CHECK(steps.status == PRAY_ERR_LIMIT);
+    CHECK(contains(steps.error, "each line an include reads counts as one"));
+    pray_option_fix(c, "maxsteps", "0");
+    pray_option_fix(c, "maxnest", "3");
+    REQUIRE(reg(c, "n1", "include \"n2\"\n"));
+    REQUIRE(reg(c, "n2", "include \"n3\"\n"));
+    REQUIRE(reg(c, "n3", "include \"n4\"\n"));
+    REQUIRE(reg(c, "n4", "x = 1\n"));
+    testkit::Result deep = run_in(c, "include \"n1\"\n");
+    CHECK(deep.status == PRAY_ERR_LIMIT);
+    CHECK(contains(deep.error, "option maxnest"));
+    pray_option_fix(c, "maxline", "20");
+    REQUIRE(reg(c, "wide.ray", "x = 1 + 2 + 3 + 4 + 5 + 6\n"));
+    testkit::Result wide = run_in(c, "include \"wide.ray\"\n");
+    CHECK(wide.status == PRAY_ERR_LIMIT);
+    CHECK(wide.error.rfind("wide.ray:1:", 0) == 0);
+}
+
 #ifndef PRAY_NO_STDIO
+TEST_CASE("pray_include_register: the same bytes as the file; registered names come first") {
+    char dir[] = "/tmp/pray_include_XXXXXX";
+    REQUIRE(mkdtemp(dir));
+    std::string sub = std::string(dir) + "/parts", file = sub + "/ball.ray";
+    REQUIRE(mkdir(sub.c_str(), 0700) == 0);
+    FILE *f = std::fopen(file.c_str(), "wb");
+    REQUIRE(f);
+    std::fputs(PART.c_str(), f);
+    std::fclose(f);
+    std::string prog = main_program("include \"parts/ball.ray\"\n"), name = std::string(dir) + "/scene.ray";
+    testkit::Result from_file, from_host, first;
+    {
+        Ctx c;
+        pray_set_frame(c, testkit::frame_sink, &from_file.frames);
+        REQUIRE_MESSAGE(pray_run_string(c, name.c_str(), prog.data(), prog.size()) == PRAY_OK, pray_error(c));
+    }
+    {
+        Ctx c;
+        REQUIRE(reg(c, "parts/ball.ray", PART));
+        from_host = run_in(c, prog);
+        REQUIRE_MESSAGE(from_host.status == PRAY_OK, from_host.error);
+        // beside a file of the same name, the registered text is read
+        REQUIRE(reg(c, "parts/ball.ray", "Ball = sphere(color({1}), [0, 0, 0], 0.2)\nL = none\n"));
+        pray_set_frame(c, testkit::frame_sink, &first.frames);
+        REQUIRE_MESSAGE(pray_run_string(c, name.c_str(), prog.data(), prog.size()) == PRAY_OK, pray_error(c));
+    }
+    REQUIRE(from_file.frames.size() == 1);
+    REQUIRE(from_host.frames.size() == 1);
+    CHECK(from_host.frames[0].pixels == from_file.frames[0].pixels);
+    CHECK(first.frames[0].pixels != from_file.frames[0].pixels);
+    std::remove(file.c_str());
+    std::remove(sub.c_str());
+    std::remove(dir);
+}
+
 TEST_CASE("pray_texture_register: a registered image renders as the same image read from a TIFF file") {
     std::vector<float> px = checker(8, 0.9f, 0.1f);
     char dir[] = "/tmp/pray_buffers_XXXXXX";
@@ -561,7 +933,8 @@ TEST_CASE("PRAY_NO_STDIO: registered textures work without file access") {
     testkit::Result r2 = run_in(c, texture_program("unregistered.tif"));
     CHECK(r2.status == PRAY_ERR_RUNTIME);
     CHECK(contains(r2.error, "this build has no file access"));
-    // include reads a file: an error at the statement, after what ran before it
+    // include of a name not registered would read a file: an error at the statement, after what
+    // ran before it
     testkit::Result r3 = run_in(c, "x = 1\ninclude \"part.ray\"\n");
     CHECK(r3.status == PRAY_ERR_RUNTIME);
     CHECK(r3.error == "scene.ray:2:9: error: include: this build has no file access");

@@ -114,7 +114,7 @@ pray_status render_rows(void *ud, pray_ctx *c, pray_object *root, pray_light *li
     if (st != PRAY_OK) return st;
     int mid = (r->y0 + r->y1 + 1) / 2;
     pray_rect top = {0, r->y0, w, mid - r->y0}, rest = {0, mid, w, r->y1 - mid};
-    pray_buffers b = {out->pixels, NULL, NULL, NULL, 0};
+    pray_buffers b = {out->pixels, NULL, NULL, NULL, 0, NULL, NULL, 0};
     st = pray_render_into(c, root, lights, &top, &b);
     if (st != PRAY_OK || rest.height == 0) return st;
     b.rgb = out->pixels + (size_t)3 * w * top.height;

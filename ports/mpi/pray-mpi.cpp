@@ -252,7 +252,7 @@ pray_status worker_render(void *ud, pray_ctx *c, pray_object *root, pray_light *
                           pray_image *) {
     Worker &w = *(Worker *)ud;
     int W = (int)pray_option_get(c, "width"), H = (int)pray_option_get(c, "height");
-    pray_buffers b = {NULL, NULL, NULL, NULL, 0};
+    pray_buffers b = {NULL, NULL, NULL, NULL, 0, NULL, NULL, 0};
     if (w.rows_mode) {
         ask(frame);
         float *band = NULL;
