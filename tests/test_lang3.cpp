@@ -262,7 +262,7 @@ TEST_CASE("spotlight: the light on a floor is I x share(angle) x cos, at every p
         pray_light *l = pray_spotlight(c, in, P, D, sp.a1, sp.a2);
         REQUIRE(l);
         std::vector<float> rgb(W * H * 3);
-        pray_buffers out = {rgb.data(), nullptr, nullptr, nullptr, 0};
+        pray_buffers out = {rgb.data(), nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0};
         REQUIRE_MESSAGE(pray_render_into(c, floor, l, nullptr, &out) == PRAY_OK, pray_error(c));
         int zones[3] = {0, 0, 0};
         double dl = std::sqrt(D.x * D.x + D.y * D.y + D.z * D.z);
@@ -413,7 +413,7 @@ TEST_CASE("checker: every pixel is one of its two colours, the one of the hit po
                 pray_scene *sc = pray_prepare_render(c, root, nullptr);
                 REQUIRE_MESSAGE(sc, pray_error(c));
                 std::vector<float> rgb(W * H * 3);
-                pray_buffers out = {rgb.data(), nullptr, nullptr, nullptr, 0};
+                pray_buffers out = {rgb.data(), nullptr, nullptr, nullptr, 0, nullptr, nullptr, 0};
                 REQUIRE(pray_render_prepared(c, sc, nullptr, &out) == PRAY_OK);
                 int seen[2] = {0, 0}, wrong = 0;
                 for (int y = 0; y < H; y++)

@@ -2,7 +2,7 @@
    (ports/wasm/playground/worker.js), on top of pray's C API.
 
    One context at a time: pg_new makes it (untrusted, with a memory cap), pg_texture lends it a
-   texture under the name a program uses, pg_option fixes an option as `-D name=value` does,
+   texture under the name a program uses, pg_include a program text for `include`, pg_option fixes an option as `-D name=value` does,
    pg_run runs a program and renders only band K of N of every frame (`pray --part K/N`),
    a few rows at a time, each handed to the page through the imported function pg_rows as
    8-bit RGBA samples: the bytes of an 8-bit image file of the same rows.
@@ -56,7 +56,7 @@ pray_status render_band(void *, pray_ctx *c, pray_object *root, pray_light *ligh
     for (int y = y0; y < y1 && st == PRAY_OK; y += ROWS_AT_ONCE) {
         int n = y1 - y < ROWS_AT_ONCE ? y1 - y : ROWS_AT_ONCE;
         pray_rect r = {0, y, W, n};
-        pray_buffers b = {rgb, NULL, NULL, NULL, 0};
+        pray_buffers b = {rgb, NULL, NULL, NULL, 0, NULL, NULL, 0};
         pray_image img = {W, n, rgb};
         st = pray_render_into(c, root, lights, &r, &b);
         if (st == PRAY_OK) st = pray_image_bytes(c, &img, 4, bytes);
@@ -95,6 +95,11 @@ PG_EXPORT(pg_texture) int pg_texture(const char *name, const void *data, int siz
     pray_status st = pray_texture_register(ctx, name, t);
     pray_texture_release(ctx, t);
     return st;
+}
+
+/* Lend the context the program text[0 .. len) for `include "name"`. */
+PG_EXPORT(pg_include) int pg_include(const char *name, const char *text, int len) {
+    return pray_include_register(ctx, name, text, (size_t)len);
 }
 
 /* Fix option `name` to the text `value`, as the command line's -D does. */

@@ -10,7 +10,9 @@
 //     rows and checks that the workers are gone and that none sends a row afterwards;
 //  4. renders the red sphere (examples/redsph.ray, antialias 2, 2 workers, statistics) and
 //     compares it with ./pray -D antialias=2, and the statistics shown;
-//  5. renders csg.ray at 1024x1024 in 1 worker, timed against the native program (1 thread).
+//  5. renders examples/street.ray, which includes parts/house.ray (a text the page lends the
+//     renderer), at 120x80 in 2 workers, and compares it with ./pray -s 120x80;
+//  6. renders csg.ray at 1024x1024 in 1 worker, timed against the native program (1 thread).
 // Environment: CHROMIUM (default /usr/bin/chromium), PUPPETEER (the puppeteer-core module's
 // directory). Ends with "N passed, N failed"; exit status 1 when any check failed.
 import { createServer } from 'node:http';
@@ -47,6 +49,7 @@ function readPPM(path) {
 }
 native(['-s', '160x125', '-o', WORK + '/csg.ppm', 'examples/csg.ray']);
 native(['-D', 'antialias=2', '-o', WORK + '/redsph.ppm', 'examples/redsph.ray']);
+native(['-s', '120x80', '-o', WORK + '/street.ppm', 'examples/street.ray']);
 const nativeSeconds = Math.min(...[1, 2, 3].map(() =>
     native(['-D', 'threads=1', '-s', '1024x1024', '-o', WORK + '/csg-1024.ppm', 'examples/csg.ray'])));
 const BAD = 'A = 1\nB = [1, 2, 3]\nC = (2 +\nrendertiff C, none\n';
@@ -214,7 +217,17 @@ try {
     check(/^worker 1 of 2:\nprimitives: 1 declared, 1 kept/.test(stats) && /worker 2 of 2:/.test(stats),
           'the statistics of both workers are shown', JSON.stringify(stats.split('\n').slice(0, 2).join(' / ')));
 
-    // 5. csg.ray at 1024x1024 in one worker, timed
+    // 5. a program that includes another
+    await choose('street.ray');
+    await set('width', '120');
+    await set('height', '80');
+    await set('antialias', '');
+    await set('stats', false);
+    status = await renderAndWait();
+    check(status.startsWith('Done'), 'street.ray (include "parts/house.ray") renders', status);
+    compare(await canvasRGB(), readPPM(WORK + '/street.ppm'), 'street.ray at 120x80 in 2 workers equals ./pray -s 120x80');
+
+    // 6. csg.ray at 1024x1024 in one worker, timed
     await choose('csg.ray');
     await set('width', '1024');
     await set('height', '1024');

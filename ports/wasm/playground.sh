@@ -29,20 +29,24 @@ make -s -f ports/wasm/wasm.mk ports/build/wasm/libpray.wasm
 [ -f examples/tex/wood.tif ] || make -s textures
 
 rm -rf $SITE
-mkdir -p $SITE/examples/tex
+mkdir -p $SITE/examples/tex $SITE/examples/parts
 cp ports/wasm/playground/index.html ports/wasm/playground/playground.js ports/wasm/playground/worker.js \
     ports/build/wasm/libpray.wasm $SITE/
-# every example but those that read other program files (include: the page has no files)
+# every example; the program files they include (examples/parts/) are lent to every program
 examples=""
 for f in examples/*.ray; do
-    grep -q '^[[:space:]]*include[[:space:]]' "$f" && continue
     cp "$f" $SITE/examples/
     examples="$examples${examples:+, }\"$(basename "$f")\""
+done
+includes=""
+for f in examples/parts/*.ray; do
+    cp "$f" $SITE/examples/parts/
+    includes="$includes${includes:+, }\"parts/$(basename "$f")\""
 done
 textures=""
 for f in examples/tex/*.tif; do
     cp "$f" $SITE/examples/tex/
     textures="$textures${textures:+, }\"tex/$(basename "$f")\""
 done
-printf '{"examples": [%s],\n "textures": [%s]}\n' "$examples" "$textures" >$SITE/examples/index.json
+printf '{"examples": [%s],\n "textures": [%s],\n "includes": [%s]}\n' "$examples" "$textures" "$includes" >$SITE/examples/index.json
 echo "playground: $SITE ($(wc -c <$SITE/libpray.wasm | tr -d ' ') bytes of libpray.wasm)"

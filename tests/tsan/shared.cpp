@@ -25,7 +25,7 @@ void *render_band(void *arg) {
     pray_ctx *c = pray_new();
     pray_option(c, "threads", 2);
     pray_rect r = {0, H * b->k / N, W, H * (b->k + 1) / N - H * b->k / N};
-    pray_buffers out = {b->rgb + (size_t)3 * W * r.y, NULL, NULL, NULL, W};
+    pray_buffers out = {b->rgb + (size_t)3 * W * r.y, NULL, NULL, NULL, W, NULL, NULL, 0};
     b->st = pray_render_prepared(c, b->scene, &r, &out);
     if (b->st != PRAY_OK) fprintf(stderr, "band %d: %s\n", b->k, pray_error(c));
     pray_free(c);
@@ -47,7 +47,7 @@ int main() {
     pray_option(c, "height", H);
     pray_option(c, "antialias", 2);
     static float whole[3 * W * H], bands[3 * W * H];
-    pray_buffers all = {whole, NULL, NULL, NULL, 0};
+    pray_buffers all = {whole, NULL, NULL, NULL, 0, NULL, NULL, 0};
     if (pray_render_into(c, scene, l, NULL, &all) != PRAY_OK) return fprintf(stderr, "%s\n", pray_error(c)), 1;
     pray_scene *q = pray_prepare_render(c, scene, l);
     if (!q) return fprintf(stderr, "%s\n", pray_error(c)), 1;

@@ -10,6 +10,7 @@ const TEXTURE_DIR = 'examples/';      // a program's "tex/x.tif" is fetched from
 const state = {
     module: null,    // the compiled libpray.wasm
     textures: [],    // [name, bytes] of every texture the examples use
+    includes: [],    // [name, bytes] of every program file the examples include
     workers: [],
     running: false,
     frame: -1,       // the frame on the canvas
@@ -90,7 +91,7 @@ function render() {
     const n = Math.max(1, Math.min(16, parseInt($('workers').value, 10) || 1));
     const job = {
         module: state.module, name: $('example').value || 'program.ray', text: $('program').value,
-        n, options: options(), textures: state.textures, memcap: MEMORY_CAP,
+        n, options: options(), textures: state.textures, includes: state.includes, memcap: MEMORY_CAP,
     };
     Object.assign(state, { running: true, frame: -1, rows: 0, height: 0, results: [], started: performance.now() });
     $('render').disabled = true;
@@ -200,6 +201,10 @@ async function start() {
             ...index.textures.map(async (name) => {
                 const data = new Uint8Array(await (await fetchOk(TEXTURE_DIR + name)).arrayBuffer());
                 state.textures.push([name, data]);
+            }),
+            ...index.includes.map(async (name) => {
+                const data = new Uint8Array(await (await fetchOk('examples/' + name)).arrayBuffer());
+                state.includes.push([name, data]);
             }),
         ]);
         state.module = await WebAssembly.compile(bytes);

@@ -2,7 +2,7 @@
 // of its frames (as `pray --part K/N` does), handing the rows to the page as they come.
 //
 // In:  {module, name, text, k, n, options: [[name, value], ...], textures: [[name, bytes], ...],
-//       memcap}
+//       includes: [[name, bytes], ...], memcap}
 // Out: {type: 'rows', frame, y, n, width, height, pixels}   8-bit RGBA, rows y .. y+n-1
 //      {type: 'print', text}                                what the program printed
 //      {type: 'done', status, error, line, col, frames, stats, seconds}
@@ -91,6 +91,10 @@ async function run(job) {
     }
     for (const [name, bytes] of job.textures) {
         st = exports.pg_texture(str(name), put(bytes, false), bytes.length);
+        if (st) return done(st);
+    }
+    for (const [name, bytes] of job.includes) {
+        st = exports.pg_include(str(name), put(bytes, false), bytes.length);
         if (st) return done(st);
     }
     const text = encoder.encode(job.text);
