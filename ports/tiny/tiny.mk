@@ -5,7 +5,7 @@
 #                                       build scenes through the API
 NAME      = tiny
 CXX       = g++
-PORTFLAGS = -Os -ffunction-sections -fdata-sections -ffp-contract=off
+PORTFLAGS = -Os -ffunction-sections -fdata-sections -ffp-contract=off -fno-asynchronous-unwind-tables -fno-unwind-tables
 LDFLAGS   = -Wl,--gc-sections -s
 EXE       =
 RUN       =
