@@ -358,7 +358,7 @@ int pray_object_primitives(const pray_object *a);
    union is its parts' unless one has its own. pray_hit.id and pray_buffers.id report it, or
    PRAY_NO_ID where no object around the primitive has one. id >= 0 sets it, PRAY_NO_ID removes
    it; other negative ids are refused (PRAY_ERR_ARG). The id belongs to this handle: the `.`
-   transformations and stretch make new objects without it, and a union (intersection) made of
+   transformations, stretch and pray_paint make new objects without it, and a union (intersection) made of
    a union (intersection) without an id takes its parts instead of it, so set an id on a chain
    before making more of it. Scenes prepared before (pray_prepare, pray_prepare_render) keep the
    ids they were prepared with; the scene pray_render_into keeps is prepared again. */
