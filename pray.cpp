@@ -3777,7 +3777,13 @@ bool sweep_start(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
 // Is the start of the ray inside the solid? Exact, as every sweep begins: one test per primitive.
 bool starts_inside(const Scene *s, Scratch *w, const Ray &ray) {
     int nc;
-    return s->root < 0 ? s->root == E_ALL : sweep_start(s, w, ray, 0, -1, &nc);
+    if (s->root < 0) return s->root == E_ALL;
+    // a point outside the solid's box is outside the solid (a parallel camera's rays, mostly)
+    const Box &b = elem_box(s, s->root);
+    real o[3] = {ray.o.x, ray.o.y, ray.o.z};
+    for (int l = 0; l < 3; l++)
+        if (o[l] < b.lo[l] || o[l] > b.hi[l]) return false;
+    return sweep_start(s, w, ray, 0, -1, &nc);
 }
 
 // The face where materials meet at the crossings [g0, g1) of a sweep, all at one t: the last of
