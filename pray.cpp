@@ -11066,11 +11066,17 @@ pray_status pray_write_image_note(pray_ctx *c, const pray_image *img, const char
 pray_status pray_image_bytes(pray_ctx *c, const pray_image *img, int channels, unsigned char *out) {
     if (!c) return PRAY_ERR_ARG;
     if (!image_ok(c, img)) return c->status;
+    bool srgb = channels >= PRAY_BYTES_SRGB;
+    channels -= srgb ? PRAY_BYTES_SRGB : 0;
     if ((channels != 3 && channels != 4) || !out)
-        return fail(c, PRAY_ERR_ARG, "pray_image_bytes: %s", out ? "channels must be 3 or 4" : "no buffer");
+        return fail(c, PRAY_ERR_ARG, "pray_image_bytes: %s", out ? "channels must be 3 or 4 (+ PRAY_BYTES_SRGB)" : "no buffer");
     size_t n = (size_t)img->width * (size_t)img->height;
     for (size_t i = 0; i < n; i++, out += channels) {
-        for (int k = 0; k < 3; k++) out[k] = (unsigned char)quantize(img->pixels[3 * i + k], 255);
+        for (int k = 0; k < 3; k++) {
+            double v = img->pixels[3 * i + k];
+            if (srgb) v = !(v > 0) ? 0 : v >= 1 ? 1 : v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1 / 2.4) - 0.055;
+            out[k] = (unsigned char)(srgb ? (unsigned)(v * 255 + 0.5) : quantize(img->pixels[3 * i + k], 255));
+        }
         if (channels == 4) out[3] = 255;
     }
     return PRAY_OK;

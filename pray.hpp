@@ -530,8 +530,13 @@ pray_status pray_write_image_note(pray_ctx *ctx, const pray_image *img, const ch
 pray_status pray_image_new(pray_ctx *ctx, int width, int height, pray_image *out);
 /* The image as 8-bit samples into the caller's buffer, rows from the top, `channels` bytes a
    pixel: 3 (R, G, B) or 4 (R, G, B and 255): exactly the samples an 8-bit file of it holds
-   (pray_write_image: PPM, TIFF and PNG alike). out must hold width x height x channels bytes.
-   PRAY_ERR_ARG for an image that is not valid, channels not 3 or 4, or a NULL out. */
+   (pray_write_image: PPM, TIFF and PNG alike), which are linear in the light (value x 255,
+   rounded). With PRAY_BYTES_SRGB added to channels (3 + PRAY_BYTES_SRGB, 4 + PRAY_BYTES_SRGB)
+   the samples are encoded with the sRGB curve instead, as displays and denoisers of 8-bit
+   colour expect: 12.92 v up to v = 0.0031308, else 1.055 v^(1/2.4) - 0.055, then x 255 rounded
+   (values below 0 and above 1 taken as 0 and 1). out must hold width x height x channels bytes.
+   PRAY_ERR_ARG for an image that is not valid, channels not one of those four, or a NULL out. */
+#define PRAY_BYTES_SRGB 256
 pray_status pray_image_bytes(pray_ctx *ctx, const pray_image *img, int channels, unsigned char *out);
 /* Record an error as pray's own calls do: status `status`, message "error: " + message (NULL:
    the status's text); returns status. For callbacks (render, frame) that fail with a message of

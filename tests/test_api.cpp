@@ -1066,8 +1066,23 @@ TEST_CASE("api: an image as 8-bit samples in the host's buffer holds the bytes o
     }
     CHECK(rgb[0] == 0);  // (-0.02: black)
     CHECK(rgb[4] == 1);
+    // sRGB: the curve of IEC 61966-2-1 at exact points (0.5 -> 0.7354 -> 188; 0.002 -> 0.02584 -> 7;
+    // 0.2 -> 0.4845 -> 124), and the alpha channel
+    float keep[3] = {img.pixels[0], img.pixels[1], img.pixels[2]};
+    img.pixels[0] = 0.5f, img.pixels[1] = 0.002f, img.pixels[2] = 0.2f;
+    std::vector<unsigned char> srgb(7 * 5 * 4);
+    REQUIRE(pray_image_bytes(c, &img, 4 + PRAY_BYTES_SRGB, srgb.data()) == PRAY_OK);
+    CHECK((srgb[0] == 188 && srgb[1] == 7 && srgb[2] == 124 && srgb[3] == 255));
+    for (int i = 3; i < 7 * 5 * 3; i++) {  // the others: the curve of the same samples
+        double v = img.pixels[i], e = v <= 0 ? 0 : v >= 1 ? 1 : v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055;
+        CHECK(srgb[i / 3 * 4 + i % 3] == (unsigned char)(e * 255 + 0.5));
+    }
+    REQUIRE(pray_image_bytes(c, &img, 3 + PRAY_BYTES_SRGB, rgb.data()) == PRAY_OK);
+    CHECK((rgb[0] == 188 && rgb[1] == 7 && rgb[2] == 124));
+    img.pixels[0] = keep[0], img.pixels[1] = keep[1], img.pixels[2] = keep[2];
     CHECK(pray_image_bytes(c, &img, 2, rgb.data()) == PRAY_ERR_ARG);
-    CHECK(std::string(pray_error(c)) == "error: pray_image_bytes: channels must be 3 or 4");
+    CHECK(std::string(pray_error(c)) == "error: pray_image_bytes: channels must be 3 or 4 (+ PRAY_BYTES_SRGB)");
+    CHECK(pray_image_bytes(c, &img, 5 + PRAY_BYTES_SRGB, rgb.data()) == PRAY_ERR_ARG);
     CHECK(pray_image_bytes(c, &img, 3, nullptr) == PRAY_ERR_ARG);
     CHECK(pray_image_bytes(c, nullptr, 3, rgb.data()) == PRAY_ERR_ARG);
     CHECK(pray_image_bytes(nullptr, &img, 3, rgb.data()) == PRAY_ERR_ARG);
