@@ -1456,16 +1456,26 @@ bool frame_ok(const Xform &f) {
 
 // A copy of primitive a (which has a frame, or is given one) with f applied to its frame: its
 // local parameters and texture coordinates stay as they are.
-pray_object *obj_reframe(pray_ctx *c, const pray_object *a, const Xform &f, const char *what) {
-    pray_object *o = obj_new(c, a->kind, a->mat);
+// Primitive a (or `one`, `nothing`) copied in model m: shape, texture coordinates; no frame, no pattern.
+pray_object *prim_copy(pray_ctx *c, const pray_object *a, pray_model *m) {
+    pray_object *o = obj_new(c, a->kind, m);
     if (!o) return NULL;
     o->p = a->p;
     o->v = a->v;
     o->r = a->r;
     o->r2 = a->r2;
+    if (a->map && !obj_map(c, o, a->map->kind, a->map->u, a->map->v, a->map->mirrored)) {
+        release_handle(c, o);
+        return NULL;
+    }
+    return o;
+}
+
+pray_object *obj_reframe(pray_ctx *c, const pray_object *a, const Xform &f, const char *what) {
+    pray_object *o = prim_copy(c, a, a->mat);
+    if (!o) return NULL;
     o->fr = (Xform *)mem_alloc(c, sizeof(Xform));
-    if (!o->fr || (a->map && !obj_map(c, o, a->map->kind, a->map->u, a->map->v, a->map->mirrored)) ||
-        !pat_carry(c, o, a, f)) {
+    if (!o->fr || !pat_carry(c, o, a, f)) {
         release_handle(c, o);
         return NULL;
     }
@@ -1595,19 +1605,17 @@ pray_object *obj_stretch(pray_ctx *c, pray_object *a, pray_vec v) {
 // coordinates stay; a checker in m takes the world's coordinates as they are now.
 pray_object *paint_kid(pray_ctx *c, pray_object *a, const void *m);
 pray_object *obj_paint(pray_ctx *c, pray_object *a, pray_model *m) {
-    pray_object *o = obj_new(c, a->kind, is_node(a->kind) || a->kind == O_NOTHING ? NULL : m);
-    if (!o) return NULL;
-    o->p = a->p;
-    o->v = a->v;
-    o->r = a->r;
-    o->r2 = a->r2;
-    o->fr = a->fr ? (Xform *)mem_alloc(c, sizeof(Xform)) : NULL;
-    if ((a->fr && !o->fr) || (a->map && !obj_map(c, o, a->map->kind, a->map->u, a->map->v, a->map->mirrored))) {
+    if (is_node(a->kind)) {
+        pray_object *o = obj_new(c, a->kind, NULL);
+        return o ? copy_kids(c, o, a, paint_kid, m) : NULL;
+    }
+    pray_object *o = prim_copy(c, a, a->kind == O_NOTHING ? NULL : m);
+    if (o && a->fr && !(o->fr = (Xform *)mem_alloc(c, sizeof(Xform)))) {
         release_handle(c, o);
         return NULL;
     }
-    if (a->fr) *o->fr = *a->fr;
-    return is_node(a->kind) ? copy_kids(c, o, a, paint_kid, m) : o;
+    if (o && a->fr) *o->fr = *a->fr;
+    return o;
 }
 pray_object *paint_kid(pray_ctx *c, pray_object *a, const void *m) { return obj_paint(c, a, (pray_model *)m); }
 
@@ -9399,10 +9407,10 @@ struct Sink {
     void put(const void *p, size_t n) { fn(ud, p, n); }
 };
 
-inline unsigned quantize(float v, unsigned maxval) {
+inline unsigned quantize(double v, unsigned maxval) {
     if (!(v > 0)) return 0;  // also NaN
     if (v >= 1) return maxval;
-    return (unsigned)((double)v * maxval + 0.5);  // in double: the same on x87 and SSE
+    return (unsigned)(v * maxval + 0.5);  // in double: the same on x87 and SSE
 }
 
 // Little-endian ("II") byte layout, written byte by byte so every host writes the same file.
@@ -11074,8 +11082,8 @@ pray_status pray_image_bytes(pray_ctx *c, const pray_image *img, int channels, u
     for (size_t i = 0; i < n; i++, out += channels) {
         for (int k = 0; k < 3; k++) {
             double v = img->pixels[3 * i + k];
-            if (srgb) v = !(v > 0) ? 0 : v >= 1 ? 1 : v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1 / 2.4) - 0.055;
-            out[k] = (unsigned char)(srgb ? (unsigned)(v * 255 + 0.5) : quantize(img->pixels[3 * i + k], 255));
+            if (srgb && v > 0 && v < 1) v = v <= 0.0031308 ? 12.92 * v : 1.055 * pow(v, 1 / 2.4) - 0.055;
+            out[k] = (unsigned char)quantize(v, 255);
         }
         if (channels == 4) out[3] = 255;
     }
