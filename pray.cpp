@@ -14,7 +14,7 @@
    [SECTION] 8     450  Ray/primitive intersection; primitives in a frame (box, rod, cone, torus,
                           stretched)
    [SECTION] 9     450  CSG status-tree sweep (the brute-force reference, thesis 3.4)
-   [SECTION] 9b   2800  Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
+   [SECTION] 9b   2100  Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
                           [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas
                           and jumps, [9b.4] accel_build; per ray: [9b.5] list evaluation with
                           freezing, [9b.6] the grid walk, [9b.7] the ray driver
@@ -29,7 +29,7 @@
    [SECTION] 14   1650  PRAY interpreter: values, operators, builtins, statements
    [SECTION] 15    200  One-call helpers and the running of programs
    [SECTION] 16    800  Command-line program (PRAY_MAIN)
-   The whole file: at most 15200 lines.
+   The whole file: at most 14500 lines.
 */
 
 // =============================================================================================
@@ -4573,17 +4573,20 @@ struct VoxelRange {
 // how many voxels nested grids may still take.
 struct GridPlan {
     const Box *eff;
+    const int *obj;  // per primitive: its object (NEST_OBJECTS)
     double round;
     double budget;
 };
 
-// A voxel with more primitives to check than this gets a grid of its own (option nest: how many
-// levels deep). The nested grid covers the box that holds those primitives within the voxel,
-// with about 4 voxels per primitive to check (as auto_grid), at most 32 a side; the rest of the
-// voxel has the voxel's list without them (Grid::rest). A primitive that crosses the whole voxel
-// along some axis (a floor, a wall, a long rod) is no part of a crowd: the box leaves it out,
-// and the rest of the voxel checks it, unless that would crowd the rest.
-const int NEST_CHECKS = 32;
+// A voxel with more objects to check than this gets a grid of its own (option nest: how many
+// levels deep). An object is a primitive, or the intersection it is part of (with the
+// intersections above that one): a box of six half-spaces is one object, since finer voxels
+// would not part its faces. The nested grid covers the box that holds those primitives within
+// the voxel, with about 4 voxels per object to check (as auto_grid), at most 32 a side; the rest
+// of the voxel has the voxel's list without them (Grid::rest). A primitive that crosses the
+// whole voxel along some axis (a floor, a wall, a long rod) is no part of a crowd: the box leaves
+// it out, and the rest of the voxel checks it, unless that would crowd the rest.
+const int NEST_OBJECTS = 8;
 // Nested grids have at most this many voxels for each primitive of the scene, all together; and
 // a nested grid is built only where it separates the voxel's primitives: its voxels reach, on
 // average, at most this share of the primitives the voxel has to check.
@@ -4591,6 +4594,21 @@ const double NEST_PER_PRIM = 64, NEST_SEPARATES = 0.5;
 
 bool grid_lists(ListBuilder &b, Grid &G, GridPlan &gp, const Array<int> &cand, const Array<int> &start, double margin,
                 int steps, int depth);
+
+// Per primitive, its object: the highest node above it through intersections alone (a box of
+// half-spaces), or else the primitive (numbered after the nodes); NULL when out of memory.
+int *nest_objects(pray_ctx *c, const Scene *s) {
+    int np = s->prims.n, nn = s->nodes.n, *top = (int *)mem_alloc(c, sizeof(int) * (size_t)(np + nn + 1));
+    for (int j = nn - 1; top && j >= 0; j--) {  // parents before children
+        int pa = s->nodes[j].parent;
+        top[np + j] = s->nodes[j].op != O_INTER ? -1 : pa >= 0 && top[np + pa] >= 0 ? top[np + pa] : j;
+    }
+    for (int i = 0; top && i < np; i++) {
+        int pa = s->prims[i].parent;
+        top[i] = pa >= 0 && top[np + pa] >= 0 ? top[np + pa] : nn + i;
+    }
+    return top;
+}
 
 // Box bx widened by wid, within the voxel [v0, v1]: lo, hi; whether it crosses the voxel along
 // some axis.
@@ -4616,7 +4634,7 @@ bool nest_holds(const Box &bx, double wid, const double *v0, const double *v1, c
 
 // The box of a nested grid in the voxel [v0, v1]: of the primitives to check (b.rprims, b.rcls)
 // whose boxes do not cross the voxel, when the others are few enough for the rest of the voxel
-// (at most NEST_CHECKS outside that box), else of them all. Their boxes are widened by wid; the
+// (at most NEST_OBJECTS outside that box), else of them all. Their boxes are widened by wid; the
 // box is within the voxel, and false when it is empty.
 bool nest_box(const ListBuilder &b, const Box *eff, double wid, const double *v0, const double *v1, double *lo,
               double *hi) {
@@ -4637,7 +4655,7 @@ bool nest_box(const ListBuilder &b, const Box *eff, double wid, const double *v0
     int out = 0;
     for (int i = 0; local > 0 && i < b.rprims.n; i++)
         if (b.rcls[i] == CL_BD && !nest_holds(eff[b.rprims[i]], wid, v0, v1, lo, hi)) out++;
-    bool all = local == 0 || out > NEST_CHECKS;
+    bool all = local == 0 || out > NEST_OBJECTS;
     for (int l = 0; l < 3; l++) {
         if (all) lo[l] = alo[l], hi[l] = ahi[l];
         if (!(hi[l] > lo[l])) return false;
@@ -4646,9 +4664,9 @@ bool nest_box(const ListBuilder &b, const Box *eff, double wid, const double *v0
 }
 
 // A grid of its own for voxel ix of G, whose candidates are ids[0 .. n) and which has `checks`
-// primitives to check (classed in the voxel: b.rprims, b.rcls): its index in Accel::nested; -1
+// primitives in `objs` objects to check (classed in the voxel: b.rprims, b.rcls): its index in Accel::nested; -1
 // when it is not worth it or does not fit the budget; -2 on failure.
-int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const int *ids, int n, int checks, int steps,
+int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const int *ids, int n, int checks, int objs, int steps,
                int depth) {
     pray_ctx *c = b.c;
     // the box of the primitives to check, widened by the most a nested grid's margin can be
@@ -4661,10 +4679,10 @@ int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const
     if (!nest_box(b, gp.eff, wid, v0, v1, lo, hi)) return -1;
     for (int l = 0; l < 3; l++) ext = hi[l] - lo[l] > ext ? hi[l] - lo[l] : ext;
     for (int l = 0; l < 3; l++) vol *= hi[l] - lo[l] > ext / 16 ? hi[l] - lo[l] : ext / 16;
-    // cubic voxels, about 4 per primitive to check, fewer while the budget is short
+    // cubic voxels, about 4 per object to check, fewer while the budget is short
     Grid S;
     memset(&S, 0, sizeof S);
-    double h = cbrt_pos(vol / (4.0 * checks)), nv = 0;
+    double h = cbrt_pos(vol / (4.0 * objs)), nv = 0;
     h = h > ext / 32 ? h : ext / 32;
     for (;;) {
         nv = 1;
@@ -4735,9 +4753,10 @@ bool grid_lists(ListBuilder &b, Grid &G, GridPlan &gp, const Array<int> &cand, c
                 in.s = b.s;
                 voxels_box(G, ix, ix1, margin, in.lo, in.hi);
                 if (!lb_region(b, cand.p + k0, k1 - k0, in)) return false;
-                int checks = 0;
-                for (int i = 0; i < b.rcls.n; i++) checks += b.rcls[i] == CL_BD;
-                int g = depth > 0 && checks > NEST_CHECKS ? nest_build(b, G, ix, gp, cand.p + k0, k1 - k0, checks, steps, depth - 1) : -1;
+                int checks = 0, objs = 0;
+                for (int i = 0, o = -1; i < b.rcls.n; i++)  // (an object's primitives are numbered together)
+                    if (b.rcls[i] == CL_BD) checks++, objs += gp.obj[b.rprims[i]] != o, o = gp.obj[b.rprims[i]];
+                int g = depth > 0 && objs > NEST_OBJECTS ? nest_build(b, G, ix, gp, cand.p + k0, k1 - k0, checks, objs, steps, depth - 1) : -1;
                 if (g == -2) return false;
                 if (g >= 0) {
                     G.voxel[v] = -1 - g;
@@ -5076,14 +5095,16 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
         // each primitive: the scene decides, never the image
         GridPlan gp;
         gp.eff = eff;
+        gp.obj = nest_objects(c, s);
         gp.round = 64 * REAL_EPS * (mag + ext);
         gp.budget = (budget - (double)nv * (2 * sizeof(int) + 1)) / 16;
         gp.budget = gp.budget < NEST_PER_PRIM * np ? gp.budget : NEST_PER_PRIM * np;
-        if (!a->g.voxel || !bucket(c, a->g.n, np, VoxelRange(a->g, eff, NULL, margin), cand, start) ||
+        if (!gp.obj || !a->g.voxel || !bucket(c, a->g.n, np, VoxelRange(a->g, eff, NULL, margin), cand, start) ||
             !grid_lists(b, a->g, gp, cand, start, margin, want + 4, opt_int(c, OPT_NEST)))
             st = c->status;
         for (int i = -1; st == PRAY_OK && i < a->nested.n; i++)
             if (!grid_areas(c, i < 0 ? a->g : a->nested[i], &a->areas)) st = c->status;
+        mem_free(c, (void *)gp.obj);
     }
     // the space outside the grid (or everything): primitives not inside the grid's box are active
     if (st == PRAY_OK) {

@@ -1127,6 +1127,39 @@ TEST_CASE("accel stats: a layer of balls over a floor is divided as finely as wi
     CHECK(frame_difference(ref.frames, runs[1].frames) == "");
 }
 
+TEST_CASE("accel stats: a crowd of boxes of six half-spaces nests like the same boxes made by box") {
+    // 150 small cubes in one corner of a voxel, each an intersection of six half-spaces or one
+    // `box`: an object is the node above its half-spaces, so the nested grids are the same
+    std::string program = "M = phong({0.6}, {0.3}, {0.1}, 10)\nAll = sphere(M, [0.8, 0.8, 0.8], 0.15)\n" +
+                          random_balls(150, "[-0.9 + 0.5*X, -0.9 + 0.5*Y, -0.9 + 0.5*Z], 0.02");
+    program += "perspective <1, 0, 0>, <0, 0.8, 0.6>, [0, -3, 2.5], [0, 0, 0]\n"
+               "rendertiff All | plane(M, [0, 0, -0.95], <0, 0, 1>), dirlight({1}, <1, 2, -3>)\n";
+    const std::string ball = "All = All | sphere(M, [-0.9 + 0.5*X, -0.9 + 0.5*Y, -0.9 + 0.5*Z], 0.02)\n";
+    const std::string made[2] = {
+        "R = 0.02\nP = [-0.9 + 0.5*X, -0.9 + 0.5*Y, -0.9 + 0.5*Z]\n"
+        "All = All | (plane(M, P + <R, 0, 0>, <1, 0, 0>) & plane(M, P - <R, 0, 0>, <-1, 0, 0>) & "
+        "plane(M, P + <0, R, 0>, <0, 1, 0>) & plane(M, P - <0, R, 0>, <0, -1, 0>) & "
+        "plane(M, P + <0, 0, R>, <0, 0, 1>) & plane(M, P - <0, 0, R>, <0, 0, -1>))\n",
+        "All = All | box(M, [-0.92 + 0.5*X, -0.92 + 0.5*Y, -0.92 + 0.5*Z], [-0.88 + 0.5*X, -0.88 + 0.5*Y, -0.88 + 0.5*Z])\n"};
+    const std::vector<std::string> options = {"grid=2", "nest=1", "width=64", "height=64"};
+    Run runs[2];
+    for (int k = 0; k < 2; k++) {
+        std::string text = program;
+        text.replace(text.find(ball), ball.size(), made[k]);
+        runs[k] = run_program("cubes.ray", text, options);
+        INFO("made by ", k ? "box" : "half-spaces", ": ", stats_text(runs[k].stats));
+        REQUIRE(runs[k].status == PRAY_OK);
+        CHECK(runs[k].stats.nested_grids > 0);
+        std::vector<std::string> brute = options;
+        brute.push_back("brute=1");
+        Run ref = run_program("cubes.ray", text, brute);
+        REQUIRE(ref.status == PRAY_OK);
+        CHECK(frame_difference(ref.frames, runs[k].frames) == "");
+    }
+    CHECK(runs[0].stats.nested_grids == runs[1].stats.nested_grids);
+    CHECK(runs[0].stats.nested_voxels == runs[1].stats.nested_voxels);
+}
+
 TEST_CASE("accel stats: a few parts far from a cluster are left out of the grid's box") {
     // 400 balls in a unit cube and three moons (one of them a difference) a thousand units away,
     // in view: the grid covers the balls as without the moons, which the outer list holds
