@@ -14,10 +14,10 @@
    [SECTION] 8     450  Ray/primitive intersection; primitives in a frame (box, rod, cone, torus,
                           stretched)
    [SECTION] 9     450  CSG status-tree sweep (the brute-force reference, thesis 3.4)
-   [SECTION] 9b   2100  Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
+   [SECTION] 9b   2825  Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
                           [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas
-                          and jumps, [9b.4] accel_build; per ray: [9b.5] list evaluation with
-                          freezing, [9b.6] the grid walk, [9b.7] the ray driver
+                          and jumps, [9b.4] light and eye buffers, [9b.5] accel_build; per ray: [9b.6]
+                          list evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver
    [SECTION] 9c    950  Reading files (programs, textures, fonts), TIFF reader and textures, the
                           built-in font
    [SECTION] 10   1250  Whitted shading, textured surfaces, the render driver (threads, undersampling)
@@ -29,7 +29,7 @@
    [SECTION] 14   1650  PRAY interpreter: values, operators, builtins, statements
    [SECTION] 15    200  One-call helpers and the running of programs
    [SECTION] 16    800  Command-line program (PRAY_MAIN)
-   The whole file: at most 14500 lines.
+   The whole file: at most 15225 lines.
 */
 
 // =============================================================================================
@@ -553,8 +553,8 @@ struct TexName {
 
 // Options by index; the table in section 6 has their names, defaults and ranges.
 enum {
-    OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_COHERENCE, OPT_CUTOFF, OPT_DEPTH, OPT_FREEZE,
-    OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_MAXFRAMES, OPT_MAXLINE, OPT_MAXMEM, OPT_MAXNEST,
+    OPT_ADAPTIVE, OPT_ANTIALIAS, OPT_BITS, OPT_BOUNDS, OPT_BRUTE, OPT_COHERENCE, OPT_CUTOFF, OPT_DEPTH, OPT_EYEBUFFER, OPT_FREEZE,
+    OPT_GRID, OPT_GRIDMEM, OPT_HEIGHT, OPT_LIGHTBUFFER, OPT_MAXFRAMES, OPT_MAXLINE, OPT_MAXMEM, OPT_MAXNEST,
     OPT_MAXOUTPUT, OPT_MAXPIXELS, OPT_MAXPRIMS, OPT_MAXRAYS, OPT_MAXSTEPS, OPT_MAXSTRING, OPT_MAXTIME, OPT_MERGE, OPT_NEST, OPT_OUTPUT,
     OPT_PLANS, OPT_SHADOWCACHE, OPT_SHADOWS, OPT_TEXMEM, OPT_THREADS,
     OPT_WIDTH, OPT_COUNT
@@ -1783,7 +1783,7 @@ struct OptDef {
 };
 // Alphabetical, in the order of the OPT_ enumeration. grid -1 means "automatic". The max* options
 // and depth, gridmem and texmem are the limits of a run (pray.hpp, "Limits"). brute, grid, nest,
-// freeze, merge, bounds, shadowcache, plans and coherence are diagnostic
+// freeze, merge, bounds, lightbuffer, eyebuffer, shadowcache, plans and coherence are diagnostic
 // (pray.hpp, "Options"; --help): they change how fast an image is made, never the image.
 const OptDef OPTS[OPT_COUNT] = {
     {"adaptive", 0, 0, 1e9, 0, 0},
@@ -1794,10 +1794,12 @@ const OptDef OPTS[OPT_COUNT] = {
     {"coherence", 1, 0, 1, 1, 0},
     {"cutoff", 1, 0, 1, 1, 0},
     {"depth", 5, 1, 64, 1, 16},
+    {"eyebuffer", 1, 0, 1, 1, 0},
     {"freeze", 1, 0, 1, 1, 0},
     {"grid", -1, -1, 4096, 1, 0},
     {"gridmem", 64, 1, 65536, 1, 64},
     {"height", 256, 1, MAX_IMAGE_SIDE, 1, 0},
+    {"lightbuffer", 1, 0, 1, 1, 0},
     {"maxframes", 0, 0, 1e9, 1, 1000},
     {"maxline", 65536, 1, 1e9, 1, 4096},
     {"maxmem", 0, 0, 1e9, 1, 1024},
@@ -3504,6 +3506,8 @@ struct Counters {
     double rays[4];  // primary, shadow, reflected, refracted
     double tests;
     double steps, moves, set_in, set_out, checks, frozen;
+    double lbuf;  // shadow rays answered by a light buffer
+    double ebuf;  // primary rays answered by the eye's buffer
     double cache; // shadow rays answered by the shadow cache
     double notes, cells;  // image sequences: rays and region cells noted in records (10b)
 };
@@ -3890,16 +3894,47 @@ inline real visit_end(const Visit &) { return REAL_INF; }
 // [SECTION] 9b Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
 // =============================================================================================
 // Building (once per scene) and tracing (per ray) are apart:
-//   [9b.1] The structure: classes, action lists, the grid; lookups both use
+//   [9b.1] The structure: classes, action lists, the grid, light buffers; lookups both use
 //   [9b.2] Building: action lists, plans, the region-to-list builder
 //   [9b.3] Building: the grid, areas and jumps
-//   [9b.4] Building: the whole structure (accel_build)
-//   [9b.5] Per ray: list evaluation with freezing (the one list evaluator)
-//   [9b.6] Per ray: the grid walk (the stretch source)
-//   [9b.7] Per ray: the ray driver, the shadow cache, the entry points
-// ---- [9b.1] The structure: classes, action lists, the grid; lookups both use ----
+//   [9b.4] Building: light buffers and the eye's buffer
+//   [9b.5] Building: the whole structure (accel_build)
+//   [9b.6] Per ray: list evaluation with freezing (the one list evaluator)
+//   [9b.7] Per ray: stretch sources (grid walk, light buffer voxel, eye buffer cell)
+//   [9b.8] Per ray: the ray driver, the shadow cache, the entry points
+// ---- [9b.1] The structure: classes, action lists, the grid, light buffers; lookups both use ----
 // Classes of a node against a region of space (thesis 3.4).
 enum { CL_OUT = 0, CL_IN = 1, CL_BD = 2 };
+
+// One face of a light buffer: cells in (u, v), slabs in depth w. A directional light has one,
+// whose frame has e[2] towards the light: u, v, w are a point's coordinates in the frame, and a
+// zone runs from its slab to the buffer's end (`top`). A point light has six, one per axis and
+// sign, e[2] pointing away from the light: w is the distance along e[2], u and v the
+// coordinates along e[0], e[1] over w; a zone is the cell's pyramid from the light to the end
+// of its slab.
+struct LightFace {
+    R3 e[3];
+    real lo[3], h[3], inv[3];  // the grid: the low corner, the sides and their reciprocals
+    int n[3];                  // cells along u, v; slabs (0: a face without voxels)
+    int base;                  // the face's first voxel in LightBuf::list
+    int cbase;                 // the eye's buffer: the face's first cell in LightBuf::runs
+};
+
+// The eye's buffer (option eyebuffer) is a point light's buffer at the perspective camera's eye
+// whose voxels keep the list of their own piece of the cell, between the slab's two depths: a
+// primary ray stays in one cell and walks its slabs outwards.
+struct LightBuf {
+    int point, faces;
+    int pieces;                // 1: the eye's buffer
+    R3 o;                      // the light's position (a point light), or the eye
+    real top;                  // a directional light: w where the zones end, past the grid
+    LightFace f[6];
+    int *list;                 // per voxel: its list; -1: the ray walks the grid
+    // The eye's buffer: per cell, where its runs start (and, after the last cell, where they
+    // end); then the runs, each a list and the slab where it ends, in order from the eye. A cell
+    // whose primary rays walk the grid has one run of list -1.
+    int *runs, nruns;
+};
 
 // An action list, stored in Accel::data at off[L]:
 //   [na, np, set_inside, set_outside, na x (node, count, first), np x primitive]
@@ -3933,6 +3968,9 @@ struct Accel {
     int outer;         // list of the space outside the grid (everything without a grid)
     int freeze, merge, bounds;
     int cache;              // option shadowcache
+    LightBuf *lbuf;         // per light, then the eye's; or NULL (options lightbuffer, eyebuffer)
+    int nlbuf;              // the lights'
+    const LightBuf *eye;    // &lbuf[nlbuf] when the eye has a buffer
     long areas;
     double memory;
 };
@@ -3948,6 +3986,11 @@ void accel_release(pray_ctx *c, Accel *a) {
     a->off.release(c);
     a->plan_at.release(c);
     a->plan.release(c);
+    for (int i = 0; a->lbuf && i <= a->nlbuf; i++) {
+        mem_free(c, a->lbuf[i].list);
+        mem_free(c, a->lbuf[i].runs);
+    }
+    mem_free(c, a->lbuf);
     mem_free(c, a);
 }
 
@@ -3968,6 +4011,35 @@ void voxels_box(const Grid &G, const int *i0, const int *i1, double margin, real
         lo[l] = (real)((double)G.org[l] + i0[l] * (double)G.h - margin);
         hi[l] = (real)((double)G.org[l] + i1[l] * (double)G.h + margin);
     }
+}
+
+// The face of a point light's buffer that holds direction m (from the light): its largest
+// component's axis and sign.
+inline int cube_face(R3 m) {
+    real ax = m.x < 0 ? -m.x : m.x, ay = m.y < 0 ? -m.y : m.y, az = m.z < 0 ? -m.z : m.z;
+    int a = ax >= ay && ax >= az ? 0 : ay >= az ? 1 : 2;
+    return 2 * a + (comp(m, a) < 0);
+}
+
+// A point light's zones (and the eye's) are widened by this share of a cell, and a point is
+// looked up in the cells widened by as much: so a point rounded just past a cell's edge (u = 1
+// in one face, -1 in the next) still belongs to the cell it is given.
+const real CELL_SLACK = (real)0.25;
+
+// The cell of face F at (u, v) (a point light's u and v are over w), the face's cells widened
+// by `slack` cells and clamped: 1 and *cell set; 0 when (u, v) is beside the cells; -1 when not
+// a number.
+inline int face_cell(const LightFace &F, real u, real v, real slack, int *cell) {
+    real g[2] = {u, v};
+    int i[2];
+    for (int l = 0; l < 2; l++) {
+        real k = (g[l] - F.lo[l]) * F.inv[l];
+        if (k != k) return -1;
+        if (!(k >= -slack && k < (real)F.n[l] + slack)) return 0;
+        i[l] = k < 0 ? 0 : k < (real)F.n[l] ? (int)k : F.n[l] - 1;
+    }
+    *cell = i[1] * F.n[0] + i[0];
+    return 1;
 }
 
 // ---- [9b.2] Building: action lists, plans, the region-to-list builder ----
@@ -4260,7 +4332,7 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
 
 // The primitives of a region and their classes there, into b.rprims and b.rcls, for lb_list:
 // each candidate classed by `cl` (a functor, by primitive), those outside left out. Every region
-// that gets a list (a voxel, the space around the grid) is gathered
+// that gets a list (a voxel, a light buffer's zone, the space around the grid) is gathered
 // here. False when out of memory.
 template <class Classify>
 bool lb_region(ListBuilder &b, const int *cand, int n, const Classify &cl) {
@@ -4403,6 +4475,9 @@ int list_plan(pray_ctx *c, const Scene *s, const int *d, int *kids, int *solid, 
     plan->p[base + 2] = ng;
     return base;
 }
+
+// A plain list: one with a plan and no holes (list_plan).
+inline bool list_plain(const Accel *A, int L) { return A->plan_at[L] >= 0 && !A->plan.p[A->plan_at[L] + 1]; }
 
 // ---- [9b.3] Building: the grid, areas and jumps ----
 // Voxels along the longest axis when the grid option is automatic. Measured on the benchmark
@@ -4802,7 +4877,504 @@ bool grid_areas(pray_ctx *c, const Grid &G, long *areas) {
     return ok;
 }
 
-// ---- [9b.4] Building: the whole structure ----
+// ---- [9b.4] Building: light buffers and the eye's buffer ----
+// (Haines and Greenberg's light buffer, in the survey [Woo90].)
+// A shadow ray runs from a surface point to its light. Around each light the directions are
+// cut into cells (across a directional light: columns), and each cell into slabs by distance
+// from the light; a voxel of this light-space grid keeps the action list of its zone, the part
+// of the cell between the voxel and the light, which holds every shadow ray that starts in the
+// voxel. Such a ray evaluates that one list instead of walking the grid. The zones are classed
+// like the grid's voxels, with a margin for rounding.
+#ifndef PRAY_NO_BUFFERS  // (a build without them: their options change nothing)
+
+// The squared distance from point p to box bx (0 inside it).
+inline real box_dist2(const Box &bx, R3 p) {
+    real d2 = 0;
+    for (int l = 0; l < 3; l++) {
+        real c = comp(p, l), e = bx.lo[l] - c > 0 ? bx.lo[l] - c : c - bx.hi[l] > 0 ? c - bx.hi[l] : 0;
+        d2 += e * e;
+    }
+    return d2;
+}
+
+// A convex zone: {x : n[i].x <= d[i]}, the hull of v[0 .. nv); with a ball of radius r around c
+// joined to it (a point light's neighbourhood, where the pyramids meet; r = 0: none).
+struct Zone {
+    int np, nv;
+    R3 n[6], v[8];
+    real d[6];
+    R3 c;
+    real r;
+    real lo[3], hi[3];  // the hull's box (zone_hull)
+};
+
+// Sets the box of zone z's hull from its vertices.
+void zone_hull(Zone *z) {
+    for (int l = 0; l < 3; l++) {
+        z->lo[l] = REAL_BIG, z->hi[l] = -REAL_BIG;
+        for (int k = 0; k < z->nv; k++) {
+            real x = comp(z->v[k], l);
+            z->lo[l] = x < z->lo[l] ? x : z->lo[l];
+            z->hi[l] = x > z->hi[l] ? x : z->hi[l];
+        }
+    }
+}
+
+// Class of primitive q, which bounds place in box bx, against a zone: conservative, like
+// classify_prim (outside only when it misses the zone, inside only when it holds all of it).
+int classify_zone(const Prim &q, const Box &bx, const Zone &z) {
+    bool out = false;  // clear of the hull's box or beyond one of the polytope's planes
+    for (int l = 0; l < 3 && !out; l++) out = z.hi[l] < bx.lo[l] || bx.hi[l] < z.lo[l];
+    for (int i = 0; i < z.np && !out; i++) {
+        real lo = 0;  // the least n.x over the box
+        for (int l = 0; l < 3; l++) {
+            real nl = comp(z.n[i], l);  // (no 0 x infinity: a box may be unbounded)
+            lo += nl * (nl > 0 ? bx.lo[l] : nl < 0 ? bx.hi[l] : 0);
+        }
+        out = lo > z.d[i];
+    }
+    bool out_ball = z.r == 0 || box_dist2(bx, z.c) > z.r * z.r;
+    bool in = true;  // every vertex inside the solid (then all of the polytope, which is convex)
+    switch (q.kind) {
+    case O_SPHERE: {
+        for (int i = 0; i < z.np && !out; i++) out = dot(z.n[i], q.p) - z.d[i] > q.r;
+        for (int k = 0; k < z.nv && in; k++) in = dot(z.v[k] - q.p, z.v[k] - q.p) < q.r2;
+        real dc = (real)sqrt((double)dot(z.c - q.p, z.c - q.p));
+        out_ball = out_ball || dc > q.r + z.r;
+        in = in && (z.r == 0 || dc + z.r < q.r);
+        break;
+    }
+    case O_PLANE: {
+        bool all_out = true;
+        for (int k = 0; k < z.nv; k++) {
+            real sd = dot(q.n, z.v[k]) - q.d;
+            in = in && sd < 0;
+            all_out = all_out && sd > 0;
+        }
+        out = out || all_out;
+        real sc = dot(q.n, z.c) - q.d;
+        out_ball = out_ball || sc > z.r;
+        in = in && (z.r == 0 || sc < -z.r);
+        break;
+    }
+    case O_CYLINDER: {
+        for (int k = 0; k < z.nv && in; k++) {
+            R3 x = z.v[k] - q.p;
+            R3 perp = x - q.n * dot(x, q.n);
+            in = dot(perp, perp) < q.r2;
+        }
+        R3 x = z.c - q.p;
+        R3 perp = x - q.n * dot(x, q.n);
+        in = in && (z.r == 0 || (real)sqrt((double)dot(perp, perp)) + z.r < q.r);
+        break;
+    }
+    default:  // in a frame: inside when convex and holding every vertex (no ball)
+        for (int k = 0; k < z.nv && in; k++) in = framed_inside(q, z.v[k]);
+        in = in && z.r == 0;
+    }
+    if (out && out_ball) return CL_OUT;
+    return in ? CL_IN : CL_BD;
+}
+
+// Classes in a zone of a light buffer, for primitives whose depths (key: per primitive, the
+// least and the most w of its box) meet the zone's [w0, w1].
+struct ZoneClass {
+    const Scene *s;
+    const Box *eff;  // where bounds place each primitive
+    const real *key;
+    real w0, w1;
+    Zone z;
+    int operator()(int i) const {
+        if (!(key[2 * i] <= w1 && key[2 * i + 1] >= w0)) return CL_OUT;
+        return classify_zone(s->prims[i], eff[i], z);
+    }
+};
+
+// Near a point light, where that widening is less than the rounding of a point, a ball around
+// the light of this radius joins every zone (`eps`: the widening in u and v).
+inline real tip_ball(real margin, real eps) {
+    real r = margin * (real)2.6 / eps;
+    return r > margin ? r : margin;
+}
+
+// The zone of voxel (iu, iv, k) of face F, widened by the margin (a point light's cells by
+// eps, its ball of radius r). A piece of the eye's buffer also has a near side, unless it
+// reaches the eye.
+void lightbuf_zone(const LightBuf &B, const LightFace &F, int iu, int iv, int k, real margin, real eps, real r, Zone *z) {
+    const R3 *e = F.e;
+    real u[2], v[2];
+    if (!B.point) {
+        u[0] = F.lo[0] + (real)iu * F.h[0] - margin;
+        u[1] = F.lo[0] + (real)(iu + 1) * F.h[0] + margin;
+        v[0] = F.lo[1] + (real)iv * F.h[1] - margin;
+        v[1] = F.lo[1] + (real)(iv + 1) * F.h[1] + margin;
+        real w[2] = {F.lo[2] + (real)k * F.h[2] - margin, B.top + margin};
+        z->np = 6;
+        for (int l = 0; l < 3; l++) {
+            real lo = l == 0 ? u[0] : l == 1 ? v[0] : w[0], hi = l == 0 ? u[1] : l == 1 ? v[1] : w[1];
+            z->n[2 * l] = e[l];
+            z->d[2 * l] = hi;
+            z->n[2 * l + 1] = e[l] * (real)-1;
+            z->d[2 * l + 1] = -lo;
+        }
+        z->nv = 8;
+        for (int i = 0; i < 8; i++) z->v[i] = e[0] * u[i & 1] + e[1] * v[i >> 1 & 1] + e[2] * w[i >> 2];
+        z->c = r3(0, 0, 0);
+        z->r = 0;
+        zone_hull(z);
+        return;
+    }
+    u[0] = F.lo[0] + (real)iu * F.h[0] - eps;
+    u[1] = F.lo[0] + (real)(iu + 1) * F.h[0] + eps;
+    v[0] = F.lo[1] + (real)iv * F.h[1] - eps;
+    v[1] = F.lo[1] + (real)(iv + 1) * F.h[1] + eps;
+    real far = F.lo[2] + (real)(k + 1) * F.h[2] + margin;
+    z->np = 5;
+    z->n[0] = unit(e[2] * u[0] - e[0]);
+    z->n[1] = unit(e[0] - e[2] * u[1]);
+    z->n[2] = unit(e[2] * v[0] - e[1]);
+    z->n[3] = unit(e[1] - e[2] * v[1]);
+    z->n[4] = e[2];
+    for (int i = 0; i < 4; i++) z->d[i] = dot(z->n[i], B.o);
+    z->d[4] = dot(e[2], B.o) + far;
+    z->nv = 5;
+    z->v[0] = B.o;
+    for (int i = 0; i < 4; i++) z->v[1 + i] = B.o + (e[2] + e[0] * u[i & 1] + e[1] * v[i >> 1]) * far;
+    z->c = B.o;
+    z->r = r;
+    real near = F.lo[2] + (real)k * F.h[2] - margin;
+    if (!B.pieces || !(near > 0)) {
+        zone_hull(z);
+        return;
+    }
+    z->np = 6;
+    z->n[5] = e[2] * (real)-1;
+    z->d[5] = -(dot(e[2], B.o) + near);
+    z->nv = 8;
+    for (int i = 0; i < 4; i++) {
+        R3 edge = e[2] + e[0] * u[i & 1] + e[1] * v[i >> 1];
+        z->v[i] = B.o + edge * near;
+        z->v[4 + i] = B.o + edge * far;
+    }
+    z->r = 0;
+    zone_hull(z);
+}
+
+// The depths w between which zone k of face F lies, widened by the margin: its slab's for a
+// piece of the eye's buffer; from a point light to the slab's far side; from the slab to the
+// buffer's end (past the grid) for a directional light.
+inline void zone_depths(const LightBuf &B, const LightFace &F, int k, real margin, real *w0, real *w1) {
+    *w0 = B.point && !B.pieces ? -REAL_BIG : F.lo[2] + (real)k * F.h[2] - margin;
+    *w1 = !B.point ? REAL_BIG : F.lo[2] + (real)(k + 1) * F.h[2] + margin;
+}
+
+// The box in the face's coordinates (u, v, w), projected for a point light: *lo, *hi over its
+// corners. Returns whether a corner is not in front of a point light's face.
+bool face_extent(const LightBuf &B, const LightFace &F, const Box &bx, real *lo, real *hi) {
+    bool behind = false;
+    for (int l = 0; l < 3; l++) lo[l] = REAL_BIG, hi[l] = -REAL_BIG;
+    for (int k = 0; k < 8; k++) {
+        R3 x = r3(k & 1 ? bx.hi[0] : bx.lo[0], k & 2 ? bx.hi[1] : bx.lo[1], k & 4 ? bx.hi[2] : bx.lo[2]) - B.o;
+        real g[3] = {dot(x, F.e[0]), dot(x, F.e[1]), dot(x, F.e[2])};
+        if (B.point) {
+            behind = behind || !(g[2] > 0);
+            if (g[2] > 0) g[0] /= g[2], g[1] /= g[2];
+        }
+        for (int l = 0; l < 3; l++) {
+            lo[l] = g[l] < lo[l] ? g[l] : lo[l];
+            hi[l] = g[l] > hi[l] ? g[l] : hi[l];
+        }
+    }
+    return behind;
+}
+
+// A voxel whose zone meets more primitives than this is left to the grid, which stops at the
+// first blocker instead of testing everything between the point and the light. A piece of the
+// eye's buffer may meet half as many: a primary ray evaluates several (beyond that the Room's
+// primary rays made a fifth more intersection tests than through the grid).
+const int LB_MAX_CAND = 64;
+
+// The eye's buffer as runs (LightBuf::runs): the slabs of a cell with the same list, one after
+// the other, become one run, which a primary ray crosses in one step. Its voxels' lists are not
+// kept. A buffer without a cell to give is dropped.
+bool eye_runs(pray_ctx *c, LightBuf &B, int cells) {
+    Array<int> r;
+    r.init();
+    bool ok = r.reserve(c, cells + 1), any = false;
+    r.n = cells + 1;
+    for (int fi = 0; ok && fi < B.faces; fi++) {
+        const LightFace &F = B.f[fi];
+        int stride = F.n[0] * F.n[1];
+        for (int cel = 0; ok && F.n[2] > 0 && cel < stride; cel++) {
+            const int *col = B.list + F.base + cel;
+            int first = r[F.cbase + cel] = r.n;
+            any = any || col[0] >= 0;
+            for (int k = 0; ok && k < F.n[2]; k++) {
+                if (r.n > first && r[r.n - 2] == col[k * stride]) r[r.n - 1] = k + 1;
+                else ok = r.push(c, col[k * stride]) && r.push(c, k + 1);
+            }
+        }
+    }
+    if (ok) r[cells] = r.n;
+    mem_free(c, B.list);
+    B.list = NULL;
+    B.runs = r.p;
+    B.nruns = r.n;
+    if (!any) B.faces = 0;
+    return ok;
+}
+
+// A buffer is built when the image has at least this many pixels (samples) per voxel of it: a
+// voxel costs about as much to build as a few rays save. On the Fractal at 256 x 256 the light
+// buffers (49 300 voxels for 65 536 pixels) made the picture 40 % slower; at 512 x 512 they
+// were even, and at 1024 x 1024 they save a fifth.
+const int RAYS_PER_VOXEL = 8;
+
+// Face fi of a point light's cube of directions: e[2] along axis fi / 2, away from the light
+// (towards -1 for odd fi), e[0] and e[1] the next two axes.
+void point_face(int fi, LightFace *F) {
+    int ax = fi / 2;
+    real sg = fi & 1 ? (real)-1 : (real)1;
+    R3 unitv[3] = {r3(1, 0, 0), r3(0, 1, 0), r3(0, 0, 1)};
+    F->e[2] = unitv[ax] * sg;
+    F->e[0] = unitv[(ax + 1) % 3];
+    F->e[1] = unitv[(ax + 2) % 3];
+}
+
+// The cells of a face that each primitive's footprint covers (per primitive u0, u1, v0, v1), for
+// bucket.
+struct Footprint {
+    const int *foot;
+    explicit Footprint(const int *foot_) : foot(foot_) {}
+    bool operator()(int k, int *i, int *lo, int *hi) const {
+        const int *ft = foot + 4 * k;
+        *i = k;
+        lo[0] = ft[0], hi[0] = ft[1], lo[1] = ft[2], hi[1] = ft[3], lo[2] = hi[2] = 0;
+        return lo[0] <= hi[0] && lo[1] <= hi[1];
+    }
+};
+
+// Each primitive's cells on face F (foot: the first and last along u, then v; none when first >
+// last) and its depths from the light (key: nearest and farthest), which decide its slabs. A
+// point light's primitives within r of it, and unbounded ones, reach every cell and depth; wid
+// widens the footprints (a point light's: eps, else the margin).
+void face_footprints(const LightBuf &B, const LightFace &F, const Box *eff, int np, real r, real wid, real *key,
+                     int *foot) {
+    for (int i = 0; i < np; i++) {
+        const Box &bx = eff[i];
+        int *ft = foot + 4 * i;
+        ft[0] = 0, ft[1] = F.n[0] - 1, ft[2] = 0, ft[3] = F.n[1] - 1;
+        key[2 * i] = -REAL_BIG;
+        key[2 * i + 1] = REAL_BIG;
+        if (box_empty(bx)) {
+            ft[0] = 1, ft[1] = 0;
+            continue;
+        }
+        if (!box_finite(bx)) continue;
+        if (B.point && box_dist2(bx, B.o) <= r * r) continue;
+        real lo[3], hi[3];
+        bool behind = face_extent(B, F, bx, lo, hi);
+        if (B.point && !(hi[2] > 0)) {  // behind the face: no zone reaches it
+            ft[0] = 1, ft[1] = 0;
+            continue;
+        }
+        key[2 * i + 1] = hi[2];
+        if (B.point && behind) continue;
+        key[2 * i] = lo[2];
+        for (int l = 0; l < 2; l++) {
+            double g0 = ((double)(lo[l] - wid) - (double)F.lo[l]) / (double)F.h[l];
+            double g1 = ((double)(hi[l] + wid) - (double)F.lo[l]) / (double)F.h[l];
+            ft[2 * l] = g0 < 0 ? 0 : g0 >= F.n[l] ? F.n[l] : (int)g0;
+            ft[2 * l + 1] = g1 < 0 ? -1 : g1 >= F.n[l] ? F.n[l] - 1 : (int)g1;
+        }
+    }
+}
+
+// Face F (number fi) of buffer B: its axes (across a directional light, towards it: `toward`),
+// the part of the grid's box it sees, and its cells and slabs of about `cell`; false when the box
+// is behind it.
+bool face_layout(LightBuf &B, LightFace &F, int fi, R3 toward, const Grid &g, real cell, real margin) {
+    if (!B.point) {
+        F.e[2] = toward;
+        real ax = (real)fabs((double)toward.x), ay = (real)fabs((double)toward.y), az = (real)fabs((double)toward.z);
+        R3 least = ax <= ay && ax <= az ? r3(1, 0, 0) : ay <= az ? r3(0, 1, 0) : r3(0, 0, 1);
+        F.e[0] = unit(cross(F.e[2], least));
+        F.e[1] = cross(F.e[2], F.e[0]);
+    } else point_face(fi, &F);
+    // the grid's box in the face's coordinates
+    Box grid;
+    for (int l = 0; l < 3; l++) grid.lo[l] = g.org[l], grid.hi[l] = g.top[l];
+    real lo[3], hi[3];
+    bool behind = face_extent(B, F, grid, lo, hi);
+    if (B.point) {
+        if (!(hi[2] > 0)) return false;  // the box is behind the face
+        if (behind) lo[0] = lo[1] = -1, hi[0] = hi[1] = 1, lo[2] = 0;
+        if (B.pieces) {  // the pieces hold the box whatever the rounding of a ray's depth
+            lo[2] = lo[2] - margin > 0 ? lo[2] - margin : 0;
+            hi[2] += margin;
+        }
+        for (int l = 0; l < 2; l++) {
+            lo[l] = lo[l] < -1 ? -1 : lo[l];
+            hi[l] = hi[l] > 1 ? 1 : hi[l];
+        }
+        real mid = (lo[2] + hi[2]) / 2;
+        F.h[0] = F.h[1] = cell / mid;
+        F.h[2] = cell;
+    } else {
+        for (int l = 0; l < 3; l++) lo[l] -= margin, hi[l] += margin;
+        F.h[0] = F.h[1] = F.h[2] = cell;
+        B.top = hi[2];
+    }
+    for (int l = 0; l < 3; l++) {
+        double n = ceil((double)(hi[l] - lo[l]) / (double)F.h[l]);
+        F.n[l] = n < 1 ? 1 : n > 256 ? 256 : (int)n;
+        F.h[l] = (hi[l] - lo[l]) / (real)F.n[l];
+        if (!(F.h[l] > 0)) F.h[l] = cell;
+        F.inv[l] = (real)1 / F.h[l];
+        F.lo[l] = lo[l];
+    }
+    return true;
+}
+
+// Build the light buffers: cells and slabs about `cell` wide where the grid's box is, and lists
+// for the space between each voxel and its light. `eff`: where
+// bounds place each primitive; `margin`: how far rounding may move a point (the grid's).
+// `lights`, `eye`: which buffers to build; `rays`: the primary rays of the image.
+bool lightbuf_build(ListBuilder &b, const Box *eff, real cell, real margin, bool lights, bool eye, double rays) {
+    pray_ctx *c = b.c;
+    const Scene *s = b.s;
+    Accel *a = b.a;
+    int nl = s->lights.n, np = s->prims.n;
+    a->lbuf = (LightBuf *)mem_zalloc(c, sizeof(LightBuf) * (size_t)(nl + 1));
+    if (!a->lbuf) return false;
+    a->nlbuf = nl;
+    Array<int> start, cand, seen;
+    Array<unsigned char> seen_cls;
+    Array<real> key;
+    Array<int> foot;  // per primitive: u0, u1, v0, v1 (u0 > u1: not on this face)
+    start.init();
+    cand.init();
+    seen.init();
+    seen_cls.init();
+    key.init();
+    foot.init();
+    bool ok = key.reserve(c, 2 * np + 2) && foot.reserve(c, 4 * np + 4);
+    for (int li = 0; ok && li <= nl; li++) {
+        LightBuf &B = a->lbuf[li];
+        if (li == nl ? !eye : !lights) continue;
+        B.pieces = li == nl;
+        B.point = B.pieces || s->lights[li].point;
+        B.faces = B.point ? 6 : 1;
+        B.o = B.pieces ? s->eye : B.point ? s->lights[li].v : r3(0, 0, 0);
+        long total = 0, cells = 0;
+        real eps = 0, r = 0;
+        for (int fi = 0; fi < B.faces; fi++) {
+            LightFace &F = B.f[fi];
+            if (!face_layout(B, F, fi, B.point ? r3(0, 0, 0) : s->lights[li].v, a->g, cell, margin)) continue;
+            F.base = (int)total;
+            total += (long)F.n[0] * F.n[1] * F.n[2];
+            F.cbase = (int)cells;
+            cells += (long)F.n[0] * F.n[1];
+        }
+        // (a point light's cells are widened by CELL_SLACK; near the light, where that is less
+        // than the margin, the ball takes over)
+        if ((double)total * RAYS_PER_VOXEL > rays) {  // a small image: not worth it
+            B.faces = 0;
+            continue;
+        }
+        if (B.point) {
+            eps = REAL_BIG;
+            for (int fi = 0; fi < 6; fi++)
+                if (B.f[fi].n[2] > 0 && B.f[fi].h[0] * CELL_SLACK < eps) eps = B.f[fi].h[0] * CELL_SLACK;
+            r = tip_ball(margin, eps);
+        }
+        B.list = (int *)mem_alloc(c, sizeof(int) * (size_t)(total + 1));
+        ok = B.list != NULL;
+        for (int fi = 0; ok && fi < B.faces; fi++) {
+            LightFace &F = B.f[fi];
+            if (F.n[2] == 0) continue;
+            // each primitive's cells (its footprint) and its depths, which decide its slabs
+            key.n = 2 * np;
+            foot.n = 4 * np;
+            face_footprints(B, F, eff, np, r, B.point ? eps : margin, key.p, foot.p);
+            // candidates per cell
+            int ncell = F.n[0] * F.n[1], dim[3] = {F.n[0], F.n[1], 1};
+            ok = bucket(c, dim, np, Footprint(foot.p), cand, start);
+            if (!ok) break;
+            // a face whose cells meet many primitives on average is left to the grid (and
+            // costs no time to build)
+            // (the eye's pieces are each only a slab deep)
+            bool crowded = !B.pieces && start[ncell] > (double)ncell * LB_MAX_CAND / 2;
+            for (int cel = 0; ok && cel < ncell; cel++) {
+                if (over_time(c)) {
+                    fail_cancelled(c);
+                    ok = false;
+                    break;
+                }
+                int *col = B.list + F.base + cel, stride = F.n[0] * F.n[1];  // the cell's voxels
+                bool whole = true;  // first the zones that meet few enough primitives: -2
+                int most = B.pieces ? LB_MAX_CAND / 2 : LB_MAX_CAND;
+                for (int k = 0; k < F.n[2] && (whole || !B.pieces); k++) {
+                    real w0, w1;
+                    zone_depths(B, F, k, margin, &w0, &w1);
+                    int many = 0;  // (counted only up to the limit)
+                    for (int j = start[cel]; !crowded && many <= most && j < start[cel + 1]; j++)
+                        many += key[2 * cand[j]] <= w1 && key[2 * cand[j] + 1] >= w0;
+                    col[k * stride] = crowded || many > most ? -1 : -2;
+                    whole = whole && col[k * stride] == -2;
+                }
+                if (B.pieces && !whole) {  // a primary ray walks all of its cell's pieces, or the grid
+                    for (int k = 0; k < F.n[2]; k++) col[k * stride] = -1;
+                    continue;
+                }
+                for (int k = 0, last = -1; ok && k < F.n[2]; k++) {
+                    int &out = col[k * stride];
+                    if (out == -1) continue;
+                    real w0, w1;
+                    zone_depths(B, F, k, margin, &w0, &w1);
+                    ZoneClass in;
+                    in.s = s;
+                    in.eff = eff;
+                    in.key = key.p;
+                    in.w0 = w0;
+                    in.w1 = w1;
+                    lightbuf_zone(B, F, cel % F.n[0], cel / F.n[0], k, margin, eps, r, &in.z);
+                    ok = lb_region(b, cand.p + start[cel], start[cel + 1] - start[cel], in);
+                    const Array<int> &prims = b.rprims;
+                    const Array<unsigned char> &cls = b.rcls;
+                    // the next slab's zone often meets the same: then it has the same list
+                    // (no memcmp/memcpy of an empty list: its pointer may still be null)
+                    if (last >= 0 && prims.n == seen.n &&
+                        (prims.n == 0 || (memcmp(prims.p, seen.p, sizeof(int) * (size_t)prims.n) == 0 &&
+                                          memcmp(cls.p, seen_cls.p, (size_t)cls.n) == 0))) {
+                        out = last;
+                        continue;
+                    }
+                    out = ok ? lb_list(b, prims.p, cls.p, prims.n) : -1;
+                    ok = out >= 0 && seen.reserve(c, prims.n + 1) && seen_cls.reserve(c, prims.n + 1);
+                    if (!ok) break;
+                    seen.n = seen_cls.n = prims.n;
+                    if (prims.n) {
+                        memcpy(seen.p, prims.p, sizeof(int) * (size_t)prims.n);
+                        memcpy(seen_cls.p, cls.p, (size_t)cls.n);
+                    }
+                    last = out;
+                }
+            }
+        }
+        if (ok && B.pieces) ok = eye_runs(c, B, (int)cells);
+    }
+    start.release(c);
+    cand.release(c);
+    seen.release(c);
+    seen_cls.release(c);
+    key.release(c);
+    foot.release(c);
+    return ok;
+}
+#endif  // PRAY_NO_BUFFERS
+
+// ---- [9b.5] Building: the whole structure ----
 // The measure of a box that sizes a grid (auto_grid): the cube of its longest side times its
 // fill, each side counted at least 1/16 of the longest.
 double grid_measure(const Box &bx) {
@@ -4929,14 +5501,40 @@ pray_status accel_plans(pray_ctx *c, const Scene *s, Accel *a) {
     return st;
 }
 
-// What the structure holds, into its memory and the statistics.
-void accel_account(pray_ctx *c, Accel *a) {
+// What the structure holds, into its memory and the statistics; once it is `built`, a light
+// buffer without a list to give is dropped (it costs nothing), and a voxel whose list is not
+// plain is left to the grid.
+void accel_account(pray_ctx *c, Accel *a, bool built) {
+    long lbv = 0, ebv = 0, eruns = 0;  // the light buffers' voxels, the eye's, its runs' numbers
+    for (int i = 0; built && a->lbuf && i <= a->nlbuf; i++) {
+        LightBuf &B = a->lbuf[i];
+        long nv = 0;
+        for (int f = 0; f < B.faces; f++) nv += (long)B.f[f].n[0] * B.f[f].n[1] * B.f[f].n[2];
+        (B.pieces ? ebv : lbv) += nv;
+        if (B.pieces) {
+            eruns += B.nruns;
+            continue;
+        }
+        bool any = false;  // a buffer without a list to give is dropped, and costs nothing
+        for (long v = 0; v < nv; v++) {
+            // a list answers a shadow ray in one evaluation when it is plain; else walking
+            // the grid, which stops at the first blocker, is cheaper
+            if (B.list[v] > 0 && !list_plain(a, B.list[v])) B.list[v] = -1;
+            any = any || B.list[v] >= 0;
+        }
+        if (!any) B.faces = 0;
+    }
+    a->eye = a->lbuf && a->lbuf[a->nlbuf].faces ? &a->lbuf[a->nlbuf] : NULL;
     long nv = (long)a->g.n[0] * a->g.n[1] * a->g.n[2];
     long nested = 0;
     for (int i = 0; i < a->nested.n; i++) nested += (long)a->nested[i].n[0] * a->nested[i].n[1] * a->nested[i].n[2];
     a->memory = (double)sizeof(Accel) + (double)(nv + nested) * (sizeof(int) + 1) +
                 (double)a->nested.cap * sizeof(Grid) + (double)a->data.cap * sizeof(int) +
-                (double)a->off.cap * sizeof(int) + (double)(a->plan_at.cap + a->plan.cap) * sizeof(int);
+                (double)a->off.cap * sizeof(int) + (double)(a->plan_at.cap + a->plan.cap) * sizeof(int) +
+                (double)(a->lbuf ? a->nlbuf + 1 : 0) * sizeof(LightBuf) +
+                (double)(lbv + eruns) * sizeof(int);
+    c->stats.lightbuf_voxels = lbv;
+    c->stats.eyebuf_voxels = ebv;
     c->stats.grid[0] = a->g.n[0];
     c->stats.grid[1] = a->g.n[1];
     c->stats.grid[2] = a->g.n[2];
@@ -4986,7 +5584,7 @@ pray_status grid_box(pray_ctx *c, const Scene *s, bool bounds, Array<int> &stk, 
 
 // Build the acceleration structure: the lists of the grid's voxels and of the space around it,
 // and the buffers of the lights and, for a render (`render`), of the eye.
-pray_status accel_build(pray_ctx *c, Scene *s) {
+pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     Accel *a = (Accel *)mem_zalloc(c, sizeof(Accel));
     if (!a) return c->status;
     s->accel = a;
@@ -5023,7 +5621,7 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
         double f = (double)(region.hi[l] - region.lo[l]) / ext;
         fill *= f > 1.0 / 16 ? f : 1.0 / 16;
     }
-    // the image's primary rays (samples): they size the grid
+    // the image's primary rays (samples): they size the grid and decide the buffers
     double aa = opt_int(c, OPT_ANTIALIAS), rays = (double)opt_int(c, OPT_WIDTH) * opt_int(c, OPT_HEIGHT) * aa * aa;
     int want = opt_int(c, OPT_GRID);
     if (want < 0) want = auto_grid(bounded, rays, fill);
@@ -5117,16 +5715,24 @@ pray_status accel_build(pray_ctx *c, Scene *s) {
         a->outer = st == PRAY_OK && lb_region(b, cand.p, cand.n, out) ? lb_list(b, b.rprims.p, b.rcls.p, b.rprims.n) : -1;
         if (a->outer < 0) st = c->status;
     }
+#ifndef PRAY_NO_BUFFERS
+    bool lights = opt_int(c, OPT_SHADOWS) && opt_int(c, OPT_LIGHTBUFFER) && s->lights.n > 0;
+    bool eye = render && opt_int(c, OPT_EYEBUFFER) && !s->parallel;
+    if (st == PRAY_OK && a->g.n[0] > 0 && (lights || eye) && !lightbuf_build(b, eff, a->g.h, (real)margin, lights, eye, rays))
+        st = c->status;
+#else
+    (void)render;
+#endif
     cand.release(c);
     start.release(c);
     mem_free(c, eff);
     lb_release(b);
     if (st == PRAY_OK) st = accel_plans(c, s, a);
-    accel_account(c, a);
+    accel_account(c, a, st == PRAY_OK);
     return st;
 }
 
-// ---- [9b.5] Per ray: list evaluation with freezing (the one list evaluator) ----
+// ---- [9b.6] Per ray: list evaluation with freezing (the one list evaluator) ----
 // The primitive's interval along the current ray, computed at most once per ray.
 inline const Span &span_get(const Scene *s, Scratch *w, const Ray &ray, int p, int self) {
     Span &sp = w->span[p];
@@ -5512,7 +6118,7 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
     return eval_flat(s, A, w, ray, list_prims(d), d[1], plan, a, b, tmax, self, visit);
 }
 
-// ---- [9b.6] Per ray: the grid walk (the stretch source) ----
+// ---- [9b.7] Per ray: stretch sources (grid walk, light buffer voxel, eye buffer cell) ----
 // Where the ray meets the box: [*t0, *t1]; false when it misses. `inv` holds the reciprocals
 // of the direction's components, 0 for a ray parallel to that axis.
 bool ray_box(const Ray &r, const real *inv, const real *lo, const real *hi, real *t0, real *t1) {
@@ -5726,7 +6332,81 @@ bool GridSource::walk(Out &out, real t, real tend) const {
     return false;
 }
 
-// ---- [9b.7] Per ray: the ray driver, the shadow cache, the entry points ----
+// The list for a shadow ray from x towards the buffer's light, and the part (*ta, *tb] of the
+// ray in that list's zone; before and after it the ray is outside the grid's box, where the
+// outer list holds. `outer` alone when the ray misses the grid's box; -1 when x is in no voxel's
+// reach (then the grid is walked).
+inline int lightbuf_find(const LightBuf &B, int outer, R3 x, real tmax, real *ta, real *tb) {
+    if (B.faces == 0) return -1;
+    R3 m = x - B.o;
+    const LightFace &F = B.f[B.point ? cube_face(m) : 0];
+    real g[3] = {dot(m, F.e[0]), dot(m, F.e[1]), dot(m, F.e[2])};
+    *ta = 0;
+    *tb = tmax;
+    if (B.point) {
+        if (!(g[2] > 0)) return -1;  // at the light, or not a number
+        if (F.n[2] == 0) return outer;
+        real k = (real)1 / g[2];
+        g[0] *= k;
+        g[1] *= k;
+    }
+    // (a point light's zones are widened: CELL_SLACK)
+    int cell, in = face_cell(F, g[0], g[1], B.point ? CELL_SLACK : 0, &cell);
+    if (in <= 0) return in < 0 ? -1 : outer;  // not a number; beside the grid's box
+    real k = (g[2] - F.lo[2]) * F.inv[2];
+    if (k != k) return -1;
+    int slab;
+    if (!B.point) {  // w grows towards the light
+        if (!(k < (real)F.n[2])) return outer;  // past the box already
+        *tb = B.top - g[2];
+        slab = k < 0 ? 0 : (int)k;
+        if (k < 0) *ta = F.lo[2] - g[2];  // below the box: reaches it there
+    } else {         // w shrinks towards the light
+        if (k < 0) return outer;  // between the light and the box
+        slab = k < (real)F.n[2] ? (int)k : F.n[2] - 1;
+        if (!(k < (real)F.n[2])) *ta = tmax * ((real)1 - (F.lo[2] + (real)F.n[2] * F.h[2]) / g[2]);  // beyond it
+    }
+    return B.list[F.base + slab * F.n[1] * F.n[0] + cell];
+}
+
+// A light buffer's voxel (lightbuf_find): one list for the whole part of a shadow ray in the
+// voxel's zone, found before the ray starts.
+struct ZoneSource {
+    int L;
+    real ta, tb;
+    bool span(real *a, real *b) const {
+        *a = ta;
+        *b = tb;
+        return true;
+    }
+    template <class Out>
+    bool walk(Out &out, real a, real b) const { return out(L, a, b); }
+};
+
+// A cell of the eye's buffer: a primary ray stays in the cell and crosses its runs, slab by slab
+// outwards; all of the grid's box lies between the first slab and the last.
+struct EyeSource {
+    const LightFace *F;
+    const int *run, *end;  // the cell's runs
+    real inv;              // 1 / the ray's depth per unit of t
+    bool span(real *a, real *b) const {
+        *a = F->lo[2] * inv;
+        *b = (F->lo[2] + (real)end[-1] * F->h[2]) * inv;
+        return true;
+    }
+    template <class Out>
+    bool walk(Out &out, real t, real tb) const {
+        for (const int *r = run; r < end && t < tb; r += 2) {
+            real next = r + 2 < end ? (F->lo[2] + (real)r[1] * F->h[2]) * inv : tb;
+            next = next < tb ? next : tb;
+            if (out(r[0], t, next)) return true;
+            t = next;
+        }
+        return false;
+    }
+};
+
+// ---- [9b.8] Per ray: the ray driver, the shadow cache, the entry points ----
 // A new ray: a new stamp for what is kept per ray (3.5: no explicit unfreezing).
 void ray_begin(const Scene *s, Scratch *w) {
     w->ray++;
@@ -5921,7 +6601,7 @@ bool blocker_of(const Accel *A, R3 p, Blocker *bk) {
 }
 
 // The hits along a shadow ray towards light `light`: the shadow cache's answer when it has one;
-// else as any other ray.
+// else through the light buffer's voxel when the ray starts in one; else as any other ray.
 void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int light, ShadowHit &visit) {
     const Accel *A = s->accel;
     if (!A || A->g.n[0] == 0) {
@@ -5930,19 +6610,58 @@ void shadow_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self
     }
     Blocker *bk = w->blocker + light;
     if (A->cache && bk->list >= 0 && shadow_probe(s, w, ray, tmax, self, light, visit)) return;
-    find_hits(s, w, ray, tmax, self, visit);
+    ZoneSource zone;
+    zone.L = A->lbuf ? lightbuf_find(A->lbuf[light], A->outer, ray.o, tmax, &zone.ta, &zone.tb) : -1;
+    if (zone.L >= 0) {  // (the outer list alone when the ray misses the grid's box)
+        w->k.lbuf += 1;
+        drive(s, w, ray, tmax, self, visit, &zone);
+    } else find_hits(s, w, ray, tmax, self, visit);
     if (A->cache && !(czero(visit.f) && blocker_of(A, ray.o + ray.d * visit.t, bk))) bk->list = -1;
 }
 
-// A ray of a scene where materials meet (Scene::iface), instead of find_hits: the lists while
-// the ray is outside the solid, then the reference sweep (Outside).
+// The hits along a primary ray, which starts at the eye: through the cell of the eye's buffer
+// that holds its direction, when the eye has a buffer and the cell has runs; else as any other
+// ray.
+template <class Visit>
+void primary_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, Visit &visit) {
+    const Accel *A = s->accel;
+    const LightBuf *B = A ? A->eye : NULL;
+    const LightFace *F = B ? &B->f[cube_face(ray.d)] : NULL;
+    real g2 = F ? dot(ray.d, F->e[2]) : 0;
+    if (!F || !(g2 > 0) || ray.o.x != B->o.x || ray.o.y != B->o.y || ray.o.z != B->o.z) {
+        find_hits(s, w, ray, tmax, -1, visit);
+        return;
+    }
+    EyeSource eye;
+    eye.F = F;
+    eye.run = eye.end = NULL;  // no runs: the ray misses the grid's box
+    eye.inv = (real)1 / g2;
+    if (F->n[2] > 0) {
+        int cell, in = face_cell(*F, dot(ray.d, F->e[0]) / g2, dot(ray.d, F->e[1]) / g2, CELL_SLACK, &cell);
+        if (in > 0) {
+            eye.run = B->runs + B->runs[F->cbase + cell];
+            eye.end = B->runs + B->runs[F->cbase + cell + 1];
+        }
+        if (in < 0 || (eye.run && eye.run[0] < 0)) {
+            find_hits(s, w, ray, tmax, -1, visit);
+            return;
+        }
+    }
+    w->k.ebuf += 1;
+    drive(s, w, ray, tmax, -1, visit, eye.run ? &eye : NULL);
+}
+
+// A ray of a scene where materials meet (Scene::iface), instead of find_hits or primary_hits
+// (`primary`): the lists while the ray is outside the solid, then the reference sweep (Outside).
 // `inside`: whether the ray starts inside the solid (1), outside (0), or unknown (-1).
 template <class Visit>
-PRAY_NOINLINE void across(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, int inside) {
+PRAY_NOINLINE void across(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, int inside,
+                          bool primary) {
     real done = -REAL_INF;
     if (s->accel && inside != 1) {
         Outside<Visit> o(visit);
-        find_hits(s, w, ray, tmax, self, o);
+        if (primary) primary_hits(s, w, ray, tmax, o);
+        else find_hits(s, w, ray, tmax, self, o);
         if (!o.inside && (o.hits || inside == 0 || !starts_inside(s, w, ray))) return;
         done = o.done;
     }
@@ -7239,7 +7958,8 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
     // where materials meet, a ray that starts inside the solid is traced across them (a first hit
     // from outside is where the solid is entered, as before)
     if (kind == RAY_PRIMARY) inside = tr.eye_in;
-    if (s->iface && inside) across(s, tr.w, ray, REAL_INF, self, fh, inside);
+    if (s->iface && inside) across(s, tr.w, ray, REAL_INF, self, fh, inside, kind == RAY_PRIMARY);
+    else if (kind == RAY_PRIMARY) primary_hits(s, tr.w, ray, REAL_INF, fh);
     else find_hits(s, tr.w, ray, REAL_INF, self, fh);
     if (!fh.found) return tr.bg;
     const Hit &h = fh.h;
@@ -7405,8 +8125,8 @@ void scene_camera(const pray_ctx *c, Scene *s) {
 }
 
 // The scene as the renderer sees it: primitives, nodes, lights, camera and the acceleration
-// structure.
-pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *lights) {
+// structure; `render`: for rendering with the camera (not for ray queries).
+pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *lights, bool render) {
     memset(s, 0, sizeof *s);
     s->prims.init();
     s->maps.init();
@@ -7444,7 +8164,7 @@ pray_status scene_build(pray_ctx *c, Scene *s, pray_object *root, pray_light *li
     }
     scene_camera(c, s);
     mem_phase(c, MEM_PREPARE);
-    if (!opt_int(c, OPT_BRUTE) && accel_build(c, s)) return c->status;
+    if (!opt_int(c, OPT_BRUTE) && accel_build(c, s, render)) return c->status;  // (the eye's buffer: after the camera)
     mem_phase(c, MEM_ACCEL);
     s->depth = opt_int(c, OPT_DEPTH);
     s->shadows = opt_int(c, OPT_SHADOWS);
@@ -7641,7 +8361,7 @@ void first_hit(Worker &k, Ray ray, pray_hit *h, pray_rgb *albedo) {
     ray.d = unit(ray.d);
     FirstHit fh;
     fh.found = false;
-    if (k.job->s->iface) across(k.job->s, &k.w, ray, REAL_INF, -1, fh, -1);
+    if (k.job->s->iface) across(k.job->s, &k.w, ray, REAL_INF, -1, fh, -1, false);
     else find_hits(k.job->s, &k.w, ray, REAL_INF, -1, fh);
     h->primitive = h->id = -1;
     h->t = HUGE_VAL;
@@ -8074,6 +8794,8 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         c->stats.set_outside += k.set_out;
         c->stats.checks += k.checks;
         c->stats.frozen_skips += k.frozen;
+        c->stats.rays_lightbuf += k.lbuf;
+        c->stats.rays_eyebuf += k.ebuf;
         c->stats.rays_shadowcache += k.cache;
         seen |= worker_at(wbuf, stride, i).tr.seen;
         if (job.redo) {
@@ -8107,7 +8829,7 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
 // =============================================================================================
 // A program's frame with the camera, lights, image and options of the frame before takes over
 // every pixel whose rays cannot have met anything that changed. While a pixel is traced, the
-// ray driver (9b.7) notes in the pixel's record the regions of space its rays crossed
+// ray driver (9b.8) notes in the pixel's record the regions of space its rays crossed
 // (region_note, below): cells of a grid over the scene's finite parts, and bit 0 for all space
 // outside the grid's box. The next frame compares its prepared scene with the frame before's,
 // by value (coh_diff), and marks the cells that the boxes of what changed reach, in both
@@ -9039,6 +9761,9 @@ const char *pray_features(void) {
 #if PRAY_HAS_THREADS
            "threads "
 #endif
+#ifndef PRAY_NO_BUFFERS
+           "buffers "
+#endif
 #ifndef PRAY_NO_SEQUENCES
            "sequences "
 #endif
@@ -9921,14 +10646,16 @@ void prepared_drop(pray_ctx *c) {
 }
 
 // A kept scene whose setup differs from the context's in the camera alone takes the new camera:
-// nothing of its preparation depends on the camera.
+// of its preparation only the eye's buffer depends on the camera (on the eye's place and on the
+// kind of camera, not on where it looks), so it stays unless those changed.
 void recamera(pray_ctx *c, Prepared *p) {
     Setup t;
     const Setup &n = c->cur;
     memcpy(&t, &p->setup, sizeof t);
     t.parallel = n.parallel, t.cam_x = n.cam_x, t.cam_y = n.cam_y, t.cam_eye = n.cam_eye, t.cam_point = n.cam_point;
     t.lookat = n.lookat, t.cam_up = n.cam_up, t.cam_angle = n.cam_angle;
-    if (memcmp(&t, &n, sizeof t) != 0) return;
+    bool eye = p->s.accel && p->s.accel->eye && memcmp(&n.cam_eye, &p->setup.cam_eye, sizeof n.cam_eye) != 0;
+    if (memcmp(&t, &n, sizeof t) != 0 || n.parallel != p->setup.parallel || eye) return;
     scene_camera(c, &p->s);
     memcpy(&p->setup, &n, sizeof t);
 }
@@ -9949,7 +10676,7 @@ pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, cons
     }
     Scene own;
     memset(&own, 0, sizeof own);
-    pray_status st = p ? PRAY_OK : scene_build(c, &own, root, lights);
+    pray_status st = p ? PRAY_OK : scene_build(c, &own, root, lights, true);
     if (!p && st == PRAY_OK && keep) {
         p = (Prepared *)mem_alloc(c, sizeof(Prepared));
         if (!p) st = c->status;
@@ -10136,7 +10863,7 @@ static pray_scene *prepare_call(pray_ctx *c, pray_object *root, pray_light *ligh
     pray_scene *q = (pray_scene *)mem_zalloc(c, sizeof(pray_scene));
     if (!q) return NULL;
     q->render = render;
-    if (scene_build(c, &q->s, root, lights) || !scratch_init(c, &q->w, &q->s)) {
+    if (scene_build(c, &q->s, root, lights, render) || !scratch_init(c, &q->w, &q->s)) {
         pray_scene_free(c, q);
         return NULL;
     }
@@ -10227,7 +10954,7 @@ int pray_intersect(pray_ctx *c, pray_scene *q, pray_vec origin, pray_vec dir, do
     ch.max = max_hits;
     ch.n = 0;
     real t = tmax >= HUGE_VAL ? REAL_INF : (real)tmax;
-    if (q->s.iface) across(&q->s, &q->w, ch.ray, t, -1, ch, -1);
+    if (q->s.iface) across(&q->s, &q->w, ch.ray, t, -1, ch, -1, false);
     else find_hits(&q->s, &q->w, ch.ray, t, -1, ch);
     return ch.n;
 }
@@ -13785,6 +14512,8 @@ const char *const USAGE =
     "  -D freeze=0      no freezing of CSG nodes whose status can no longer change\n"
     "  -D merge=0       no areas of neighbouring voxels with the same action lists\n"
     "  -D bounds=0      no bounding boxes around the parts of the CSG tree\n"
+    "  -D lightbuffer=0 shadow rays walk the grid, not the lists around each light\n"
+    "  -D eyebuffer=0   primary rays walk the grid, not the lists around the eye\n"
     "  -D shadowcache=0 shadow rays do not first try the voxel that stopped the last one\n"
     "  -D plans=0       every action list is evaluated in full, without shortcuts\n"
     "  -D coherence=0   every frame of a sequence is traced in full\n"
@@ -13827,6 +14556,8 @@ void print_stats(pray_ctx *c) {
             "primitives: %ld declared, %ld kept; nodes %ld\n"
             "grid: %d x %d x %d = %ld voxels and %ld in %ld nested grids, %ld distinct lists, %ld areas, %.0f bytes\n"
             "rays: primary %.0f (of %.0f without undersampling), shadow %.0f, reflected %.0f, refracted %.0f\n"
+            "light buffers: %ld voxels; shadow rays from them %.0f\n"
+            "eye buffer: %ld voxels; primary rays from it %.0f\n"
             "shadow cache: shadow rays it stopped %.0f\n"
             "traversal: %.0f voxel steps, %.0f area moves\n"
             "actions: set inside %.0f, set outside %.0f, check %.0f (frozen skips %.0f)\n"
@@ -13834,7 +14565,7 @@ void print_stats(pray_ctx *c) {
             "time: parse %.3f s, prepare %.3f s, render %.3f s on %d thread%s\n"
             "memory: peak %.0f bytes; by phase: parse %.0f, run %.0f, prepare %.0f, acceleration %.0f, render %.0f\n",
             s.primitives_declared, s.primitives, s.nodes, s.grid[0], s.grid[1], s.grid[2], s.voxels, s.nested_voxels, s.nested_grids, s.lists,
-            s.areas, s.memory, s.rays_primary, s.rays_primary_full, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.rays_shadowcache, s.voxel_steps,
+            s.areas, s.memory, s.rays_primary, s.rays_primary_full, s.rays_shadow, s.rays_reflected, s.rays_refracted, s.lightbuf_voxels, s.rays_lightbuf, s.eyebuf_voxels, s.rays_eyebuf, s.rays_shadowcache, s.voxel_steps,
             s.area_moves, s.set_inside, s.set_outside, s.checks, s.frozen_skips, s.intersection_tests,
             s.time_parse, s.time_prepare, s.time_render, s.threads, s.threads == 1 ? "" : "s", s.memory_peak,
             s.memory_parse, s.memory_run, s.memory_prepare, s.memory_accel, s.memory_render);

@@ -23,6 +23,8 @@
    @@ PRAY_NO_STDIO               no file access: write images through callbacks only
    @@ PRAY_NO_PNG                 no PNG output even when <stb/stb_image_write.h> is present
    @@ PRAY_NO_THREADS             no threads (DOS, bare targets)
+   @@ PRAY_NO_BUFFERS             no light or eye buffers (options lightbuffer and eyebuffer then
+                                  change nothing); the images stay the same, byte for byte
    @@ PRAY_NO_SEQUENCES           no image-sequence coherence (option coherence then changes
                                   nothing): every frame is traced in full, to the same bytes
    @@ PRAY_NO_DEFAULT_ALLOC       no malloc-based allocator: pray_new_with must be given one
@@ -206,8 +208,8 @@ void pray_cancel(pray_ctx *ctx);
    image never needs them, and every value gives the image of brute=1, byte for byte (manual,
    section 6): brute (1 = the brute-force reference renderer, 0), grid (voxels along the longest
    side; -1 = automatic, 0 = no grid), nest (levels of nested grids, 2), and the switches of one
-   part each, 1 = on (the default) and 0 = off: freeze, merge, bounds, shadowcache, plans,
-   coherence (1: a program's frame with the camera, lights and options of
+   part each, 1 = on (the default) and 0 = off: freeze, merge, bounds, lightbuffer, eyebuffer,
+   shadowcache, plans, coherence (1: a program's frame with the camera, lights and options of
    the frame before re-traces only the pixels whose rays could have met what changed; 0: every
    pixel).
 
@@ -417,6 +419,10 @@ typedef struct pray_stats {
     double memory;                   /* bytes of the acceleration structure */
     double rays_primary, rays_shadow, rays_reflected, rays_refracted;
     double rays_primary_full;        /* primary rays without undersampling (option adaptive) */
+    long lightbuf_voxels;            /* voxels of the light buffers (option lightbuffer) */
+    double rays_lightbuf;            /* shadow rays answered by a light buffer's list */
+    long eyebuf_voxels;              /* voxels of the eye's buffer (option eyebuffer) */
+    double rays_eyebuf;              /* primary rays traced through the eye's buffer */
     double rays_shadowcache;         /* shadow rays stopped by the shadow cache (option shadowcache) */
     int threads;                     /* threads of the last render */
     double voxel_steps, area_moves;  /* traversal steps; steps inside an area (no evaluation) */
@@ -606,9 +612,12 @@ typedef struct pray_buffers {
    context keeps the scene pray_render_into and pray_render prepared (flattened, simplified, with
    its grid), and the next render of the same root and lights with the same options, camera and
    background uses it again, so that bands, tiles and passes cost what the whole image costs. It
-   holds a reference to root and lights meanwhile (releasing yours is safe). Nothing of the
-   preparation depends on the camera, so a new camera keeps it, taking the new camera.
-   Rendering another scene or lights, changing an option or the background, setting an id
+   holds a reference to root and lights meanwhile (releasing yours is safe). Of the preparation
+   only the eye's buffer depends on the camera, so a new camera of the same kind (parallel or
+   perspective) keeps it, taking the new camera, when the eye stays where it was (the camera
+   turned about its eye) or the scene has no eye's buffer (option eyebuffer 0, a parallel
+   camera, or too few samples for one: pray_stats.eyebuf_voxels 0). Rendering another scene or
+   lights, changing an option or the background, any other new camera, setting an id
    (pray_object_set_id), the start or the end of a program's run, or pray_free drops it. To
    render one scene from several threads at once, see pray_prepare_render. */
 pray_status pray_render_into(pray_ctx *ctx, pray_object *root, pray_light *lights, const pray_rect *rect,
@@ -773,10 +782,13 @@ pray_status pray_include_register(pray_ctx *ctx, const char *name, const char *t
    an n-ary CSG status tree (thesis 3.4). Option brute=1 does exactly that for every primitive:
    the reference. By default the scene is simplified, a uniform grid of voxels with per-voxel
    action lists is built (thesis 3.3-3.6: leading-axis traversal, set/check actions, freezing,
-   areas) and refined by grids nested where the scene is crowded, bounding boxes prune what
-   cannot be met, and a shadow ray first tries the voxel where the last one towards its light
-   was stopped. Options grid, nest, freeze, merge, bounds, plans and shadowcache switch the
-   parts on and off; every setting gives the
+   areas), bounding boxes prune what cannot be met, light buffers answer shadow rays from one
+   list per voxel around each light (and, in the box around a point light where its shadow
+   rays end, from one list per direction; a shadow ray passes over lists of clear surfaces
+   only), and primary rays walk the lists of the eye's buffer, a grid of
+   pyramids around a perspective camera's eye; a shadow ray first tries the voxel where the
+   last one towards its light was stopped. Options grid, freeze, merge, bounds, plans,
+   lightbuffer, eyebuffer and shadowcache switch the parts on and off; every setting gives the
    image of brute=1, byte for byte.
    docs/acceleration.md explains the methods, docs/benchmarks.md measures them.
    Secondary rays know the primitive they start on and never meet it again at their origin;

@@ -27,6 +27,7 @@ DEFS='
 -DPRAY_NO_STDIO
 -DPRAY_NO_PNG
 -DPRAY_NO_THREADS
+-DPRAY_NO_BUFFERS
 -DPRAY_NO_SEQUENCES
 -DPRAY_NO_DEFAULT_ALLOC
 -DPRAY_MAX_ALLOC=1000000
@@ -64,11 +65,11 @@ for cxx in $compilers; do
     if $cxx -std=c++98 -ffast-math -fno-fast-math -c pray.cpp -o /dev/null; then r=ok; else r=FAILED; st=1; fi
     printf '%-8s %-12s %-52s %s\n' "$cxx" "-std=c++98" "-ffast-math -fno-fast-math" "$r"
 done
-# The layer that compiles out renders the bytes of the default build: the thesis' CSG.RAY and an
+# The layers that compile out render the bytes of the default build: the thesis' CSG.RAY and an
 # image sequence (whose later frames coherence takes over in part), every frame compared.
 cxx=$(printf '%s\n' $compilers | head -n 1)
 tmp=$(mktemp -d "${TMPDIR:-/tmp}/pray-matrix.XXXXXX") || exit 2
-for d in '' -DPRAY_NO_SEQUENCES; do
+for d in '' -DPRAY_NO_BUFFERS -DPRAY_NO_SEQUENCES; do
     dir=$tmp/x$d
     mkdir -p "$dir"
     if ! $cxx -std=c++98 $OPT $d -DPRAY_MAIN pray.cpp -o "$dir/pray" -lm -lpthread; then st=1; continue; fi

@@ -5,7 +5,7 @@
 #   1. pray_tests: every test case of its files but test_accel.cpp, less the few that take
 #      seconds (SLOW);
 #   2. pray_tests: a light choice from test_accel.cpp (ACCEL): the acceleration against the
-#      reference on degenerate trees and on a floor with solids, from eyes anywhere, freezing,
+#      reference on degenerate trees and on a floor with solids, the eye's buffer, freezing,
 #      threads and the statistics;
 #   3. pray_tests_float: its test cases, the renderer in single precision (PRAY_REAL=float);
 #   4. pray_tests_nostdio: test_buffers.cpp in a build without file access (PRAY_NO_STDIO).
@@ -17,7 +17,7 @@
 dir=${1:-build/quick}
 RUN=${RUN:-}
 SLOW='reach: every voxel*,command line: SIGINT*,the N-th allocation fails*,limit maxtime*'
-ACCEL='accel hits: degenerate roots*,accel hits: an unbounded floor*,accel eyes*,accel freezing*,accel threads*,accel stats*'
+ACCEL='accel hits: degenerate roots*,accel hits: an unbounded floor*,accel eye buffer*,accel freezing*,accel threads*,accel stats*'
 
 tmp=$(mktemp "${TMPDIR:-/tmp}/pray-quick.XXXXXX") || exit 2
 trap 'rm -f "$tmp"' EXIT

@@ -7,8 +7,10 @@
 //     edges and corners, box corners, tangents, rays in faces, starting inside the grid, on box
 //     boundaries and inside solids, with tmax limits);
 //   - the same images, float for float, on example programs and on random scenes: small images
-//     for every grid x freeze x merge x bounds, and larger ones with the automatic grid for
-//     every shadowcache x freeze x merge x bounds;
+//     for every grid x freeze x merge x bounds, and images large enough that the light buffers
+//     and the eye's buffer are built for every lightbuffer x eyebuffer x shadowcache x freeze x
+//     merge x bounds (each such case checks that the buffers were built: else it would compare
+//     nothing of them);
 //   - freezing never increases the number of intersection tests;
 //   - the statistics of the grid are plausible.
 // A mismatch is a bug in the renderer: the failure message lists the first ones in full (scene
@@ -37,17 +39,18 @@ using namespace accel_scenes;
 const int GRIDS[] = {0, 1, 2, 3, 5, 8, 16, -1};
 const int NGRIDS = sizeof GRIDS / sizeof GRIDS[0];
 
-// The thesis' switches (grid, freeze, merge, bounds; brute: the reference), the shadow cache
-// and the lists' plans, each on by default.
+// The thesis' switches (grid, freeze, merge, bounds; brute: the reference) and the three
+// methods of shadow and primary rays (light buffers, the eye's buffer, the shadow cache), each
+// on by default.
 struct Opts {
     int brute, grid, freeze, merge, bounds;
-    int shadowcache = 1, plans = 1;
-    // (the last two only where they are off)
+    int lightbuffer = 1, eyebuffer = 1, shadowcache = 1, plans = 1;
+    // (the four methods only where they are off)
     std::string text() const {
         if (brute) return "brute=1";
         std::string s;
         for (auto &o : fixed())
-            if (o != "brute=0" && o != "shadowcache=1" && o != "plans=1")
+            if (o != "brute=0" && o != "lightbuffer=1" && o != "eyebuffer=1" && o != "shadowcache=1" && o != "plans=1")
                 s += (s.empty() ? "" : " ") + o;
         return s;
     }
@@ -59,6 +62,8 @@ struct Opts {
         v.push_back("freeze=" + std::to_string(freeze));
         v.push_back("merge=" + std::to_string(merge));
         v.push_back("bounds=" + std::to_string(bounds));
+        v.push_back("lightbuffer=" + std::to_string(lightbuffer));
+        v.push_back("eyebuffer=" + std::to_string(eyebuffer));
         v.push_back("shadowcache=" + std::to_string(shadowcache));
         v.push_back("plans=" + std::to_string(plans));
         return v;
@@ -75,7 +80,7 @@ std::vector<Opts> all_combinations() {
         for (int f = 0; f < 2; f++) {
             for (int m = 0; m < 2; m++)
                 for (int b = 0; b < 2; b++) v.push_back(Opts{0, GRIDS[g], f, m, b});
-            v.push_back(Opts{0, GRIDS[g], f, 1, 1, 1, 0});
+            v.push_back(Opts{0, GRIDS[g], f, 1, 1, 1, 1, 1, 0});
         }
     return v;
 }
@@ -104,23 +109,26 @@ struct FreezeTally {
     }
 };
 
-// shadowcache x freeze x merge, and x bounds or with bounds=1, at one grid; the first is the
-// defaults (all on)
-std::vector<Opts> switch_combinations(int grid, bool with_bounds) {
+// lightbuffer x eyebuffer x shadowcache x freeze x merge, and x bounds or with bounds=1, at one
+// grid; the first is the defaults (all on)
+std::vector<Opts> buffer_combinations(int grid, bool with_bounds) {
     std::vector<Opts> v;
-    for (int sc : {1, 0})
-        for (int f : {1, 0})
-            for (int m : {1, 0})
-                for (int b : {1, 0})
-                    if (b || with_bounds) v.push_back(Opts{0, grid, f, m, b, sc});
+    for (int lb : {1, 0})
+        for (int eb : {1, 0})
+            for (int sc : {1, 0})
+                for (int f : {1, 0})
+                    for (int m : {1, 0})
+                        for (int b : {1, 0})
+                            if (b || with_bounds) v.push_back(Opts{0, grid, f, m, b, lb, eb, sc});
     return v;
 }
 
-// All seven, every time: options set on a context persist.
+// All eight, every time: options set on a context persist.
 bool apply(pray_ctx *c, const Opts &o) {
     return pray_option(c, "brute", o.brute) == PRAY_OK && pray_option(c, "grid", o.grid) == PRAY_OK &&
            pray_option(c, "freeze", o.freeze) == PRAY_OK && pray_option(c, "merge", o.merge) == PRAY_OK &&
-           pray_option(c, "bounds", o.bounds) == PRAY_OK && pray_option(c, "shadowcache", o.shadowcache) == PRAY_OK &&
+           pray_option(c, "bounds", o.bounds) == PRAY_OK && pray_option(c, "lightbuffer", o.lightbuffer) == PRAY_OK &&
+           pray_option(c, "eyebuffer", o.eyebuffer) == PRAY_OK && pray_option(c, "shadowcache", o.shadowcache) == PRAY_OK &&
            pray_option(c, "plans", o.plans) == PRAY_OK;
 }
 
@@ -771,7 +779,10 @@ std::string frame_difference(const std::vector<testkit::Frame> &want, const std:
 
 } // namespace
 
-// (shadowcache stays on, its default; the cases below with larger images switch it.)
+// (lightbuffer, eyebuffer and shadowcache stay on, their default. At 48 x 48 the light buffers and
+// the eye's buffer are built only on the coarsest grids (1 to 5 voxels along the longest side),
+// where the image has enough samples per voxel of a buffer; the buffers' cases below use larger
+// images and switch them.)
 TEST_CASE("accel images: nine examples at 48 x 48, every grid x freeze x merge x bounds, and plans=0, the same floats as "
           "--brute; freezing never adds intersection tests") {
     auto t0 = std::chrono::steady_clock::now();
@@ -893,6 +904,8 @@ Render render(pray_ctx *c, pray_object *root, pray_light *lights, const Opts &o,
     r.stats.checks = after.checks - before.checks;
     r.stats.rays_primary = after.rays_primary - before.rays_primary;
     r.stats.rays_shadow = after.rays_shadow - before.rays_shadow;
+    r.stats.rays_lightbuf = after.rays_lightbuf - before.rays_lightbuf;
+    r.stats.rays_eyebuf = after.rays_eyebuf - before.rays_eyebuf;
     r.stats.rays_shadowcache = after.rays_shadowcache - before.rays_shadowcache;
     if (r.status != PRAY_OK) {
         r.error = pray_error(c);
@@ -1230,9 +1243,14 @@ TEST_CASE("accel stats: of a program run; parts that cannot matter are not kept"
 }
 
 // ---------------------------------------------------------------------------------------------
-// The shadow cache (option shadowcache: a shadow ray first tries the voxel where the last one
-// towards its light was stopped) on or off: the images are the reference's, float for float,
-// with the lights outside the scene, inside its grid and amid its objects; and eyes anywhere.
+// The methods of shadow and primary rays, each with its option: light buffers (a list per voxel
+// of a buffer around each light), the eye's buffer (the same around a perspective camera's eye,
+// for primary rays) and the shadow cache (a shadow ray first tries the voxel where the last one
+// was stopped). On or off, the images are the reference's, float for float, with the lights
+// outside the scene, inside its grid and amid its objects. A buffer is built only for an image
+// with enough samples per voxel of the buffer: the cases use image sizes and grids where they
+// are, and check that they were, which checks the cases' setup (without the buffers they would
+// compare nothing of them), not how often the buffers answer.
 // ---------------------------------------------------------------------------------------------
 namespace {
 
@@ -1243,11 +1261,24 @@ struct SwitchTally {
     std::vector<std::string> problems;  // the first 20
 };
 
+// Of the renders with a switch on: how many had a grid; how many built a buffer (which takes a
+// grid: a scene of one unbounded primitive, or of nothing, has none).
+struct Built {
+    long grid = 0, buffer = 0;
+    void add(const Built &b) { grid += b.grid, buffer += b.buffer; }
+    // (setup) the buffer was built wherever it could be
+    void check(const std::string &label) const {
+        if (grid) CHECK_MESSAGE(buffer > 0, label << ": (setup) no render built a buffer");
+    }
+};
+
 // A scene rendered with the switch `sw` (named `option`) off and on at each grid size. With the
-// switch off, `counted` (the rays the method answered) stays 0: the option is obeyed.
-void render_switched(pray_ctx *c, pray_object *root, pray_light *lights, const Render &ref, int Opts::*sw,
-                     const char *option, double pray_stats::*counted, std::initializer_list<int> grids, int size,
-                     const std::string &label, SwitchTally &t) {
+// switch off, `counted` (the rays the method answered) and `built` (the voxels of its buffer;
+// null for the shadow cache) stay 0: the option is obeyed.
+Built render_switched(pray_ctx *c, pray_object *root, pray_light *lights, const Render &ref, int Opts::*sw,
+                     const char *option, double pray_stats::*counted, long pray_stats::*built,
+                     std::initializer_list<int> grids, int size, const std::string &label, SwitchTally &t) {
+    Built n;
     for (int grid : grids) {
         for (int on = 0; on < 2; on++) {
             Opts o{0, grid, 1, 1, 1};
@@ -1256,12 +1287,19 @@ void render_switched(pray_ctx *c, pray_object *root, pray_light *lights, const R
             Render r = render(c, root, lights, o, size);
             t.renders++;
             CHECK_MESSAGE(r.status == PRAY_OK, what << ": " << r.error);
-            if (on) t.used += r.stats.*counted;
-            else CHECK_MESSAGE(r.stats.*counted == 0, what);
+            if (on) {
+                t.used += r.stats.*counted;
+                n.grid += r.stats.grid[0] > 0;
+                n.buffer += built && r.stats.*built > 0;
+            } else {
+                CHECK_MESSAGE(r.stats.*counted == 0, what);
+                if (built) CHECK_MESSAGE(r.stats.*built == 0, what);
+            }
             std::string d = frame_difference(ref.frames, r.frames);
             if (!d.empty() && ++t.mismatches <= 20) t.problems.push_back(what + ": " + d);
         }
     }
+    return n;
 }
 
 void check_tally(const SwitchTally &t, const char *option) {
@@ -1273,10 +1311,11 @@ void check_tally(const SwitchTally &t, const char *option) {
 
 // Renders of picked random scenes under four lights, with a switch of shadow rays off and on,
 // tallied against the reference: a directional light, a point light far outside, one inside
-// the grid's box, and one on the scene's centre (amid or inside the objects).
+// the grid's box, and one on the scene's centre (amid or inside the objects). With `built`,
+// each scene with a grid must have built a buffer at one of the grids at least.
 template <size_t N>
 void shadow_switch_picks(const Pick (&picks)[N], int Opts::*sw, const char *option, double pray_stats::*counted,
-                         std::initializer_list<int> grids, int size, SwitchTally &t) {
+                         long pray_stats::*built, std::initializer_list<int> grids, int size, SwitchTally &t) {
     pray_rgb w = {0.6, 0.6, 0.6}, w2 = {0.5, 0.4, 0.3};
     each_pick(picks, [&](pray_ctx *c, const Scene &s) {
         pray_vec lo = s.lo, hi = s.hi, mid = mul(add(lo, hi), 0.5), ext = sub(hi, lo);
@@ -1286,12 +1325,13 @@ void shadow_switch_picks(const Pick (&picks)[N], int Opts::*sw, const char *opti
         REQUIRE(lights);
         Render ref = render(c, s.root, lights, reference(), size);
         REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
-        render_switched(c, s.root, lights, ref, sw, option, counted, grids, size, s.label, t);
+        Built n = render_switched(c, s.root, lights, ref, sw, option, counted, built, grids, size, s.label, t);
+        if (built) n.check(s.label);
     });
     check_tally(t, option);
 }
 
-// The field of spheres: 400 small balls on a plane, the camera's vectors
+// The field of spheres of the buffers' tests: 400 small balls on a plane, the camera's vectors
 // (for `perspective` or `parallel`) looking down on it at 45 degrees; the lights are added.
 const char *const FIELD_CAMERA = " <1.2, 0, 0>, <0, 0.85, 0.85>, [0, -3, 3], [0, 0, 0]\n";
 const char *const FIELD =
@@ -1322,6 +1362,27 @@ Switched run_switched(const std::string &program, std::vector<std::string> opts,
 
 } // namespace
 
+TEST_CASE("accel light buffers: lightbuffer=0 and 1 give the reference's image, lights outside, inside and amid "
+          "the objects; a field of spheres under the sun and a lamp") {
+    const Pick picks[] = {{K_RANDOM, 5},  {K_RANDOM, 23}, {K_RANDOM, 64}, {K_MANY, 1},   {K_MANY, 7},
+                          {K_LATTICE, 2}, {K_LATTICE, 9}, {K_BLOCKS, 4},  {K_FLOOR, 3},  {K_FLOOR, 11},
+                          {K_SCALED, 2},  {K_SCALED, 6},  {K_SCALED, 13}, {K_SHAPES, 5}};
+    SwitchTally t;
+    // (128 x 128 and coarse grids: a buffer is built for images with enough pixels per voxel)
+    shadow_switch_picks(picks, &Opts::lightbuffer, "lightbuffer", &pray_stats::rays_lightbuf, &pray_stats::lightbuf_voxels,
+                        {3, 5, 8}, 128, t);
+
+    std::string program = std::string("perspective") + FIELD_CAMERA + FIELD +
+                          "rendertiff All, dirlight({0.7}, <1, 2, -3>), pointlight({0.5}, [0.5, 0.5, 3])\n";
+    // (a coarse grid, as in the eye's buffer's case below: buffers of few voxels)
+    Switched r = run_switched(program, {"width=160", "height=160", "shadows=1", "grid=12"}, "lightbuffer");
+    INFO("lightbuffer=1: ", stats_text(r.on.stats), "; lightbuffer=0: ", stats_text(r.off.stats));
+    CHECK(r.on.stats.lightbuf_voxels > 0);  // (setup)
+    CHECK(r.on.stats.rays_shadow > 1000);   // (setup)
+    CHECK(r.off.stats.lightbuf_voxels == 0);
+    CHECK(r.off.stats.rays_lightbuf == 0);
+}
+
 TEST_CASE("accel shadow cache: shadowcache=0 and 1 give the reference's image, through glass and with lights amid "
           "the objects; a table and a pane of glass over a field of spheres; a cluster in nested grids") {
     const Pick picks[] = {{K_RANDOM, 30}, {K_RANDOM, 41}, {K_RANDOM, 64}, {K_RANDOM, 66}, {K_MANY, 4},  {K_LATTICE, 3},
@@ -1330,7 +1391,7 @@ TEST_CASE("accel shadow cache: shadowcache=0 and 1 give the reference's image, t
                           {K_FLOOR, 5, 1}, {K_CLUSTER, 2, 1}};
     SwitchTally t;
     // (the lamps amid the objects end their shadow rays in voxels that hold surfaces beyond them)
-    shadow_switch_picks(picks, &Opts::shadowcache, "shadowcache", &pray_stats::rays_shadowcache, {3, 8}, 64, t);
+    shadow_switch_picks(picks, &Opts::shadowcache, "shadowcache", &pray_stats::rays_shadowcache, nullptr, {3, 8}, 64, t);
     CHECK_MESSAGE(t.used > 0, "(setup) the cache stopped no shadow ray: the comparison does not cover it");
 
     // A table, and a pane of coloured glass with a bar across it, over the field of spheres on
@@ -1350,7 +1411,8 @@ TEST_CASE("accel shadow cache: shadowcache=0 and 1 give the reference's image, t
                           "B = " + box("M", "[0.62, -0.9, 0.5]", "[0.68, 0.2, 0.52]") + "\n" +
                           "F = " + box("M", "[-1.2, -1.2, -0.1]", "[1.2, 1.2, -0.04]") + "\n" +
                           "rendertiff All | T | P | B | F, dirlight({0.7}, <0.3, -1, -1>), pointlight({0.5}, [-0.1, 0, 0.5])\n";
-    Switched r = run_switched(program, {"width=160", "height=160", "shadows=1", "grid=12"}, "shadowcache");
+    // (without light buffers, which would answer those shadow rays first)
+    Switched r = run_switched(program, {"width=160", "height=160", "shadows=1", "grid=12", "lightbuffer=0"}, "shadowcache");
     INFO("shadowcache=1: ", stats_text(r.on.stats), "; shadow rays stopped by the cache ", r.on.stats.rays_shadowcache);
     CHECK(r.on.stats.rays_shadow > 10000);    // (setup)
     CHECK(r.on.stats.rays_shadowcache > 0);   // (setup)
@@ -1364,7 +1426,7 @@ TEST_CASE("accel shadow cache: shadowcache=0 and 1 give the reference's image, t
     const std::string pane = "transparent({0.9, 0.6, 0.3}";
     bright.replace(bright.find(pane), pane.size(), "transparent({0.9, 1.5, 0.3}");
     REQUIRE(bright != program);
-    Switched b = run_switched(bright, {"width=160", "height=160", "shadows=1", "grid=12"}, "shadowcache");
+    Switched b = run_switched(bright, {"width=160", "height=160", "shadows=1", "grid=12", "lightbuffer=0"}, "shadowcache");
     CHECK(b.on.stats.rays_shadow > 10000);  // (setup)
     CHECK(b.on.stats.rays_shadowcache == 0);
 
@@ -1413,13 +1475,12 @@ TEST_CASE("accel threads: the counts of a render are the same for 1, 2, 3 and 8 
     MESSAGE(renders << " renders with 2, 3 and 8 threads compared with one thread");
 }
 
-TEST_CASE("accel eyes: the reference's image from eyes outside, inside, on the corner of and far from the grid's "
-          "box, every grid") {
+TEST_CASE("accel eye buffer: eyebuffer=0 and 1 give the reference's image from eyes outside, inside, on the edge of "
+          "and far from the grid's box; a field of spheres; none for a parallel camera") {
     const Pick picks[] = {{K_RANDOM, 4},  {K_RANDOM, 31}, {K_MANY, 3},   {K_MANY, 8},   {K_LATTICE, 5},
                           {K_BLOCKS, 6},  {K_FLOOR, 4},   {K_FLOOR, 13}, {K_SCALED, 3}, {K_SCALED, 9}, {K_SHAPES, 6},
                           {K_RANDOM, 31, 1}, {K_BLOCKS, 6, 1}, {K_FLOOR, 13, 1}};
-    long renders = 0, mismatches = 0;
-    std::vector<std::string> problems;
+    SwitchTally t;
     each_pick(picks, [&](pray_ctx *c, const Scene &s) {
         pray_light *lights = some_lights(c);
         REQUIRE(lights);
@@ -1429,11 +1490,12 @@ TEST_CASE("accel eyes: the reference's image from eyes outside, inside, on the c
             const char *name;
             pray_vec at;
         };
-        // (a corner of the box: on three of its faces)
+        // (a corner of the box: on three of its faces, and on the edges of the buffer's faces)
         const Eye eyes[] = {{"outside", add(mid, V(0.3 * big, -2.5 * big, 0.8 * big))},
                             {"amid the objects", add(mid, mul(size, 0.1))},
                             {"on a corner of the box", lo},
                             {"far away", add(mid, V(-300 * big, -500 * big, 200 * big))}};
+        Built built;
         for (const Eye &e : eyes) {
             pray_vec look = sub(mid, e.at);
             if (dot(look, look) < 1e-6 * big * big) look = V(0, big, 0);
@@ -1443,26 +1505,34 @@ TEST_CASE("accel eyes: the reference's image from eyes outside, inside, on the c
             REQUIRE(pray_perspective(c, x, y, e.at, add(e.at, mul(unit(look), big))) == PRAY_OK);
             Render ref = render(c, s.root, lights, reference(), 64);
             REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
-            for (int grid : {3, 8, -1}) {
-                Render r = render(c, s.root, lights, Opts{0, grid, 1, 1, 1}, 64);
-                renders++;
-                std::string what = s.label + ", eye " + e.name + ", grid=" + std::to_string(grid);
-                CHECK_MESSAGE(r.status == PRAY_OK, what << ": " << r.error);
-                std::string d = frame_difference(ref.frames, r.frames);
-                if (!d.empty() && ++mismatches <= 20) problems.push_back(what + ": " + d);
-            }
+            built.add(render_switched(c, s.root, lights, ref, &Opts::eyebuffer, "eyebuffer", &pray_stats::rays_eyebuf,
+                                     &pray_stats::eyebuf_voxels, {3, 8}, 64, s.label + ", eye " + e.name, t));
         }
+        built.check(s.label);
     });
-    std::string all;
-    for (auto &p : problems) all += "\n  - " + p;
-    MESSAGE(renders << " renders from four eyes, " << mismatches << " differing from brute=1");
-    CHECK_MESSAGE(mismatches == 0, mismatches << " renders differ from brute=1:" << all);
+    check_tally(t, "eyebuffer");
+
+    // A field of spheres seen from above; and through a parallel projection, which has no eye
+    // (its rays are parallel): no eye's buffer.
+    std::string field = std::string(FIELD_CAMERA) + FIELD + "rendertiff All, dirlight({0.7}, <1, 2, -3>)\n";
+    // (a coarse grid: the buffer's cells are as wide as its voxels, and this image has pixels
+    // enough for that many)
+    const std::vector<std::string> opts = {"width=160", "height=160", "shadows=0", "grid=12"};
+    Switched r = run_switched("perspective" + field, opts, "eyebuffer");
+    INFO("eyebuffer=1: ", stats_text(r.on.stats), "; eyebuffer=0: ", stats_text(r.off.stats));
+    CHECK(r.on.stats.eyebuf_voxels > 0);  // (setup)
+    CHECK(r.off.stats.eyebuf_voxels == 0);
+    CHECK(r.off.stats.rays_eyebuf == 0);
+    Switched par = run_switched("parallel" + field, opts, "eyebuffer");
+    CHECK(par.on.stats.eyebuf_voxels == 0);
+    CHECK(par.on.stats.rays_eyebuf == 0);
 }
 
 // ---------------------------------------------------------------------------------------------
-// Larger images with everything switched: example programs and random scenes, each rendered
-// with every combination of shadowcache x freeze x merge (x bounds for the random scenes), the
-// same floats as --brute; freezing never adds intersection tests.
+// The buffers where they are built, with everything switched: example programs and random
+// scenes, each rendered with every combination of lightbuffer x eyebuffer x shadowcache x
+// freeze x merge (x bounds for the random scenes), the same floats as --brute; freezing never
+// adds intersection tests.
 // ---------------------------------------------------------------------------------------------
 namespace {
 
@@ -1518,12 +1588,14 @@ void check_net(const NetTally &t, double secs) {
     CHECK_MESSAGE(t.freeze_violations == 0, t.freeze_violations << " cases where freezing added intersection tests:" << all);
 }
 
-// A program of the net: its name and text.
+// A program of the net: its name, text, and which buffers its default render must build.
 struct NetProgram {
     std::string name, text;
+    bool light, eye;
 };
 
-// Each program at size x size with the combinations of switch_combinations(grid, with_bounds).
+// Each program at size x size with the combinations of buffer_combinations(grid, with_bounds); in
+// the first (the defaults) the buffers must have been built.
 void program_net(const std::vector<NetProgram> &programs, int size, int grid, bool with_bounds, NetTally &t) {
     std::vector<std::string> dims = {"width=" + std::to_string(size), "height=" + std::to_string(size)};
     for (const NetProgram &p : programs) {
@@ -1534,11 +1606,14 @@ void program_net(const std::vector<NetProgram> &programs, int size, int grid, bo
         REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
         REQUIRE(!ref.frames.empty());
         CHECK(ref.frames[0].width == size);
-        compare_combinations(p.name, ref.frames, switch_combinations(grid, with_bounds), [&](const Opts &o) {
+        pray_stats on = compare_combinations(p.name, ref.frames, buffer_combinations(grid, with_bounds), [&](const Opts &o) {
             std::vector<std::string> opts = dims;
             for (auto &x : o.fixed()) opts.push_back(x);
             return run_program(p.name, p.text, opts);
         }, t);
+        INFO("defaults: ", stats_text(on));
+        if (p.light) CHECK_MESSAGE(on.lightbuf_voxels > 0, p.name << ": (setup) no light buffer built");
+        if (p.eye) CHECK_MESSAGE(on.eyebuf_voxels > 0, p.name << ": (setup) no eye's buffer built");
     }
 }
 
@@ -1566,35 +1641,44 @@ std::string lamp_program(const char *bulb) {
 } // namespace
 
 // (bounds=1 only: the random scenes' case below switches it)
-TEST_CASE("accel switches: examples at 160 x 160 on a grid of 8, every shadowcache x freeze x merge: the same "
-          "floats as --brute; freezing never adds tests") {
+TEST_CASE("accel buffers: examples at 160 x 160 on a grid of 8, where the buffers are built, every lightbuffer x "
+          "eyebuffer x shadowcache x freeze x merge: the same floats as --brute; freezing never adds tests") {
     auto t0 = std::chrono::steady_clock::now();
-    // (room.ray: its eye is amid the grid; parallel.ray: a parallel camera; anim.ray: three frames)
-    std::vector<NetProgram> programs = examples_of({{"room.ray", ""}, {"fractal.ray", ""}, {"glass.ray", ""},
-                                                    {"cube.ray", ""}, {"csg.ray", ""}, {"holes.ray", ""},
-                                                    {"mirror.ray", ""}, {"models.ray", ""}, {"anim.ray", ""},
-                                                    {"parallel.ray", ""}});
-    programs.push_back({"lamp (clear bulb)", lamp_program("{1}")});
-    programs.push_back({"lamp (dim bulb)", lamp_program("{0.97}")});
+    // (room.ray: its eye is amid the grid, whose buffer would have too many voxels for this
+    // image; parallel.ray: a parallel camera has no eye's buffer; anim.ray: three frames)
+    std::vector<NetProgram> programs = examples_of({{"room.ray", "", true, false},
+                                                    {"fractal.ray", "", true, true},
+                                                    {"glass.ray", "", true, true},
+                                                    {"cube.ray", "", true, true},
+                                                    {"csg.ray", "", true, true},
+                                                    {"holes.ray", "", true, true},
+                                                    {"mirror.ray", "", true, true},
+                                                    {"models.ray", "", true, true},
+                                                    {"anim.ray", "", true, true},
+                                                    {"parallel.ray", "", true, false}});
+    programs.push_back({"lamp (clear bulb)", lamp_program("{1}"), true, true});
+    programs.push_back({"lamp (dim bulb)", lamp_program("{0.97}"), true, true});
     programs.push_back({"field", std::string("perspective") + FIELD_CAMERA + FIELD +
-                                     "rendertiff All, dirlight({0.7}, <1, 2, -3>), pointlight({0.5}, [0.5, 0.5, 3])\n"});
+                                     "rendertiff All, dirlight({0.7}, <1, 2, -3>), pointlight({0.5}, [0.5, 0.5, 3])\n",
+                        true, true});
     NetTally t;
     program_net(programs, 160, 8, false, t);
     check_net(t, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 }
 
-// (the automatic grid is finer for larger images, and nests deeper)
-TEST_CASE("accel switches: examples at 384 and 512 pixels square with the automatic grid, every shadowcache x "
-          "freeze x merge: the same floats as --brute") {
+// (the automatic grid is finer for larger images: these sizes are the smallest where it builds
+// both buffers of these programs)
+TEST_CASE("accel buffers: examples at 384 and 512 pixels square with the automatic grid, where the buffers are "
+          "built, every lightbuffer x eyebuffer x shadowcache x freeze x merge: the same floats as --brute") {
     auto t0 = std::chrono::steady_clock::now();
     NetTally t;
-    program_net(examples_of({{"cube.ray", ""}}), 384, -1, false, t);
-    program_net(examples_of({{"fractal.ray", ""}, {"csg.ray", ""}}), 512, -1, false, t);
+    program_net(examples_of({{"cube.ray", "", true, true}}), 384, -1, false, t);
+    program_net(examples_of({{"fractal.ray", "", true, true}, {"csg.ray", "", true, true}}), 512, -1, false, t);
     check_net(t, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 }
 
-TEST_CASE("accel switches: random scenes at 128 x 128 under the sun and lamps outside, inside the grid's box and amid "
-          "the objects, every shadowcache x freeze x merge x bounds: the same floats as --brute") {
+TEST_CASE("accel buffers: random scenes at 128 x 128 under the sun and lamps outside, inside the grid's box and amid "
+          "the objects, every lightbuffer x eyebuffer x shadowcache x freeze x merge x bounds: the same floats as --brute") {
     const Pick picks[] = {{K_RANDOM, 5},  {K_RANDOM, 42}, {K_RANDOM, 77}, {K_MANY, 2},  {K_MANY, 7},   {K_LATTICE, 4},
                           {K_BLOCKS, 7},  {K_BLOCKS, 12}, {K_FLOOR, 3},   {K_FLOOR, 9}, {K_SCALED, 2}, {K_SCALED, 6},
                           {K_RANDOM, 42, 1}, {K_BLOCKS, 12, 1}, {K_FLOOR, 9, 1}, {K_SCALED, 2, 1}};
@@ -1615,9 +1699,12 @@ TEST_CASE("accel switches: random scenes at 128 x 128 under the sun and lamps ou
         REQUIRE(pray_perspective(c, x, y, eye, mid) == PRAY_OK);
         Render ref = render(c, s.root, lights, reference(), 128);
         REQUIRE_MESSAGE(ref.status == PRAY_OK, ref.error);
-        compare_combinations(s.label, ref.frames, switch_combinations(5, true), [&](const Opts &o) {
+        pray_stats on = compare_combinations(s.label, ref.frames, buffer_combinations(5, true), [&](const Opts &o) {
             return render(c, s.root, lights, o, 128);
         }, t);
+        INFO("defaults: ", stats_text(on));
+        CHECK_MESSAGE(on.lightbuf_voxels > 0, "(setup) no light buffer built");
+        CHECK_MESSAGE(on.eyebuf_voxels > 0, "(setup) no eye's buffer built");
     });
     check_net(t, std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 }

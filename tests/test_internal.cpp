@@ -73,7 +73,7 @@ struct TScene {
         memset(&s, 0, sizeof s);
         memset(&w, 0, sizeof w);
         if (!o) return;
-        if (scene_build(c, &s, o, NULL) != PRAY_OK) return;
+        if (scene_build(c, &s, o, NULL, false) != PRAY_OK) return;
         ok = scratch_init(c, &w, &s);
     }
     ~TScene() {
@@ -122,7 +122,7 @@ TSpan t_span_of(pray_ctx *c, pray_object *o, const Ray &r, bool self = false) {
     sp.kind = -1;
     sp.t0 = sp.t1 = 0;
     Scene s;
-    if (!o || scene_build(c, &s, o, NULL) != PRAY_OK || s.prims.n != 1) return sp;
+    if (!o || scene_build(c, &s, o, NULL, false) != PRAY_OK || s.prims.n != 1) return sp;
     sp.kind = prim_span(s.prims[0], r, self, &sp.t0, &sp.t1);
     scene_release(c, &s);
     return sp;

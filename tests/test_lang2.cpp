@@ -494,8 +494,8 @@ TEST_CASE("a warning once a frame when the eye is inside the rendered solid, nev
     CHECK(two.warned == "two.ray:2:1: warning: the eye is inside the rendered solid\n"
                         "two.ray:3:1: warning: the eye is inside the rendered solid\n"
                         "two.ray:5:1: warning: the eye is inside the rendered solid\n");
-    // with the grid and brute force off: the same
-    for (const char *o : {"brute", "grid"}) {
+    // with the grid, brute force, and the eye's buffer off: the same
+    for (const char *o : {"brute", "eyebuffer", "grid"}) {
         std::string p = std::string("option \"") + o + "\", " + (std::string(o) == "brute" ? "1" : "0") + "\n" + prog;
         Run x = run_warned(p, "eye.ray", 8, 8);
         CHECK(x.r.status == PRAY_OK);
