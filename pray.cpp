@@ -4739,10 +4739,10 @@ bool nest_box(const ListBuilder &b, const Box *eff, double wid, const double *v0
 }
 
 // A grid of its own for voxel ix of G, whose candidates are ids[0 .. n) and which has `checks`
-// primitives in `objs` objects to check (classed in the voxel: b.rprims, b.rcls): its index in Accel::nested; -1
-// when it is not worth it or does not fit the budget; -2 on failure.
-int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const int *ids, int n, int checks, int objs, int steps,
-               int depth) {
+// primitives in `objs` objects to check (classed in the voxel: b.rprims, b.rcls): its index in
+// Accel::nested; -1 when it is not worth it or does not fit the budget; -2 on failure.
+int nest_build(ListBuilder &b, const Grid &G, const int *ix, GridPlan &gp, const int *ids, int n, int checks, int objs,
+               int steps, int depth) {
     pray_ctx *c = b.c;
     // the box of the primitives to check, widened by the most a nested grid's margin can be
     // (m <= 32 below), within the voxel
