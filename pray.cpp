@@ -6380,7 +6380,10 @@ struct ZoneSource {
         return true;
     }
     template <class Out>
-    bool walk(Out &out, real a, real b) const { return out(L, a, b); }
+    bool walk(Out &out, real a, real b) const {
+        out.w->k.steps += 1;  // (a step, as a voxel's)
+        return out(L, a, b);
+    }
 };
 
 // A cell of the eye's buffer: a primary ray stays in the cell and crosses its runs, slab by slab
@@ -6399,6 +6402,7 @@ struct EyeSource {
         for (const int *r = run; r < end && t < tb; r += 2) {
             real next = r + 2 < end ? (F->lo[2] + (real)r[1] * F->h[2]) * inv : tb;
             next = next < tb ? next : tb;
+            out.w->k.steps += 1;  // (a step, as a voxel's: image sequences weigh tracing by them)
             if (out(r[0], t, next)) return true;
             t = next;
         }

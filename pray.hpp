@@ -425,7 +425,7 @@ typedef struct pray_stats {
     double rays_eyebuf;              /* primary rays traced through the eye's buffer */
     double rays_shadowcache;         /* shadow rays stopped by the shadow cache (option shadowcache) */
     int threads;                     /* threads of the last render */
-    double voxel_steps, area_moves;  /* traversal steps; steps inside an area (no evaluation) */
+    double voxel_steps, area_moves;  /* traversal steps (a buffer's stretch is one); steps inside an area (no evaluation) */
     double set_inside, set_outside, checks; /* actions executed, by kind */
     double intersection_tests;       /* ray/primitive intersections computed */
     double frozen_skips;             /* checks skipped because the node was frozen */
