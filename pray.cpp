@@ -4709,8 +4709,8 @@ bool nest_holds(const Box &bx, double wid, const double *v0, const double *v1, c
 
 // The box of a nested grid in the voxel [v0, v1]: of the primitives to check (b.rprims, b.rcls)
 // whose boxes do not cross the voxel, when the others are few enough for the rest of the voxel
-// (at most NEST_OBJECTS outside that box), else of them all. Their boxes are widened by wid; the
-// box is within the voxel, and false when it is empty.
+// (at most NEST_OBJECTS primitives, not objects, outside that box), else of them all. Their
+// boxes are widened by wid; the box is within the voxel, and false when it is empty.
 bool nest_box(const ListBuilder &b, const Box *eff, double wid, const double *v0, const double *v1, double *lo,
               double *hi) {
     double alo[3], ahi[3], plo[3], phi[3];
