@@ -10,11 +10,11 @@
    [SECTION] 4     200  Vector math and the `.` transformations
    [SECTION] 5     700  Scene values: models, lights, solids (reference counted handles)
    [SECTION] 6     150  Options
-   [SECTION] 7    1150  Prepared scene: flattened n-ary CSG tree, boxes, simplification, snapping
+   [SECTION] 7    1155  Prepared scene: flattened n-ary CSG tree, boxes, simplification, snapping
    [SECTION] 8     450  Ray/primitive intersection; primitives in a frame (box, rod, cone, torus,
                           stretched)
    [SECTION] 9     450  CSG status-tree sweep (the brute-force reference, thesis 3.4)
-   [SECTION] 9b   2825  Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
+   [SECTION] 9b   2940  Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
                           [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas
                           and jumps, [9b.4] light and eye buffers, [9b.5] accel_build; per ray: [9b.6]
                           list evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver
@@ -29,7 +29,7 @@
    [SECTION] 14   1650  PRAY interpreter: values, operators, builtins, statements
    [SECTION] 15    200  One-call helpers and the running of programs
    [SECTION] 16    800  Command-line program (PRAY_MAIN)
-   The whole file: at most 15225 lines.
+   The whole file: at most 15375 lines.
 */
 
 // =============================================================================================
@@ -2012,6 +2012,8 @@ struct Prim {
     int parent;         // node index, -1 for the root
     unsigned char first;  // first child of a difference
     unsigned char settles;  // 1: being outside for good decides the parent, 2: inside (3.5)
+    unsigned char owns;     // may fill the solid with its material (owner): no complement, later
+                            // child of a difference or earlier one of an intersection above it
 };
 
 struct Node {
@@ -2046,7 +2048,7 @@ struct Scene {
     int leaves;       // primitives met so far while flattening
     int uid;          // the id of the innermost object with one, around what is flattened
     int tori;         // tori among the primitives (each may cross a ray four times)
-    int iface;        // two different materials may meet inside the solid (scene_interfaces)
+    int iface;        // two different materials may fill the solid (scene_interfaces)
     Accel *accel;     // NULL: the brute-force reference
     Array<Light> lights;
     int parallel;
@@ -3016,53 +3018,60 @@ bool solids_apart(const Prim &a, const Prim &b) {
     return (n > 0 ? n * b.box.lo[l] : n * b.box.hi[l]) >= a.d;
 }
 
-// Scene::iface: may two primitives of different models (as values) overlap or touch? Only then
-// can a ray meet a face between two materials inside the solid. The boxes in n buckets of their
-// lower ends along one axis (a counting sort), each against those after it that start in a
-// bucket up to the one of its upper end; the answer at the first such pair.
+// Two primitives of different materials (language 12: models that differ as values).
+inline bool other_material(const Scene *s, int p, int q) {
+    return s->prims[p].mat != s->prims[q].mat && !model_same(s->prims[p].mat, s->prims[q].mat);
+}
+
+// Each primitive's box into out[], with `clip` clipped by the boxes of all its ancestors: a
+// primitive matters only there, since outside a node's box the node is outside, and so is what
+// its primitives alone would make of it. False when out of memory.
+bool prim_boxes(pray_ctx *c, const Scene *s, Box *out, bool clip) {
+    Box *nb = clip ? (Box *)mem_alloc(c, sizeof(Box) * (size_t)(s->nodes.n + 1)) : NULL;
+    if (clip && !nb) return false;
+    for (int j = s->nodes.n - 1; clip && j >= 0; j--) {  // parents before children
+        nb[j] = s->nodes[j].box;
+        if (s->nodes[j].parent >= 0) box_clip(&nb[j], nb[s->nodes[j].parent]);
+    }
+    for (int i = 0; i < s->prims.n; i++) {
+        out[i] = s->prims[i].box;
+        if (clip && s->prims[i].parent >= 0) box_clip(&out[i], nb[s->prims[i].parent]);
+    }
+    mem_free(c, nb);
+    return true;
+}
+
+// Prim::owns, from the root down (a parent is numbered after its children), as owner (section
+// 9) descends: every child of a union, the first of a difference, the last of an intersection
+// that is not a complement, nothing under a complement. `own`: per node, zeroed.
+void scene_owners(Scene *s, unsigned char *own) {
+    for (int i = 0; i < s->prims.n; i++) s->prims[i].owns = s->root == 2 * i;
+    if (e_is_node(s->root)) own[e_index(s->root)] = 1;
+    for (int j = s->nodes.n - 1; j >= 0; j--) {
+        const Node &nd = s->nodes[j];
+        const int *k = &s->kids[nd.k0];
+        int last = nd.n - 1;
+        while (nd.op == O_INTER && last > 0 && e_is_node(k[last]) && s->nodes[e_index(k[last])].op == O_COMPL) last--;
+        for (int i = 0; own[j] && nd.op != O_COMPL && i < nd.n; i++) {
+            if ((nd.op == O_DIFF && i > 0) || (nd.op == O_INTER && i != last)) continue;
+            if (e_is_node(k[i])) own[e_index(k[i])] = 1;
+            else s->prims[e_index(k[i])].owns = 1;
+        }
+    }
+}
+
+// Scene::iface: may two primitives of different materials (models that differ as values) fill
+// the solid (Prim::owns)? Only then can it have a face between two materials; the lists find
+// where (lb_mixed).
 pray_status scene_interfaces(pray_ctx *c, Scene *s) {
-    int n = s->prims.n, k = 1;
-    s->iface = 0;
-    while (k < n && (s->prims[k].mat == s->prims[0].mat || model_same(s->prims[k].mat, s->prims[0].mat))) k++;
-    if (k >= n) return PRAY_OK;  // one material
-    int *key = (int *)mem_alloc(c, sizeof(int) * 2 * (size_t)n), *at = (int *)mem_zalloc(c, sizeof(int) * ((size_t)n + 1));
-    if (!key || !at) {
-        mem_free(c, key);
-        mem_free(c, at);
-        return c->status;
-    }
-    int *order = key + n, l = 0;
-    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};  // finite lower ends
-    for (int i = 0; i < n; i++)
-        for (int a = 0; a < 3; a++) {
-            double x = (double)s->prims[i].box.lo[a];
-            if (x > -REAL_BIG) lo[a] = x < lo[a] ? x : lo[a], hi[a] = x > hi[a] ? x : hi[a];
-        }
-    for (int a = 1; a < 3; a++)  // (along the axis where they spread most)
-        if (hi[a] - lo[a] > hi[l] - lo[l]) l = a;
-    double x0 = lo[l], x1 = hi[l], scale = x1 > x0 ? (n - 1) / (x1 - x0) : 0;
-    struct Bucket {  // (of x, clamped: 0 below x0, n - 1 above x1)
-        double x0, scale;
-        int last;
-        int operator()(real x) const {
-            double f = ((double)x - x0) * scale;
-            return !(f > 0) ? 0 : f >= last ? last : (int)f;
-        }
-    } bucket = {x0, scale, n - 1};
-    for (int i = 0; i < n; i++) at[(key[i] = bucket(s->prims[i].box.lo[l])) + 1]++;
-    for (int j = 0; j < n; j++) at[j + 1] += at[j];
-    for (int i = 0; i < n; i++) order[at[key[i]]++] = i;
-    for (int a = 0; a < n && !s->iface; a++) {
-        const Prim &p = s->prims[order[a]];
-        for (int b = a + 1, end = bucket(p.box.hi[l]); b < n && key[order[b]] <= end; b++) {
-            const Prim &q = s->prims[order[b]];
-            if (p.mat == q.mat || !box_overlap(p.box, q.box) || model_same(p.mat, q.mat) || solids_apart(p, q)) continue;
-            s->iface = 1;
-            break;
-        }
-    }
-    mem_free(c, key);
-    mem_free(c, at);
+    unsigned char *own = (unsigned char *)mem_zalloc(c, (size_t)s->nodes.n + 1);
+    if (!own) return c->status;
+    scene_owners(s, own);
+    mem_free(c, own);
+    int n = s->prims.n, k = 0, m = 0;
+    while (k < n && !s->prims[k].owns) k++;
+    for (m = k + 1; m < n && !(s->prims[m].owns && other_material(s, m, k));) m++;
+    s->iface = m < n;
     return PRAY_OK;
 }
 
@@ -3540,7 +3549,6 @@ struct Scratch {
     Cross *cross;
     Hull *hull;  // per solid of a list with a plan (at most one per node)
     unsigned char *pstat, *nstat, *nfirst;
-    unsigned char *away;  // per node: a ray of across misses its box (sweep_start)
     int *cnt;
     Counters k;
     // per ray, stamped with the ray number (thesis 3.5: no explicit unfreezing)
@@ -3578,7 +3586,6 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->pstat = (unsigned char *)thread_alloc(c, np);
     w->nstat = (unsigned char *)thread_alloc(c, nn);
     w->nfirst = (unsigned char *)thread_alloc(c, nn);
-    w->away = (unsigned char *)thread_alloc(c, nn);
     w->cnt = (int *)thread_alloc(c, sizeof(int) * nn);
     w->span = (Span *)thread_alloc(c, sizeof(Span) * np);
     w->nfrozen = (unsigned *)thread_alloc(c, sizeof(unsigned) * nn);
@@ -3586,7 +3593,7 @@ bool scratch_init(pray_ctx *c, Scratch *w, const Scene *s) {
     w->nfixval = (unsigned char *)thread_alloc(c, nn);
     w->blocker = (Blocker *)thread_alloc(c, sizeof(Blocker) * (size_t)(s->lights.n + 1));
     if (w->blocker) shadow_cache_clear(s, w);
-    return w->blocker && w->cross && (w->span2 || !s->tori) && w->hull && w->pstat && w->nstat && w->nfirst && w->away && w->cnt && w->span &&
+    return w->blocker && w->cross && (w->span2 || !s->tori) && w->hull && w->pstat && w->nstat && w->nfirst && w->cnt && w->span &&
            w->nfrozen && w->nfixed && w->nfixval;
 }
 
@@ -3602,7 +3609,6 @@ void scratch_release(pray_ctx *c, Scratch *w) {
     mem_free(c, w->pstat);
     mem_free(c, w->nstat);
     mem_free(c, w->nfirst);
-    mem_free(c, w->away);
     mem_free(c, w->cnt);
 }
 
@@ -3685,11 +3691,6 @@ inline Hit solid_hit(real t, int prim, int prim_enter, bool root_enter) {
     return h;
 }
 
-// Two primitives of different materials (language 12: models that differ as values).
-inline bool other_material(const Scene *s, int p, int q) {
-    return s->prims[p].mat != s->prims[q].mat && !model_same(s->prims[p].mat, s->prims[q].mat);
-}
-
 // The primitive whose material fills the solid where the ray is, the root being inside
 // (language 12): in a union the last child the ray is in, in an intersection its last child
 // that is not a complement, in a difference its first; -1 in a complement (no primitive puts
@@ -3711,6 +3712,9 @@ int owner(const Scene *s, const Scratch *w) {
     return e_index(e);
 }
 
+// owner in the region of a list with materials (9b).
+int owner_mixed(const Scene *s, const Scratch *w, const int *d);
+
 // A crossing of a primitive at t, when t is in (a, b] and before tmax: noted for a sweep
 // (`prim`: the primitive, or its place in a list with a plan, 9b).
 inline void add_cross(Scratch *w, int *nc, real t, int prim, int enter, real a, real b, real tmax) {
@@ -3721,62 +3725,51 @@ inline void add_cross(Scratch *w, int *nc, real t, int prim, int enter, real a, 
     x.enter = enter;
 }
 
-bool ray_box(const Ray &r, const real *inv, const real *lo, const real *hi, real *t0, real *t1);
-inline void ray_inverse(const Ray &ray, real *inv);
+int elem_parent(const Scene *s, int e) {
+    return e_is_node(e) ? s->nodes[e_index(e)].parent : s->prims[e_index(e)].parent;
+}
+bool elem_first(const Scene *s, int e) {
+    return (e_is_node(e) ? s->nodes[e_index(e)].first : s->prims[e_index(e)].first) != 0;
+}
 
-// Does the part (0, tmax) of the ray miss the box (whose solid is then outside all along it)?
-inline bool misses(const Ray &ray, const real *inv, real tmax, const Box &b) {
-    real t0, t1;
-    return box_finite(b) && !(ray_box(ray, inv, b.lo, b.hi, &t0, &t1) && t1 > 0 && t0 < tmax);
+// Element e is inside: count it in its parent (bump, 9b: unless the parent's status is fixed).
+inline void tally(const Scene *s, Scratch *w, int e) {
+    int p = elem_parent(s, e);
+    if (p < 0) return;
+    if (elem_first(s, e) && s->nodes[p].op == O_DIFF) w->nfirst[p] = 1;
+    else w->cnt[p]++;
+}
+
+// Primitive p's status just after a, from its span (kind; t: its ends, a torus' second
+// interval after them), counted in its parent when inside; its crossings in (a, b] before tmax
+// are noted.
+inline void prim_at(const Scene *s, Scratch *w, int p, int kind, const real *t, real a, real b, real tmax, int *nc) {
+    bool in = kind == SPAN_ALL;
+    for (int j = 0; (kind == SPAN || kind == SPAN2) && j < (kind == SPAN2 ? 4 : 2); j += 2) {
+        in = in || (t[j] <= a && a < t[j + 1]);
+        add_cross(w, nc, t[j], p, 1, a, b, tmax);
+        add_cross(w, nc, t[j + 1], p, 0, a, b, tmax);
+    }
+    w->pstat[p] = in;
+    if (in) tally(s, w, 2 * p);
 }
 
 // The start of a sweep: the status of every primitive and node at the start of the ray (just
 // after it, for a start on a surface) into w, and the crossings in (0, tmax) into w->cross
-// (*ncross of them, unsorted). Returns the root's status. The root must be an element. `cull`
-// (across, not the reference): the primitives and nodes whose boxes the ray misses are outside
-// without a test.
-bool sweep_start(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int *ncross, bool cull = false) {
+// (*ncross of them, unsorted). Returns the root's status. The root must be an element.
+bool sweep_start(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, int *ncross) {
     int nc = 0;
     int np = s->prims.n;
-    real inv[3];
-    if (cull) ray_inverse(ray, inv);
-    for (int j = s->nodes.n - 1; j >= 0; j--) {  // (parents first)
-        const Node &nd = s->nodes[j];
-        w->cnt[j] = 0;
-        w->nfirst[j] = 0;
-        w->away[j] = cull && ((nd.parent >= 0 && w->away[nd.parent]) || misses(ray, inv, tmax, nd.box));
-    }
+    for (int j = 0; j < s->nodes.n; j++) w->cnt[j] = 0, w->nfirst[j] = 0;
     for (int i = 0; i < np; i++) {
-        const Prim &q = s->prims[i];
-        if (cull && ((q.parent >= 0 && w->away[q.parent]) || misses(ray, inv, tmax, q.box))) {
-            w->pstat[i] = 0;
-            continue;
-        }
         real t[4] = {0, 0, 0, 0};
         w->k.tests += 1;
-        int k = prim_span(q, ray, twin(s, i, self), &t[0], &t[1], &t[2]);
-        bool in = false;
-        if (k == SPAN_ALL) in = true;
-        else if (k == SPAN || k == SPAN2) {
-            for (int j = 0; j < (k == SPAN2 ? 4 : 2); j++) {
-                in = in || (!(j & 1) && t[j] <= 0 && 0 < t[j + 1]);
-                add_cross(w, &nc, t[j], i, !(j & 1), 0, REAL_INF, tmax);
-            }
-        }
-        w->pstat[i] = in;
-        if (in && q.parent >= 0) {
-            if (q.first && s->nodes[q.parent].op == O_DIFF) w->nfirst[q.parent] = 1;
-            else w->cnt[q.parent]++;
-        }
+        int k = prim_span(s->prims[i], ray, twin(s, i, self), &t[0], &t[1], &t[2]);
+        prim_at(s, w, i, k, t, 0, REAL_INF, tmax, &nc);
     }
     for (int j = 0; j < s->nodes.n; j++) {
-        const Node &nd = s->nodes[j];
-        bool st = !w->away[j] && node_status(nd, w->cnt[j], w->nfirst[j]);
-        w->nstat[j] = st;
-        if (st && nd.parent >= 0) {
-            if (nd.first && s->nodes[nd.parent].op == O_DIFF) w->nfirst[nd.parent] = 1;
-            else w->cnt[nd.parent]++;
-        }
+        w->nstat[j] = node_status(s->nodes[j], w->cnt[j], w->nfirst[j]);
+        if (w->nstat[j]) tally(s, w, 2 * j + 1);
     }
     *ncross = nc;
     return e_is_node(s->root) ? w->nstat[e_index(s->root)] != 0 : w->pstat[e_index(s->root)] != 0;
@@ -3794,64 +3787,77 @@ bool starts_inside(const Scene *s, Scratch *w, const Ray &ray) {
     return sweep_start(s, w, ray, 0, -1, &nc);
 }
 
-// The face where materials meet at the crossings [g0, g1) of a sweep, all at one t: the last of
-// them that its primitive's status took, of a primitive within every box above it (so that a
-// sweep which leaves out the parts whose boxes the ray misses, across, takes the same one).
-int face_of(const Scene *s, const Scratch *w, const Ray &ray, real tmax, int g0, int g1) {
-    real inv[3];
-    ray_inverse(ray, inv);
-    for (int k = g1 - 1; k > g0; k--) {
+// The face where materials meet at the crossings [g0, g1) of a sweep, all at one t, the ray
+// going from the material of primitive `was` into that of `mat`: the last crossing whose status
+// its primitive took and that changed its parent's status (CROSS_MOVED) or is a face of `was`
+// or `mat`. (A crossing that changes nothing above it is no face of the solid there; so a
+// list's region, which leaves out what is under a node outside, takes the same one.)
+const int CROSS_MOVED = 2;  // a flag of Cross::enter, set by sweep_crossings
+
+int face_of(const Scratch *w, int g0, int g1, int was, int mat) {
+    for (int k = g1 - 1; k >= g0; k--) {
         const Cross &x = w->cross[k];
-        int p = s->prims[x.prim].parent;
-        while (p >= 0 && !misses(ray, inv, tmax, s->nodes[p].box)) p = s->nodes[p].parent;
-        if (p < 0 && (w->pstat[x.prim] != 0) == (x.enter != 0)) return k;
+        if ((w->pstat[x.prim] != 0) == ((x.enter & 1) != 0) && ((x.enter & CROSS_MOVED) || x.prim == was || x.prim == mat))
+            return k;
     }
     return g0;
 }
 
-// Visit the visible surfaces along the ray in (0, tmax) in order; `visit` returns false to stop.
-// Returns the number of hits visited.
+// The crossings w->cross[0, nc) in order, from the statuses at their start (the root's: `root`):
+// each change of the root's status is a hit, and where materials meet (Scene::iface) each change
+// of the material the ray is in while inside (owner, or owner_mixed in list `mixed`) is a hit
+// on a face between two materials. Counts the hits visited in *hits; true when `visit` stopped.
+// The reference's and the lists with materials' (eval_mixed, 9b) one loop.
 template <class Visit>
-int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, bool cull = false) {
-    if (s->root < 0) return 0;
-    int nc = 0;
-    bool root = sweep_start(s, w, ray, tmax, self, &nc, cull);
+bool sweep_crossings(const Scene *s, Scratch *w, int nc, bool root, Visit &visit, int *hits, const int *mixed = NULL) {
     if (nc > 1) sort_crossings(w->cross, nc);
-    int hits = 0;
-    // where materials meet (Scene::iface): the material the ray is in while inside (owner)
-    int mat = s->iface && root ? owner(s, w) : -1;
+    int mat = !s->iface || !root ? -1 : mixed ? owner_mixed(s, w, mixed) : owner(s, w);
     for (int i = 0; i < nc;) {
         real t = w->cross[i].t;
         bool before = root;
         int last = -1, moved = -1, g0 = i;
         for (; i < nc && w->cross[i].t == t; i++) {
-            const Cross &x = w->cross[i];
+            Cross &x = w->cross[i];
             bool st = x.enter != 0;
             if ((w->pstat[x.prim] != 0) == st) continue;
             w->pstat[x.prim] = st;
             moved = i;
+            int p = s->prims[x.prim].parent;
+            bool was_in = p >= 0 && w->nstat[p];
             if (propagate(s, w, 2 * x.prim, st)) {
                 root = !root;
                 last = i;
             }
+            if (p < 0 || (w->nstat[p] != 0) != was_in) x.enter |= CROSS_MOVED;
         }
         if (root != before && last >= 0) {
-            hits++;
-            if (!visit(solid_hit(t, w->cross[last].prim, w->cross[last].enter, root))) break;
+            ++*hits;
+            if (!visit(solid_hit(t, w->cross[last].prim, w->cross[last].enter & 1, root))) return true;
         }
         if (!s->iface || moved < 0) continue;
         int was = mat;
-        mat = root ? owner(s, w) : -1;
+        mat = !root ? -1 : mixed ? owner_mixed(s, w, mixed) : owner(s, w);
         if (root && before && was >= 0 && mat >= 0 && other_material(s, was, mat)) {
             // a face between two materials inside the solid: a surface of the one entered
-            const Cross &x = w->cross[face_of(s, w, ray, tmax, g0, i)];
-            Hit h = solid_hit(t, x.prim, x.enter, true);
+            const Cross &x = w->cross[face_of(w, g0, i, was, mat)];
+            Hit h = solid_hit(t, x.prim, x.enter & 1, true);
             h.mat = mat;
             h.from = was;
-            hits++;
-            if (!visit(h)) break;
+            ++*hits;
+            if (!visit(h)) return true;
         }
     }
+    return false;
+}
+
+// Visit the visible surfaces along the ray in (0, tmax) in order; `visit` returns false to stop.
+// Returns the number of hits visited.
+template <class Visit>
+int sweep(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
+    if (s->root < 0) return 0;
+    int nc = 0, hits = 0;
+    bool root = sweep_start(s, w, ray, tmax, self, &nc);
+    sweep_crossings(s, w, nc, root, visit, &hits);
     return hits;
 }
 
@@ -3866,8 +3872,9 @@ struct FirstHit {
 };
 
 // Transmission along a shadow ray: the product of the transmit weights of every surface
-// crossed; stops at the first opaque one, at t.
-pray_rgb transmit_at(const Prim &q, R3 x, R3 d, bool ahead);
+// crossed, each of the material it shows (Hit::mat: on a face between two materials, the one
+// entered, as for any ray); stops at the first opaque one, at t.
+pray_rgb transmit_at(const Prim &qm, const Prim &q, R3 x, R3 d, bool ahead);
 
 struct ShadowHit {
     const Scene *s;
@@ -3875,9 +3882,9 @@ struct ShadowHit {
     pray_rgb f;
     real t;
     bool operator()(const Hit &x) {
-        if (x.from >= 0) return true;  // (a face between materials inside the solid: trace)
-        const Prim &q = s->prims[x.prim];
-        f = cmul(f, q.mat->kind == M_FLAT ? q.mat->transmit : transmit_at(q, ray->o + ray->d * x.t, ray->d, x.root_enter));
+        const Prim &q = s->prims[x.mat];
+        f = cmul(f, q.mat->kind == M_FLAT ? q.mat->transmit
+                                          : transmit_at(q, s->prims[x.prim], ray->o + ray->d * x.t, ray->d, x.root_enter));
         if (!czero(f)) return true;
         t = x.t;
         return false;
@@ -3937,14 +3944,23 @@ struct LightBuf {
 };
 
 // An action list, stored in Accel::data at off[L]:
-//   [na, np, set_inside, set_outside, na x (node, count, first), np x primitive]
+//   [na, np, set_inside, set_outside, 0, na x (node, count, first), np x primitive]
 // The active nodes are listed children first; `count` and `first` are the node's children that
 // are constant in the region, summed up: the thesis' "set inside" / "set outside" actions of
 // one node done at once. Then the "check" actions: the active primitives. List 0 is the empty
 // list of a region where the root is constant, so nothing can be hit there.
-const int LIST_HEAD = 4;  // the numbers before the nodes
+// A list with materials (lb_mixed: two materials may meet in the region, language 12) has its
+// length as fifth number, and after the primitives its materials' part, which eval_mixed
+// evaluates as the reference does:
+//   [na, na x (node, count, first, children), the children's lists]
+// Every node the region touches is listed, children first, but what is under a node outside
+// there; `count` and `first` sum up its children that are inside and not to be checked; at
+// `children` (from the part's start) its children to check, in the order owner_mixed reads
+// them (lb_mixed_list). Where the root is inside throughout, the list before that part is
+// empty.
+const int LIST_HEAD = 5;  // the numbers before the nodes
 inline const int *list_prims(const int *d) { return d + LIST_HEAD + 3 * d[0]; }
-inline int list_len(const int *d) { return LIST_HEAD + 3 * d[0] + d[1]; }
+inline int list_len(const int *d) { return d[4] ? d[4] : LIST_HEAD + 3 * d[0] + d[1]; }
 
 // A uniform grid of cubic voxels. A voxel that holds many primitives to check has a grid of its
 // own, nested in it (Accel::nested), whose voxels are classed in turn: fine where the scene is
@@ -3967,6 +3983,7 @@ struct Accel {
     Array<int> plan;
     int outer;         // list of the space outside the grid (everything without a grid)
     int freeze, merge, bounds;
+    int mixed;              // some list has materials (LIST_HEAD)
     int cache;              // option shadowcache
     LightBuf *lbuf;         // per light, then the eye's; or NULL (options lightbuffer, eyebuffer)
     int nlbuf;              // the lights'
@@ -4110,22 +4127,18 @@ struct ListBuilder {
     const Scene *s;
     Accel *a;
     unsigned char *dflt;   // class of each element when all primitives are outside, by code
+    int *pos;              // position of each element among its parent's children, by code
     int *base_in;          // per node: children inside by default (a difference: not its first)
     unsigned stamp, *mark; // per node: touched in the current region
     int *acc_in, *acc_bd;  // per node: children inside / on the boundary
     unsigned char *first_cls, *cls;  // per node: class of the first child; class (by code)
     int *head, *next;      // per node: touched children (a list through `next`, by code)
-    Array<int> touched, out, hash;
+    Array<int> touched, out, hash, mix;
     Array<int> rprims;           // lb_region: the region's primitives ...
     Array<unsigned char> rcls;   // ... and their classes there
+    const real *rlo, *rhi;       // the region's box, for lb_mixed (NULL: not a box)
+    const Box *obox;             // per primitive, where it may fill the solid (lb_mixed)
 };
-
-int elem_parent(const Scene *s, int e) {
-    return e_is_node(e) ? s->nodes[e_index(e)].parent : s->prims[e_index(e)].parent;
-}
-bool elem_first(const Scene *s, int e) {
-    return (e_is_node(e) ? s->nodes[e_index(e)].first : s->prims[e_index(e)].first) != 0;
-}
 
 int node_class(const Node &nd, int in, int bd, int first) {
     switch (nd.op) {
@@ -4145,6 +4158,7 @@ bool lb_init(ListBuilder &b, pray_ctx *c, const Scene *s, Accel *a) {
     b.a = a;
     size_t ne = 2 * (size_t)(s->prims.n > s->nodes.n ? s->prims.n : s->nodes.n) + 2, nn = (size_t)s->nodes.n + 1;
     b.dflt = (unsigned char *)mem_zalloc(c, ne);
+    b.pos = (int *)mem_zalloc(c, sizeof(int) * ne);
     b.cls = (unsigned char *)mem_zalloc(c, ne);
     b.next = (int *)mem_zalloc(c, sizeof(int) * ne);
     b.base_in = (int *)mem_zalloc(c, sizeof(int) * nn);
@@ -4155,16 +4169,18 @@ bool lb_init(ListBuilder &b, pray_ctx *c, const Scene *s, Accel *a) {
     b.head = (int *)mem_zalloc(c, sizeof(int) * nn);
     b.touched.init();
     b.out.init();
+    b.mix.init();
     b.hash.init();
     b.rprims.init();
     b.rcls.init();
-    if (!b.dflt || !b.cls || !b.next || !b.base_in || !b.mark || !b.acc_in || !b.acc_bd || !b.first_cls || !b.head)
+    if (!b.dflt || !b.pos || !b.cls || !b.next || !b.base_in || !b.mark || !b.acc_in || !b.acc_bd || !b.first_cls || !b.head)
         return false;
     for (int j = 0; j < s->nodes.n; j++) {  // children before parents
         const Node &nd = s->nodes[j];
         int in = 0, first = CL_OUT;
         for (int i = 0; i < nd.n; i++) {
             int k = s->kids[nd.k0 + i];
+            b.pos[k] = i;
             if (i == 0 && (nd.op == O_DIFF || nd.op == O_COMPL)) first = b.dflt[k];
             else in += b.dflt[k] == CL_IN;
         }
@@ -4177,6 +4193,7 @@ bool lb_init(ListBuilder &b, pray_ctx *c, const Scene *s, Accel *a) {
 void lb_release(ListBuilder &b) {
     pray_ctx *c = b.c;
     mem_free(c, b.dflt);
+    mem_free(c, b.pos);
     mem_free(c, b.cls);
     mem_free(c, b.next);
     mem_free(c, b.base_in);
@@ -4187,6 +4204,7 @@ void lb_release(ListBuilder &b) {
     mem_free(c, b.head);
     b.touched.release(c);
     b.out.release(c);
+    b.mix.release(c);
     b.hash.release(c);
     b.rprims.release(c);
     b.rcls.release(c);
@@ -4250,6 +4268,122 @@ int lb_store(ListBuilder &b) {
     return a->off.n - 1;
 }
 
+// May primitive p fill the solid with its material somewhere in the region (lb_list has classed
+// its ancestors there)? It must be able to (Prim::owns), and no ancestor may be outside there.
+bool lb_owns(const ListBuilder &b, int p) {
+    if (!b.s->prims[p].owns) return false;
+    for (int j = b.s->prims[p].parent; j >= 0; j = b.s->nodes[j].parent)
+        if (b.cls[2 * j + 1] == CL_OUT) return false;
+    return true;
+}
+
+// Where materials meet (Scene::iface): may two primitives of the region that may fill the solid
+// there (lb_owns), of different materials, meet in it? (Their boxes overlap within the region's,
+// and they are not apart for certain; a region crowded past MIXED_PAIRS primitives that may is
+// taken to be mixed, without trying every pair.) -1 when out of memory.
+const int MIXED_PAIRS = 64;
+
+int lb_mixed(ListBuilder &b, const int *prims, int n) {
+    const Scene *s = b.s;
+    Array<int> &own = b.mix;  // (lb_mixed_list fills it after)
+    own.n = 0;
+    for (int i = 0; i < n; i++)
+        if (lb_owns(b, prims[i]) && !own.push(b.c, prims[i])) return -1;
+    int m = 1;
+    while (m < own.n && !other_material(s, own[0], own[m])) m++;
+    if (m >= own.n) return 0;
+    if (own.n > MIXED_PAIRS) return 1;
+    for (int i = 0; i < own.n; i++)
+        for (int j = i + 1; j < own.n; j++) {
+            const Box &pb = b.obox[own[i]], &qb = b.obox[own[j]];
+            bool meet = true;
+            for (int l = 0; l < 3 && meet; l++) {
+                real lo = pb.lo[l] > qb.lo[l] ? pb.lo[l] : qb.lo[l];
+                real hi = pb.hi[l] < qb.hi[l] ? pb.hi[l] : qb.hi[l];
+                if (b.rlo) lo = lo > b.rlo[l] ? lo : b.rlo[l], hi = hi < b.rhi[l] ? hi : b.rhi[l];
+                meet = lo <= hi;
+            }
+            if (meet && other_material(s, own[i], own[j]) && !solids_apart(s->prims[own[i]], s->prims[own[j]])) return 1;
+        }
+    return 0;
+}
+
+// The materials' part of a region's list (see LIST_HEAD) into b.mix, once lb_list has classed
+// the nodes it touches (b.touched, sorted: children first, the root last) and linked each one's
+// touched children. What is under a node outside in the region decides nothing there and is
+// left out; a primitive inside the whole region is counted in its parent, and named only where
+// owner_mixed may stop at it. A node's children, in the order owner_mixed reads them: a union's
+// by position from the last, an intersection's or a difference's the one that fills it first;
+// each a listed node's 2 * entry + 1, a primitive to check 2 * index, one inside the whole
+// region -2 - index, -1 a child not listed but inside anyway (through a complement). False when
+// out of memory.
+bool lb_mixed_list(ListBuilder &b) {
+    const Scene *s = b.s;
+    Array<int> &kept = b.out, &x = b.mix;  // (lb_active fills b.out after)
+    kept.n = x.n = 0;
+    bool ok = true;
+    for (int i = b.touched.n - 1; i >= 0; i--) {  // (parents first)
+        int q = s->nodes[b.touched[i]].parent;
+        if (q >= 0 && b.cls[2 * q + 1] == CL_OUT) b.cls[2 * b.touched[i] + 1] = CL_OUT;
+    }
+    for (int i = 0; ok && i < b.touched.n; i++)
+        if (b.cls[2 * b.touched[i] + 1] != CL_OUT) ok = kept.push(b.c, b.touched[i]);
+    int na = kept.n;
+    for (int i = 0; ok && i < 1 + 4 * na; i++) ok = x.push(b.c, 0);
+    PRAY_ASSERT(!ok || kept[na - 1] == e_index(s->root));
+    for (int i = 0; ok && i < na; i++) {
+        int p = kept[i];
+        const Node &nd = s->nodes[p];
+        const int *kid = &s->kids[nd.k0];
+        bool lead = nd.op == O_DIFF || nd.op == O_COMPL, first_touched = false;
+        int cnt = nd.op == O_COMPL ? 0 : b.base_in[p], first = 0, at = x.n;
+        int one = nd.op == O_DIFF ? 0 : nd.n - 1;  // (the child that fills an intersection: as owner)
+        while (nd.op == O_INTER && one > 0 && e_is_node(kid[one]) && s->nodes[e_index(kid[one])].op == O_COMPL) one--;
+        ok = x.push(b.c, 0);
+        for (int k = b.head[p]; ok && k >= 0; k = b.next[k]) {
+            bool in_prim = !e_is_node(k) && b.cls[k] == CL_IN;
+            if (k == kid[0] && lead) {
+                first_touched = true;
+                if (nd.op == O_DIFF) first = in_prim;
+                else cnt = in_prim;
+            } else cnt += in_prim - (b.dflt[k] == CL_IN);
+            if (b.cls[k] != CL_OUT && (nd.op == O_UNION || !in_prim || k == kid[one])) ok = x.push(b.c, k);
+        }
+        if (!first_touched && nd.op == O_DIFF) first = b.dflt[kid[0]] == CL_IN;
+        if (!first_touched && nd.op == O_COMPL) cnt = b.dflt[kid[0]] == CL_IN;
+        bool one_listed = false;  // (an intersection or a difference filled by an untouched child: -1)
+        for (int k = at + 1; k < x.n; k++) one_listed = one_listed || x[k] == kid[one];
+        if (ok && (nd.op == O_INTER || nd.op == O_DIFF) && !one_listed) ok = x.push(b.c, -1);
+        for (int j = 0; ok && nd.op == O_UNION && b.dflt[2 * p + 1] == CL_IN && j < nd.n; j++) {
+            bool touched = false;  // (a union inside by default: rare, every child looked at)
+            for (int k = b.head[p]; k >= 0 && !touched; k = b.next[k]) touched = k == kid[j];
+            if (!touched && b.dflt[kid[j]] == CL_IN) ok = x.push(b.c, kid[j]);
+        }
+        int m = ok ? x.n - at - 1 : 0, *ch = x.p + at + 1;
+        for (int j = 1; j < m; j++)  // (insertion sorts: a node's children in a region are few)
+            for (int k = j; k > 0; k--) {
+                bool before = nd.op == O_UNION ? b.pos[ch[k]] > b.pos[ch[k - 1]] : ch[k] == kid[one] || ch[k] == -1;
+                if (!before) break;
+                int t = ch[k];
+                ch[k] = ch[k - 1];
+                ch[k - 1] = t;
+            }
+        for (int j = 0; j < m; j++) {
+            int e = ch[j], key = e_index(e);
+            if (e < 0) continue;
+            const int *f = e_is_node(e) ? (const int *)bsearch(&key, kept.p, (size_t)na, sizeof(int), int_cmp) : NULL;
+            ch[j] = e_is_node(e) ? (f ? 2 * (int)(f - kept.p) + 1 : -1) : b.cls[e] == CL_IN ? -2 - key : e;
+        }
+        x[at] = m;
+        int *en = x.p + 1 + 4 * i;
+        en[0] = p, en[1] = cnt, en[2] = first, en[3] = at;
+    }
+    if (ok) x[0] = na;
+    return ok;
+}
+
+bool lb_active(ListBuilder &b);
+
 // The list of a region, given the primitives it touches and their classes there.
 int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int n) {
     const Scene *s = b.s;
@@ -4279,15 +4413,32 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
         lb_contribute(b, 2 * p + 1, cl);
         if (2 * p + 1 == s->root) root_cls = cl;
     }
-    if (root_cls != CL_BD) return 0;
-    // the active part: boundary nodes reached from the root through boundary nodes
+    int mixed = root_cls != CL_OUT && s->iface ? lb_mixed(b, prims, n) : 0;
+    if (mixed < 0 || (mixed && !lb_mixed_list(b))) return -1;
+    if (!mixed && root_cls != CL_BD) return 0;
+    if (root_cls != CL_BD) {  // (inside throughout: nothing to check but the materials)
+        b.out.n = 0;
+        for (int i = 0; i < LIST_HEAD; i++)
+            if (!b.out.push(b.c, 0)) return -1;
+    } else if (!lb_active(b))
+        return -1;
+    for (int i = 0; mixed && i < b.mix.n; i++)
+        if (!b.out.push(b.c, b.mix[i])) return -1;
+    if (mixed) b.out[4] = b.out.n, b.a->mixed = 1;
+    return lb_store(b);
+}
+
+// The list of the region lb_list has classed into b.out: the active part, boundary nodes reached
+// from the root through boundary nodes.
+bool lb_active(ListBuilder &b) {
+    const Scene *s = b.s;
     b.out.n = 0;
-    int h[LIST_HEAD] = {0, 0, 0, 0};  // na, np, set inside, set outside
+    int h[LIST_HEAD] = {0, 0, 0, 0, 0};  // na, np, set inside, set outside, 0
     for (int i = 0; i < LIST_HEAD; i++)
-        if (!b.out.push(b.c, 0)) return -1;
+        if (!b.out.push(b.c, 0)) return false;
     Array<int> &stk = b.touched;  // reused: the touched nodes are done with
     stk.n = 0;
-    if (!stk.push(b.c, s->root)) return -1;
+    if (!stk.push(b.c, s->root)) return false;
     Array<int> nodes, prims_out;
     nodes.init();
     prims_out.init();
@@ -4325,9 +4476,9 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
     }
     nodes.release(b.c);
     prims_out.release(b.c);
-    if (!ok) return -1;
+    if (!ok) return false;
     for (int i = 0; i < LIST_HEAD; i++) b.out[i] = h[i];
-    return lb_store(b);
+    return true;
 }
 
 // The primitives of a region and their classes there, into b.rprims and b.rcls, for lb_list:
@@ -4837,7 +4988,10 @@ bool grid_lists(ListBuilder &b, Grid &G, GridPlan &gp, const Array<int> &cand, c
                     G.voxel[v] = -1 - g;
                     continue;
                 }
+                b.rlo = in.lo;
+                b.rhi = in.hi;
                 int L = lb_list(b, b.rprims.p, b.rcls.p, b.rprims.n);
+                b.rlo = b.rhi = NULL;
                 if (L < 0) return false;
                 G.voxel[v] = L;
             }
@@ -5601,7 +5755,7 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     for (int i = 0; a->cache && i < s->prims.n; i++) a->cache = model_clear(s->prims[i].mat) <= 1;
     a->bounds = opt_int(c, OPT_BOUNDS);
     if (!a->off.push(c, 0)) return c->status;  // list 0: nothing can be hit
-    for (int i = 0; i < 4; i++)
+    for (int i = 0; i < LIST_HEAD; i++)
         if (!a->data.push(c, 0)) return c->status;
     ListBuilder b;
     if (!lb_init(b, c, s, a)) {
@@ -5633,25 +5787,14 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
         double m = fabs((double)region.lo[l]) > fabs((double)region.hi[l]) ? fabs((double)region.lo[l]) : fabs((double)region.hi[l]);
         if (m > mag) mag = m;
     }
-    // With bounds, a primitive matters only where all its ancestors' boxes reach: outside a
-    // node's box the node is outside, and so is what its primitives alone would make of it
-    // (a box smaller than all of space implies that). So each primitive is placed in the grid
-    // by the intersection of the boxes from it up to the root.
-    Box *eff = (Box *)mem_alloc(c, sizeof(Box) * (size_t)(np + 1));
-    if (!eff) st = c->status;
-    if (st == PRAY_OK) {
-        Box *neff = (Box *)mem_alloc(c, sizeof(Box) * (size_t)(s->nodes.n + 1));
-        if (!neff) st = c->status;
-        for (int j = s->nodes.n - 1; neff && j >= 0; j--) {  // parents before children
-            neff[j] = s->nodes[j].box;
-            if (s->nodes[j].parent >= 0) box_clip(&neff[j], neff[s->nodes[j].parent]);
-        }
-        for (int i = 0; neff && i < np; i++) {
-            eff[i] = s->prims[i].box;
-            if (a->bounds && s->prims[i].parent >= 0) box_clip(&eff[i], neff[s->prims[i].parent]);
-        }
-        mem_free(c, neff);
-    }
+    // With bounds, each primitive is placed in the grid by the intersection of the boxes from
+    // it up to the root (prim_boxes); lists with materials always look there (lb_mixed).
+    Box *eff = (Box *)mem_alloc(c, sizeof(Box) * (size_t)(np + 1)), *clipped = NULL;
+    if (!eff || !prim_boxes(c, s, eff, a->bounds != 0)) st = c->status;
+    else if (s->iface && !a->bounds && !((clipped = (Box *)mem_alloc(c, sizeof(Box) * (size_t)(np + 1))) &&
+                                         prim_boxes(c, s, clipped, true)))
+        st = c->status;
+    b.obox = clipped ? clipped : eff;
     Array<int> cand, start;
     cand.init();
     start.init();
@@ -5726,6 +5869,7 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     cand.release(c);
     start.release(c);
     mem_free(c, eff);
+    mem_free(c, clipped);
     lb_release(b);
     if (st == PRAY_OK) st = accel_plans(c, s, a);
     accel_account(c, a, st == PRAY_OK);
@@ -5751,13 +5895,19 @@ inline bool frozen(const Scratch *w, int parent) {
     return parent >= 0 && (w->nfixed[parent] == w->ray || w->nfrozen[parent] == w->ray);
 }
 
+// The root keeps status st for the rest of the ray: nothing further can be seen on it, but where
+// materials meet a face between two may still come inside the solid.
+inline void root_settles(const Scene *s, Scratch *w, bool st) {
+    if (!st || !s->accel->mixed) w->root_fixed = 1;
+}
+
 // Element e is known to keep status st for the rest of the ray: tell its parent, which may then
 // know its own status for good and freeze its other children (3.5).
 void settle(const Scene *s, Scratch *w, int e, bool st) {
     for (;;) {
         int p = elem_parent(s, e);
         if (p < 0) {
-            if (e == s->root) w->root_fixed = 1;
+            if (e == s->root) root_settles(s, w, st);
             return;
         }
         if (frozen(w, p) || w->nfixed[p] == w->ray) return;
@@ -5773,8 +5923,8 @@ void settle(const Scene *s, Scratch *w, int e, bool st) {
         if (fix < 0) return;
         w->nfixed[p] = w->ray;
         w->nfixval[p] = (unsigned char)fix;
-        if (2 * p + 1 == s->root) {  // nothing more can be seen on this ray: no need to freeze
-            w->root_fixed = 1;
+        if (2 * p + 1 == s->root) {  // no need to freeze
+            root_settles(s, w, fix != 0);
             return;
         }
         e = 2 * p + 1;
@@ -5809,9 +5959,7 @@ bool propagate_live(const Scene *s, Scratch *w, int e, bool st) {
 
 inline void bump(const Scene *s, Scratch *w, int e) {
     int p = elem_parent(s, e);
-    if (p < 0 || w->nfixed[p] == w->ray) return;
-    if (elem_first(s, e) && s->nodes[p].op == O_DIFF) w->nfirst[p] = 1;
-    else w->cnt[p]++;
+    if (p >= 0 && w->nfixed[p] != w->ray) tally(s, w, e);
 }
 
 // The solids of a plan (list_plan) whose node's status is fixed for this ray: Hull::fixed 1 when
@@ -5833,7 +5981,7 @@ inline void fix_solid(const Scene *s, Scratch *w, const int *solids, int k) {
     w->nfixed[j] = w->ray;
     w->nfixval[j] = (unsigned char)solids[2 * k + 1];
     w->hull[k].fixed = 1;
-    if (2 * j + 1 == s->root) w->root_fixed = 1;
+    if (2 * j + 1 == s->root) root_settles(s, w, solids[2 * k + 1] != 0);
 }
 
 // The flat sweep of a list with a plan (list_plan), holed or not, on the part (a, b] of the ray
@@ -6096,6 +6244,67 @@ bool eval_full(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, const
     return false;
 }
 
+// owner in the region of a list with materials, from its materials' part x (LIST_HEAD), which
+// lists every element the region touches with the children owner looks at (lb_mixed_list):
+// from the root, its last entry.
+int owner_mixed(const Scene *s, const Scratch *w, const int *x) {
+    const int *nodes = x + 1;
+    for (int i = x[0] - 1;;) {
+        const int *ch = x + nodes[4 * i + 3];
+        int op = s->nodes[nodes[4 * i]].op, next = -1;
+        for (int k = 1; k <= ch[0] && next == -1 && op != O_COMPL; k++) {
+            int c = ch[k];
+            if (c == -1) return -1;  // (inside only through a complement)
+            if (op != O_UNION || c < -1 || (c & 1 ? w->nstat[nodes[4 * (c >> 1)]] : w->pstat[c >> 1])) next = c;
+        }
+        if (next == -1) return -1;
+        if (next < -1) return -2 - next;
+        if (!(next & 1)) return next >> 1;
+        i = next >> 1;
+    }
+}
+
+// The evaluation of a list with materials (LIST_HEAD) on (a, b]. While the ray is outside the
+// solid, a plain list's nearest entry; else the reference's sweep on the region: every element
+// of its materials' part gets its status at a from the spans of its primitives (and of those
+// inside the whole region, counted); every element left out keeps the status it has in the whole
+// region. Freezing is not used: a face between two materials may come while the root's status
+// is fixed.
+template <class Visit>
+PRAY_NOINLINE bool eval_mixed(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L, real a, real b,
+                              real tmax, int self, Visit &visit) {
+    const int *d = A->data.p + A->off[L], *x = list_prims(d) + d[1];
+    int at = A->plan_at[L], na = x[0], nc = 0, hits = 0;
+    if (at >= 0 && !A->plan[at + 1]) {
+        int r = eval_plain(s, A, w, ray, list_prims(d), d[1], A->plan.p + at, &a, b, tmax, self, visit);
+        if (r >= 0) return r != 0;
+    }
+    const int *nodes = x + 1;
+    for (int i = 0; i < na; i++) {
+        int j = nodes[4 * i];
+        w->cnt[j] = nodes[4 * i + 1];
+        w->nfirst[j] = (unsigned char)nodes[4 * i + 2];
+    }
+    for (int i = 0; i < na; i++) {  // (the primitives to check: in the children's lists)
+        const int *ch = x + nodes[4 * i + 3];
+        for (int k = 1; k <= ch[0]; k++) {
+            if (ch[k] < 0 || (ch[k] & 1)) continue;
+            int p = ch[k] >> 1;
+            const Span &sp = span_get(s, w, ray, p, self);
+            real t[4] = {sp.t0, sp.t1, 0, 0};
+            if (sp.kind == SPAN2) t[2] = w->span2[2 * p], t[3] = w->span2[2 * p + 1];
+            prim_at(s, w, p, sp.kind, t, a, b, tmax, &nc);
+        }
+    }
+    for (int i = 0; i < na; i++) {  // (children first)
+        int j = nodes[4 * i];
+        w->nstat[j] = node_status(s->nodes[j], w->cnt[j], w->nfirst[j]);
+        if (w->nstat[j]) tally(s, w, 2 * j + 1);
+    }
+    bool root = w->nstat[e_index(s->root)] != 0;  // (the root is a node: two primitives meet)
+    return sweep_crossings(s, w, nc, root, visit, &hits, x);
+}
+
 // Evaluate list L on the part (a, b] of the ray (and t < tmax): the one list evaluator. A list
 // with a plan takes its shortcuts, the nearest entry when it is plain, else (or when the visitor
 // goes on from there) the flat sweep; any other is evaluated in full. All three freeze what
@@ -6108,6 +6317,7 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
     w->k.checks += d[1];
     w->k.set_in += d[2];
     w->k.set_out += d[3];
+    if (d[4]) return eval_mixed(s, A, w, ray, L, a, b, tmax, self, visit);
     int at = A->plan_at[L];
     if (at < 0) return eval_full(s, A, w, ray, d, a, b, tmax, self, visit);
     const int *plan = A->plan.p + at;
@@ -6506,38 +6716,7 @@ bool drive(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visi
     return done;
 }
 
-// Where materials meet inside the solid (Scene::iface), the lists leave out the faces between
-// them: they trace a ray while it is outside the solid only. This visitor passes their hits on
-// until the ray is inside: it started there (its first hit leaves the solid), or the visitor goes
-// on into the solid; then `inside` is set, and the reference sweep (section 9) takes the rest of
-// the ray, after `done`.
-template <class Visit>
-struct Outside {
-    Visit &v;
-    real done;
-    int hits, inside;
-    explicit Outside(Visit &v_) : v(v_), done(-REAL_INF), hits(0), inside(0) {}
-    bool operator()(const Hit &h) {
-        hits++;
-        if (!h.root_enter) inside = 1;          // it was inside from its start
-        else if (v(h)) inside = 1, done = h.t;  // the visitor goes on into the solid
-        return false;
-    }
-};
-template <class Visit>
-inline real visit_end(const Outside<Visit> &o) { return o.inside ? REAL_INF : visit_end(o.v); }
-
-// The hits of the reference sweep after t = done.
-template <class Visit>
-struct After {
-    Visit &v;
-    real done;
-    After(Visit &v_, real done_) : v(v_), done(done_) {}
-    bool operator()(const Hit &h) { return h.t <= done || v(h); }
-};
-
-// All hits along the ray in (0, tmax), by the reference or the accelerated path. (Where
-// materials meet, a ray that may be inside the solid goes through across.)
+// All hits along the ray in (0, tmax), by the reference or the accelerated path.
 template <class Visit>
 void find_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit) {
     if (!s->accel) {
@@ -6653,28 +6832,6 @@ void primary_hits(const Scene *s, Scratch *w, const Ray &ray, real tmax, Visit &
     }
     w->k.ebuf += 1;
     drive(s, w, ray, tmax, -1, visit, eye.run ? &eye : NULL);
-}
-
-// A ray of a scene where materials meet (Scene::iface), instead of find_hits or primary_hits
-// (`primary`): the lists while the ray is outside the solid, then the reference sweep (Outside).
-// `inside`: whether the ray starts inside the solid (1), outside (0), or unknown (-1).
-template <class Visit>
-PRAY_NOINLINE void across(const Scene *s, Scratch *w, const Ray &ray, real tmax, int self, Visit &visit, int inside,
-                          bool primary) {
-    real done = -REAL_INF;
-    if (s->accel && inside != 1) {
-        Outside<Visit> o(visit);
-        if (primary) primary_hits(s, w, ray, tmax, o);
-        else find_hits(s, w, ray, tmax, self, o);
-        if (!o.inside && (o.hits || inside == 0 || !starts_inside(s, w, ray))) return;
-        done = o.done;
-    }
-    After<Visit> rest(visit, done);
-    sweep(s, w, ray, tmax, self, rest, s->accel != NULL);  // (the reference's way, with boxes)
-    if (w->rbits && s->accel) {
-        real e = visit_end(visit);
-        region_note(w, ray, e < tmax ? e : tmax);
-    }
 }
 
 // =============================================================================================
@@ -7617,7 +7774,6 @@ static const unsigned char FONT6X9[95][9] = {
 struct Tracer {
     const Scene *s;
     Scratch *w;
-    int eye_in;   // primary rays start inside the solid: 1, outside: 0, unknown: -1 (across)
     int seen;     // of the surfaces primary rays met that take light: bit 0 one that no light
                   // reaches, bit 1 one that a light adds to (the warning of language 12)
     pray_rgb bg;  // background of the current pixel's row
@@ -7818,11 +7974,11 @@ void shade_at(const Prim &q, R3 x, Shade *sh, double *ts, double *tt, R3 *ds, R3
     }
 }
 
-pray_rgb transmit_at(const Prim &q, R3 x, R3 d, bool ahead) {
+pray_rgb transmit_at(const Prim &qm, const Prim &q, R3 x, R3 d, bool ahead) {
     double s, t;
     R3 ds, dt;
     Shade sh;
-    shade_at(q, x, &sh, &s, &t, &ds, &dt, q, d, ahead);
+    shade_at(qm, x, &sh, &s, &t, &ds, &dt, q, d, ahead);
     return sh.transmit;
 }
 
@@ -7916,10 +8072,6 @@ inline bool refract_dir(R3 d, R3 n, double eta, R3 *out) {
     return true;
 }
 
-// A ray reflected back to the side a ray came from starts inside the solid where the ray was
-// inside before hit h.
-inline int inside_before(const Hit &h) { return !h.root_enter || h.from >= 0; }
-
 // The ratio of the refractive indices across hit h at x (m: the model that shades it): the
 // material the ray leaves over the one it enters; empty space counts 1.
 double hit_eta(const Scene *s, const Hit &h, R3 x, R3 d, const Shade &m) {
@@ -7944,10 +8096,7 @@ inline bool worth_tracing(Tracer &tr, int level, double weight) {
 
 // The colour a ray brings back; `seen`, when given, receives what it saw; `weight`: how much of
 // it reaches the sample, at most, in any channel.
-// `inside`: whether the ray starts inside the solid (1, 0, -1 unknown; across), for rays other
-// than primary ones.
-pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *seen = NULL, double weight = 1,
-               int inside = -1) {
+pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *seen = NULL, double weight = 1) {
     const Scene *s = tr.s;
     if (seen) seen->hit = -1, seen->lit_only = 0, seen->st[0] = seen->st[1] = 0;
     if (level > s->depth) return cmake(0, 0, 0);
@@ -7959,11 +8108,7 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
     tr.w->k.rays[kind] += 1;
     FirstHit fh;
     fh.found = false;
-    // where materials meet, a ray that starts inside the solid is traced across them (a first hit
-    // from outside is where the solid is entered, as before)
-    if (kind == RAY_PRIMARY) inside = tr.eye_in;
-    if (s->iface && inside) across(s, tr.w, ray, REAL_INF, self, fh, inside, kind == RAY_PRIMARY);
-    else if (kind == RAY_PRIMARY) primary_hits(s, tr.w, ray, REAL_INF, fh);
+    if (kind == RAY_PRIMARY) primary_hits(s, tr.w, ray, REAL_INF, fh);
     else find_hits(s, tr.w, ray, REAL_INF, self, fh);
     if (!fh.found) return tr.bg;
     const Hit &h = fh.h;
@@ -8029,7 +8174,7 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
             refl = cadd(refl, m->transmit);  // total internal reflection
         } else if (worth_tracing(tr, level, wt)) {
             rr.o = x;
-            col = cadd(col, cmul(m->transmit, trace(tr, rr, level + 1, h.prim, RAY_REFRACT, NULL, wt, h.root_enter)));
+            col = cadd(col, cmul(m->transmit, trace(tr, rr, level + 1, h.prim, RAY_REFRACT, NULL, wt)));
         }
     }
     double wr = weight * rgb_maxabs(refl);
@@ -8037,7 +8182,7 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
         Ray rr;
         rr.o = x;
         rr.d = unit(ray.d - n * (2 * dot(n, ray.d)));
-        col = cadd(col, cmul(refl, trace(tr, rr, level + 1, h.prim, RAY_REFLECT, NULL, wr, inside_before(h))));
+        col = cadd(col, cmul(refl, trace(tr, rr, level + 1, h.prim, RAY_REFLECT, NULL, wr)));
     }
     return col;
 }
@@ -8365,8 +8510,7 @@ void first_hit(Worker &k, Ray ray, pray_hit *h, pray_rgb *albedo) {
     ray.d = unit(ray.d);
     FirstHit fh;
     fh.found = false;
-    if (k.job->s->iface) across(k.job->s, &k.w, ray, REAL_INF, -1, fh, -1, false);
-    else find_hits(k.job->s, &k.w, ray, REAL_INF, -1, fh);
+    find_hits(k.job->s, &k.w, ray, REAL_INF, -1, fh);
     h->primitive = h->id = -1;
     h->t = HUGE_VAL;
     h->normal = vmake(0, 0, 0);
@@ -8771,7 +8915,6 @@ pray_status render_scene(pray_ctx *c, const Scene *s, const pray_rect &r, const 
         else if (job.adaptive > 0 && !k.cache.reserve(c, (job.tile + 1) * (job.tile + 1))) st = c->status;
         k.tr.s = s;
         k.tr.w = &k.w;
-        k.tr.eye_in = s->parallel ? -1 : c->eye_inside;  // (a parallel camera's rays start apart)
         k.w.rg = job.rg;
         args[made] = &k;
     }
@@ -10958,8 +11101,7 @@ int pray_intersect(pray_ctx *c, pray_scene *q, pray_vec origin, pray_vec dir, do
     ch.max = max_hits;
     ch.n = 0;
     real t = tmax >= HUGE_VAL ? REAL_INF : (real)tmax;
-    if (q->s.iface) across(&q->s, &q->w, ch.ray, t, -1, ch, -1, false);
-    else find_hits(&q->s, &q->w, ch.ray, t, -1, ch);
+    find_hits(&q->s, &q->w, ch.ray, t, -1, ch);
     return ch.n;
 }
 

@@ -82,6 +82,26 @@ TEST_CASE("interfaces: a clear solid of index 1 standing on a floor and sunk int
     }
 }
 
+TEST_CASE("interfaces: what stands inside a clear solid of index 1 casts its own shadow") {
+    // a matte ball and a rod inside a clear block that stands on the floor, the rod on the
+    // block's floor: the block is invisible, so the image is theirs alone, shadows and all (a
+    // face between two materials stops or filters a shadow ray as any surface does); a tinted
+    // slab apart on the floor casts its tinted shadow in both
+    std::string parts = "Ball = sphere(Table, [-0.5, -0.4, 0.6], 0.4)\n"
+                        "Rod = rod(Table, [0.6, 0.2, 0], [0.6, 0.2, 1.1], 0.15)\n"
+                        "Tint = box(transparent({0.3, 0.9, 0.5}, 1), [-2, 1, 0], [-1, 1.1, 1.3])\n";
+    std::string prog = std::string(CAMERA) + parts +
+                       "Block = box(transparent({1}, 1), [-1.2, -1, 0], [1, 0.5, 1.5])\n"
+                       "rendertiff Block | Ball | Rod | Tint | Floor, L\n"
+                       "rendertiff Ball | Rod | Tint | Floor, L\n";
+    for (const auto &o : SETTINGS) {
+        CAPTURE(o.size() ? o[0] : std::string("default"));
+        std::vector<Frame> f = frames_of(prog, o);
+        REQUIRE(f.size() == 2);
+        CHECK(steps_apart(f[0], f[1]) <= 1);
+    }
+}
+
 TEST_CASE("interfaces: two glass boxes of one material sharing a face render as one box") {
     // the halves' models are equal values made apart (two handles)
     std::string prog = std::string(CAMERA) + "G1 = transparent({0.9}, 1.5) + phong({0}, {0.6}, 60)\n"
