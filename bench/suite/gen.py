@@ -677,7 +677,7 @@ def scenes():
 
 
 def main():
-    if len(sys.argv) != 2:
+    if len(sys.argv) != 2 or sys.argv[1].startswith("-"):  # (--help is no directory)
         sys.exit("usage: gen.py OUTDIR")
     out = sys.argv[1]
     os.makedirs(out, exist_ok=True)
