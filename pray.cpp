@@ -10,11 +10,11 @@
    [SECTION] 4     200  Vector math and the `.` transformations
    [SECTION] 5     700  Scene values: models, lights, solids (reference counted handles)
    [SECTION] 6     150  Options
-   [SECTION] 7    1155  Prepared scene: flattened n-ary CSG tree, boxes, simplification, snapping
+   [SECTION] 7    1165  Prepared scene: flattened n-ary CSG tree, boxes, simplification, snapping
    [SECTION] 8     450  Ray/primitive intersection; primitives in a frame (box, rod, cone, torus,
                           stretched)
    [SECTION] 9     450  CSG status-tree sweep (the brute-force reference, thesis 3.4)
-   [SECTION] 9b   2940  Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
+   [SECTION] 9b   2936  Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
                           [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas
                           and jumps, [9b.4] light and eye buffers, [9b.5] accel_build; per ray: [9b.6]
                           list evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver
@@ -3041,19 +3041,29 @@ bool prim_boxes(pray_ctx *c, const Scene *s, Box *out, bool clip) {
     return true;
 }
 
+// The child whose material fills a node wherever the node holds the point (language 12): a
+// difference's first, an intersection's last that is not a complement; -1 for a union (the
+// last child holding the point: owner) and a complement (no primitive's material).
+int fill_child(const Scene *s, const Node &nd) {
+    if (nd.op != O_DIFF && nd.op != O_INTER) return -1;
+    const int *k = &s->kids[nd.k0];
+    int i = nd.op == O_DIFF ? 0 : nd.n - 1;
+    while (nd.op == O_INTER && i > 0 && e_is_node(k[i]) && s->nodes[e_index(k[i])].op == O_COMPL) i--;
+    return i;
+}
+
 // Prim::owns, from the root down (a parent is numbered after its children), as owner (section
-// 9) descends: every child of a union, the first of a difference, the last of an intersection
-// that is not a complement, nothing under a complement. `own`: per node, zeroed.
+// 9) descends: every child of a union, the one that fills a difference or an intersection
+// (fill_child), nothing under a complement. `own`: per node, zeroed.
 void scene_owners(Scene *s, unsigned char *own) {
     for (int i = 0; i < s->prims.n; i++) s->prims[i].owns = s->root == 2 * i;
     if (e_is_node(s->root)) own[e_index(s->root)] = 1;
     for (int j = s->nodes.n - 1; j >= 0; j--) {
         const Node &nd = s->nodes[j];
         const int *k = &s->kids[nd.k0];
-        int last = nd.n - 1;
-        while (nd.op == O_INTER && last > 0 && e_is_node(k[last]) && s->nodes[e_index(k[last])].op == O_COMPL) last--;
+        int fill = fill_child(s, nd);
         for (int i = 0; own[j] && nd.op != O_COMPL && i < nd.n; i++) {
-            if ((nd.op == O_DIFF && i > 0) || (nd.op == O_INTER && i != last)) continue;
+            if (nd.op != O_UNION && i != fill) continue;
             if (e_is_node(k[i])) own[e_index(k[i])] = 1;
             else s->prims[e_index(k[i])].owns = 1;
         }
@@ -3068,9 +3078,10 @@ pray_status scene_interfaces(pray_ctx *c, Scene *s) {
     if (!own) return c->status;
     scene_owners(s, own);
     mem_free(c, own);
-    int n = s->prims.n, k = 0, m = 0;
+    int n = s->prims.n, k = 0;
     while (k < n && !s->prims[k].owns) k++;
-    for (m = k + 1; m < n && !(s->prims[m].owns && other_material(s, m, k));) m++;
+    int m = k + 1;
+    while (m < n && !(s->prims[m].owns && other_material(s, m, k))) m++;
     s->iface = m < n;
     return PRAY_OK;
 }
@@ -3700,13 +3711,11 @@ int owner(const Scene *s, const Scratch *w) {
     while (e_is_node(e)) {
         const Node &nd = s->nodes[e_index(e)];
         const int *k = &s->kids[nd.k0];
-        int i = nd.op == O_DIFF ? 0 : nd.n - 1;
+        int i = nd.op == O_UNION ? nd.n - 1 : fill_child(s, nd);
         if (nd.op == O_UNION)
             for (; i >= 0; i--)
                 if (e_is_node(k[i]) ? w->nstat[e_index(k[i])] : w->pstat[e_index(k[i])]) break;
-        if (nd.op == O_INTER)
-            while (i > 0 && e_is_node(k[i]) && s->nodes[e_index(k[i])].op == O_COMPL) i--;
-        if (nd.op == O_COMPL || i < 0) return -1;
+        if (i < 0) return -1;
         e = k[i];
     }
     return e_index(e);
@@ -4337,8 +4346,7 @@ bool lb_mixed_list(ListBuilder &b) {
         const int *kid = &s->kids[nd.k0];
         bool lead = nd.op == O_DIFF || nd.op == O_COMPL, first_touched = false;
         int cnt = nd.op == O_COMPL ? 0 : b.base_in[p], first = 0, at = x.n;
-        int one = nd.op == O_DIFF ? 0 : nd.n - 1;  // (the child that fills an intersection: as owner)
-        while (nd.op == O_INTER && one > 0 && e_is_node(kid[one]) && s->nodes[e_index(kid[one])].op == O_COMPL) one--;
+        int one = fill_child(s, nd), fill = one >= 0 ? kid[one] : -2;  // (-2: no element)
         ok = x.push(b.c, 0);
         for (int k = b.head[p]; ok && k >= 0; k = b.next[k]) {
             bool in_prim = !e_is_node(k) && b.cls[k] == CL_IN;
@@ -4347,13 +4355,13 @@ bool lb_mixed_list(ListBuilder &b) {
                 if (nd.op == O_DIFF) first = in_prim;
                 else cnt = in_prim;
             } else cnt += in_prim - (b.dflt[k] == CL_IN);
-            if (b.cls[k] != CL_OUT && (nd.op == O_UNION || !in_prim || k == kid[one])) ok = x.push(b.c, k);
+            if (b.cls[k] != CL_OUT && (nd.op == O_UNION || !in_prim || k == fill)) ok = x.push(b.c, k);
         }
         if (!first_touched && nd.op == O_DIFF) first = b.dflt[kid[0]] == CL_IN;
         if (!first_touched && nd.op == O_COMPL) cnt = b.dflt[kid[0]] == CL_IN;
-        bool one_listed = false;  // (an intersection or a difference filled by an untouched child: -1)
-        for (int k = at + 1; k < x.n; k++) one_listed = one_listed || x[k] == kid[one];
-        if (ok && (nd.op == O_INTER || nd.op == O_DIFF) && !one_listed) ok = x.push(b.c, -1);
+        bool fill_listed = false;  // (an intersection or a difference filled by an untouched child: -1)
+        for (int k = at + 1; k < x.n; k++) fill_listed = fill_listed || x[k] == fill;
+        if (ok && (nd.op == O_INTER || nd.op == O_DIFF) && !fill_listed) ok = x.push(b.c, -1);
         for (int j = 0; ok && nd.op == O_UNION && b.dflt[2 * p + 1] == CL_IN && j < nd.n; j++) {
             bool touched = false;  // (a union inside by default: rare, every child looked at)
             for (int k = b.head[p]; k >= 0 && !touched; k = b.next[k]) touched = k == kid[j];
@@ -4362,7 +4370,7 @@ bool lb_mixed_list(ListBuilder &b) {
         int m = ok ? x.n - at - 1 : 0, *ch = x.p + at + 1;
         for (int j = 1; j < m; j++)  // (insertion sorts: a node's children in a region are few)
             for (int k = j; k > 0; k--) {
-                bool before = nd.op == O_UNION ? b.pos[ch[k]] > b.pos[ch[k - 1]] : ch[k] == kid[one] || ch[k] == -1;
+                bool before = nd.op == O_UNION ? b.pos[ch[k]] > b.pos[ch[k - 1]] : ch[k] == fill || ch[k] == -1;
                 if (!before) break;
                 int t = ch[k];
                 ch[k] = ch[k - 1];

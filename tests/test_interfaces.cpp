@@ -62,6 +62,16 @@ const char *CAMERA = "lookat [3, -6, 4], [0, 0, 0.4], <0, 0, 1>, 40\n"
 
 const std::vector<std::vector<std::string>> SETTINGS = {{}, {"brute=1"}, {"grid=6", "plans=0"}, {"grid=3", "freeze=0"}};
 
+// The program's two frames, under every setting, within one output step of each other.
+void check_frames_alike(const std::string &prog) {
+    for (const auto &o : SETTINGS) {
+        CAPTURE(o.size() ? o[0] : std::string("default"));
+        std::vector<Frame> f = frames_of(prog, o);
+        REQUIRE(f.size() == 2);
+        CHECK(steps_apart(f[0], f[1]) <= 1);
+    }
+}
+
 } // namespace
 
 TEST_CASE("interfaces: a clear solid of index 1 standing on a floor and sunk into it renders as the floor alone") {
@@ -74,12 +84,7 @@ TEST_CASE("interfaces: a clear solid of index 1 standing on a floor and sunk int
                        "Ball = sphere(Clear, [-0.3, -1.6, 0], 0.5)\n"
                        "rendertiff Block | Rod | Ball | Floor, L\n"
                        "rendertiff Floor, L\n";
-    for (const auto &o : SETTINGS) {
-        CAPTURE(o.size() ? o[0] : std::string("default"));
-        std::vector<Frame> f = frames_of(prog, o);
-        REQUIRE(f.size() == 2);
-        CHECK(steps_apart(f[0], f[1]) <= 1);
-    }
+    check_frames_alike(prog);
 }
 
 TEST_CASE("interfaces: what stands inside a clear solid of index 1 casts its own shadow") {
@@ -94,12 +99,7 @@ TEST_CASE("interfaces: what stands inside a clear solid of index 1 casts its own
                        "Block = box(transparent({1}, 1), [-1.2, -1, 0], [1, 0.5, 1.5])\n"
                        "rendertiff Block | Ball | Rod | Tint | Floor, L\n"
                        "rendertiff Ball | Rod | Tint | Floor, L\n";
-    for (const auto &o : SETTINGS) {
-        CAPTURE(o.size() ? o[0] : std::string("default"));
-        std::vector<Frame> f = frames_of(prog, o);
-        REQUIRE(f.size() == 2);
-        CHECK(steps_apart(f[0], f[1]) <= 1);
-    }
+    check_frames_alike(prog);
 }
 
 TEST_CASE("interfaces: two glass boxes of one material sharing a face render as one box") {
