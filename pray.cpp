@@ -14,7 +14,7 @@
    [SECTION] 8     450  Ray/primitive intersection; primitives in a frame (box, rod, cone, torus,
                           stretched)
    [SECTION] 9     450  CSG status-tree sweep (the brute-force reference, thesis 3.4)
-   [SECTION] 9b   2936  Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
+   [SECTION] 9b   2942  Acceleration: action lists, uniform grid, traversal, freezing, areas (3.3-3.6)
                           [9b.1] the structure; building: [9b.2] lists and plans, [9b.3] the grid, areas
                           and jumps, [9b.4] light and eye buffers, [9b.5] accel_build; per ray: [9b.6]
                           list evaluation with freezing, [9b.7] stretch sources, [9b.8] the ray driver
@@ -29,7 +29,7 @@
    [SECTION] 14   1650  PRAY interpreter: values, operators, builtins, statements
    [SECTION] 15    200  One-call helpers and the running of programs
    [SECTION] 16    800  Command-line program (PRAY_MAIN)
-   The whole file: at most 15375 lines.
+   The whole file: at most 15435 lines.
 */
 
 // =============================================================================================
@@ -3796,6 +3796,26 @@ bool starts_inside(const Scene *s, Scratch *w, const Ray &ray) {
     return sweep_start(s, w, ray, 0, -1, &nc);
 }
 
+// May a primary ray of the render start inside the solid? The eye of a perspective camera
+// (starts_inside), any point of a parallel camera's window in the solid's box. -1 when out of
+// memory.
+int primaries_inside(pray_ctx *c, const Scene *s) {
+    if (s->root < 0) return s->root == E_ALL;
+    const Box &b = elem_box(s, s->root);
+    for (int l = 0; s->parallel && l < 3; l++) {
+        real e = comp(s->eye, l), r = (real)(fabs(comp(s->cx, l)) + fabs(comp(s->cy, l)));
+        if (e + r < b.lo[l] || e - r > b.hi[l]) return 0;
+    }
+    if (s->parallel) return 1;
+    Scratch w;
+    Ray eye;
+    eye.o = s->eye;
+    eye.d = s->dir;
+    int in = scratch_init(c, &w, s) ? starts_inside(s, &w, eye) : -1;
+    scratch_release(c, &w);
+    return in;
+}
+
 // The face where materials meet at the crossings [g0, g1) of a sweep, all at one t, the ray
 // going from the material of primitive `was` into that of `mat`: the last crossing whose status
 // its primitive took and that changed its parent's status (CROSS_MOVED) or is a face of `was`
@@ -3883,7 +3903,7 @@ struct FirstHit {
 // Transmission along a shadow ray: the product of the transmit weights of every surface
 // crossed, each of the material it shows (Hit::mat: on a face between two materials, the one
 // entered, as for any ray); stops at the first opaque one, at t.
-pray_rgb transmit_at(const Prim &qm, const Prim &q, R3 x, R3 d, bool ahead);
+pray_rgb transmit_at(const Scene *s, const Ray &ray, const Hit &x);
 
 struct ShadowHit {
     const Scene *s;
@@ -3891,9 +3911,7 @@ struct ShadowHit {
     pray_rgb f;
     real t;
     bool operator()(const Hit &x) {
-        const Prim &q = s->prims[x.mat];
-        f = cmul(f, q.mat->kind == M_FLAT ? q.mat->transmit
-                                          : transmit_at(q, s->prims[x.prim], ray->o + ray->d * x.t, ray->d, x.root_enter));
+        f = cmul(f, transmit_at(s, *ray, x));
         if (!czero(f)) return true;
         t = x.t;
         return false;
@@ -3993,6 +4011,9 @@ struct Accel {
     int outer;         // list of the space outside the grid (everything without a grid)
     int freeze, merge, bounds;
     int mixed;              // some list has materials (LIST_HEAD)
+    // The lists find faces between materials (lb_mixed); a render's leave them out (left_out, where
+    // two may meet) when none of its rays can be inside the solid (accel_build).
+    int faces, left_out;
     int cache;              // option shadowcache
     LightBuf *lbuf;         // per light, then the eye's; or NULL (options lightbuffer, eyebuffer)
     int nlbuf;              // the lights'
@@ -4145,7 +4166,7 @@ struct ListBuilder {
     Array<int> touched, out, hash, mix;
     Array<int> rprims;           // lb_region: the region's primitives ...
     Array<unsigned char> rcls;   // ... and their classes there
-    const real *rlo, *rhi;       // the region's box, for lb_mixed (NULL: not a box)
+    real rlo[3], rhi[3], rbox;   // the region's box, for lb_mixed (rbox 0: not a box)
     const Box *obox;             // per primitive, where it may fill the solid (lb_mixed)
 };
 
@@ -4309,7 +4330,7 @@ int lb_mixed(ListBuilder &b, const int *prims, int n) {
             for (int l = 0; l < 3 && meet; l++) {
                 real lo = pb.lo[l] > qb.lo[l] ? pb.lo[l] : qb.lo[l];
                 real hi = pb.hi[l] < qb.hi[l] ? pb.hi[l] : qb.hi[l];
-                if (b.rlo) lo = lo > b.rlo[l] ? lo : b.rlo[l], hi = hi < b.rhi[l] ? hi : b.rhi[l];
+                if (b.rbox) lo = lo > b.rlo[l] ? lo : b.rlo[l], hi = hi < b.rhi[l] ? hi : b.rhi[l];
                 meet = lo <= hi;
             }
             if (meet && other_material(s, own[i], own[j]) && !solids_apart(s->prims[own[i]], s->prims[own[j]])) return 1;
@@ -4421,7 +4442,7 @@ int lb_list(ListBuilder &b, const int *prims, const unsigned char *classes, int 
         lb_contribute(b, 2 * p + 1, cl);
         if (2 * p + 1 == s->root) root_cls = cl;
     }
-    int mixed = root_cls != CL_OUT && s->iface ? lb_mixed(b, prims, n) : 0;
+    int mixed = root_cls != CL_OUT && b.a->faces ? lb_mixed(b, prims, n) : 0;
     if (mixed < 0 || (mixed && !lb_mixed_list(b))) return -1;
     if (!mixed && root_cls != CL_BD) return 0;
     if (root_cls != CL_BD) {  // (inside throughout: nothing to check but the materials)
@@ -4996,10 +5017,10 @@ bool grid_lists(ListBuilder &b, Grid &G, GridPlan &gp, const Array<int> &cand, c
                     G.voxel[v] = -1 - g;
                     continue;
                 }
-                b.rlo = in.lo;
-                b.rhi = in.hi;
+                for (int l = 0; l < 3; l++) b.rlo[l] = in.lo[l], b.rhi[l] = in.hi[l];
+                b.rbox = 1;
                 int L = lb_list(b, b.rprims.p, b.rcls.p, b.rprims.n);
-                b.rlo = b.rhi = NULL;
+                b.rbox = 0;
                 if (L < 0) return false;
                 G.voxel[v] = L;
             }
@@ -5762,6 +5783,13 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     a->cache = opt_int(c, OPT_SHADOWCACHE);
     for (int i = 0; a->cache && i < s->prims.n; i++) a->cache = model_clear(s->prims[i].mat) <= 1;
     a->bounds = opt_int(c, OPT_BOUNDS);
+    // (a ray is inside the solid only where a surface lets light through, or at its start)
+    a->faces = s->iface && !render;
+    for (int i = 0; s->iface && !a->faces && i < s->prims.n; i++) a->faces = model_clear(s->prims[i].mat) != 0;
+    int inside = s->iface && !a->faces ? primaries_inside(c, s) : 0;
+    if (inside < 0) return c->status;
+    a->faces = a->faces || inside;
+    a->left_out = s->iface && !a->faces;
     if (!a->off.push(c, 0)) return c->status;  // list 0: nothing can be hit
     for (int i = 0; i < LIST_HEAD; i++)
         if (!a->data.push(c, 0)) return c->status;
@@ -6272,22 +6300,17 @@ int owner_mixed(const Scene *s, const Scratch *w, const int *x) {
     }
 }
 
-// The evaluation of a list with materials (LIST_HEAD) on (a, b]. While the ray is outside the
-// solid, a plain list's nearest entry; else the reference's sweep on the region: every element
+// The evaluation of a list with materials d (LIST_HEAD) on (a, b], from where a plain plan's
+// nearest entry left off (eval_list): the reference's sweep on the region. Every element
 // of its materials' part gets its status at a from the spans of its primitives (and of those
 // inside the whole region, counted); every element left out keeps the status it has in the whole
 // region. Freezing is not used: a face between two materials may come while the root's status
 // is fixed.
 template <class Visit>
-PRAY_NOINLINE bool eval_mixed(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L, real a, real b,
-                              real tmax, int self, Visit &visit) {
-    const int *d = A->data.p + A->off[L], *x = list_prims(d) + d[1];
-    int at = A->plan_at[L], na = x[0], nc = 0, hits = 0;
-    if (at >= 0 && !A->plan[at + 1]) {
-        int r = eval_plain(s, A, w, ray, list_prims(d), d[1], A->plan.p + at, &a, b, tmax, self, visit);
-        if (r >= 0) return r != 0;
-    }
-    const int *nodes = x + 1;
+PRAY_NOINLINE bool eval_mixed(const Scene *s, Scratch *w, const Ray &ray, const int *d, real a, real b, real tmax,
+                              int self, Visit &visit) {
+    const int *x = list_prims(d) + d[1], *nodes = x + 1;
+    int na = x[0], nc = 0, hits = 0;
     for (int i = 0; i < na; i++) {
         int j = nodes[4 * i];
         w->cnt[j] = nodes[4 * i + 1];
@@ -6315,8 +6338,9 @@ PRAY_NOINLINE bool eval_mixed(const Scene *s, const Accel *A, Scratch *w, const 
 
 // Evaluate list L on the part (a, b] of the ray (and t < tmax): the one list evaluator. A list
 // with a plan takes its shortcuts, the nearest entry when it is plain, else (or when the visitor
-// goes on from there) the flat sweep; any other is evaluated in full. All three freeze what
-// settles (3.5). Returns true when `visit` stopped or nothing further can be seen on the ray.
+// goes on from there) the flat sweep, or a list with materials its sweep; any other is evaluated
+// in full. All but the materials' sweep freeze what settles (3.5). Returns true when `visit`
+// stopped or nothing further can be seen on the ray.
 template <class Visit>
 bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L, real a, real b, real tmax,
                int self, Visit &visit) {
@@ -6325,14 +6349,14 @@ bool eval_list(const Scene *s, const Accel *A, Scratch *w, const Ray &ray, int L
     w->k.checks += d[1];
     w->k.set_in += d[2];
     w->k.set_out += d[3];
-    if (d[4]) return eval_mixed(s, A, w, ray, L, a, b, tmax, self, visit);
     int at = A->plan_at[L];
-    if (at < 0) return eval_full(s, A, w, ray, d, a, b, tmax, self, visit);
-    const int *plan = A->plan.p + at;
-    if (!plan[1]) {
+    const int *plan = at >= 0 ? A->plan.p + at : NULL;
+    if (plan && !plan[1]) {
         int r = eval_plain(s, A, w, ray, list_prims(d), d[1], plan, &a, b, tmax, self, visit);
         if (r >= 0) return r != 0;
     }
+    if (d[4]) return eval_mixed(s, w, ray, d, a, b, tmax, self, visit);
+    if (!plan) return eval_full(s, A, w, ray, d, a, b, tmax, self, visit);
     return eval_flat(s, A, w, ray, list_prims(d), d[1], plan, a, b, tmax, self, visit);
 }
 
@@ -7982,11 +8006,13 @@ void shade_at(const Prim &q, R3 x, Shade *sh, double *ts, double *tt, R3 *ds, R3
     }
 }
 
-pray_rgb transmit_at(const Prim &qm, const Prim &q, R3 x, R3 d, bool ahead) {
-    double s, t;
+inline pray_rgb transmit_at(const Scene *s, const Ray &ray, const Hit &x) {
+    const pray_model *m = s->prims[x.mat].mat;
+    if (m->kind == M_FLAT) return m->transmit;
+    double u, v;
     R3 ds, dt;
     Shade sh;
-    shade_at(qm, x, &sh, &s, &t, &ds, &dt, q, d, ahead);
+    shade_at(s->prims[x.mat], ray.o + ray.d * x.t, &sh, &u, &v, &ds, &dt, s->prims[x.prim], ray.d, x.root_enter);
     return sh.transmit;
 }
 
@@ -8102,6 +8128,19 @@ inline bool worth_tracing(Tracer &tr, int level, double weight) {
     return false;
 }
 
+// A shadow ray sr from hit h at x of the ray along d, sent by a bumped normal into the solid
+// entered there, beyond the face: where the lists leave out the faces between materials
+// (Accel::left_out), it starts inside the solid where they may not see one, and takes the
+// reference. False when it is not such a ray.
+PRAY_NOINLINE bool shadow_beyond(const Scene *s, Scratch *w, const Hit &h, R3 x, R3 d, const Ray &sr, real dist,
+                                 ShadowHit &sh) {
+    if (!s->accel || !s->accel->left_out || !(h.root_enter || h.from >= 0)) return false;
+    R3 g = prim_normal(s->prims[h.prim], x);
+    if (dot(g, d) * dot(g, sr.d) < 0) return false;
+    sweep(s, w, sr, dist, h.prim, sh);
+    return true;
+}
+
 // The colour a ray brings back; `seen`, when given, receives what it saw; `weight`: how much of
 // it reaches the sample, at most, in any channel.
 pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *seen = NULL, double weight = 1) {
@@ -8141,6 +8180,7 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
     }
     pray_rgb col = cadd(m->emit, m->ambient);
     bool lit = !czero(m->diffuse) || !czero(m->specular) || record;  // (the light is recorded)
+    bool bumped = m->bs != 0 || m->bt != 0;
     for (int i = 0; lit && i < s->lights.n; i++) {
         const Light &L = s->lights[i];
         R3 l;
@@ -8161,7 +8201,8 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
             // (a shadow ray is filtered at the faces of the solid it crosses; a face between two
             // materials inside the solid lets the light through as it is, ShadowHit: so that a
             // shadow ray never needs the reference sweep, whatever materials meet)
-            shadow_hits(s, tr.w, sr, dist, h.prim, i, sh);
+            if (!(bumped && shadow_beyond(s, tr.w, h, x, ray.d, sr, dist, sh)))
+                shadow_hits(s, tr.w, sr, dist, h.prim, i, sh);
             li = cmul(li, sh.f);
         }
         if (record) {
@@ -10802,17 +10843,22 @@ void prepared_drop(pray_ctx *c) {
 
 // A kept scene whose setup differs from the context's in the camera alone takes the new camera:
 // of its preparation only the eye's buffer depends on the camera (on the eye's place and on the
-// kind of camera, not on where it looks), so it stays unless those changed.
-void recamera(pray_ctx *c, Prepared *p) {
+// kind of camera, not on where it looks), so it stays unless those changed; and lists that leave
+// out faces between materials (Accel::left_out) stay while no primary ray starts inside the
+// solid.
+pray_status recamera(pray_ctx *c, Prepared *p) {
     Setup t;
     const Setup &n = c->cur;
     memcpy(&t, &p->setup, sizeof t);
     t.parallel = n.parallel, t.cam_x = n.cam_x, t.cam_y = n.cam_y, t.cam_eye = n.cam_eye, t.cam_point = n.cam_point;
     t.lookat = n.lookat, t.cam_up = n.cam_up, t.cam_angle = n.cam_angle;
     bool eye = p->s.accel && p->s.accel->eye && memcmp(&n.cam_eye, &p->setup.cam_eye, sizeof n.cam_eye) != 0;
-    if (memcmp(&t, &n, sizeof t) != 0 || n.parallel != p->setup.parallel || eye) return;
+    if (memcmp(&t, &n, sizeof t) != 0 || n.parallel != p->setup.parallel || eye) return PRAY_OK;
     scene_camera(c, &p->s);
-    memcpy(&p->setup, &n, sizeof t);
+    int in = p->s.accel && p->s.accel->left_out ? primaries_inside(c, &p->s) : 0;
+    if (in < 0) return c->status;
+    if (!in) memcpy(&p->setup, &n, sizeof t);  // (else dropped)
+    return PRAY_OK;
 }
 
 // The one way to render: rectangle r of the image into the buffers (stride set), both checked;
@@ -10824,7 +10870,7 @@ pray_status render_into(pray_ctx *c, pray_object *root, pray_light *lights, cons
     mem_phase(c, MEM_RUN);
     Prepared *p = c->prep;
     bool keep = (!c->running || c->in_render_fn) && c->drop != root;
-    if (p && keep && p->root == root && p->lights == lights) recamera(c, p);
+    if (p && keep && p->root == root && p->lights == lights && recamera(c, p)) return c->status;
     if (p && !(keep && p->root == root && p->lights == lights && memcmp(&p->setup, &c->cur, sizeof(Setup)) == 0)) {
         prepared_drop(c);  // (before another is built: the two need not fit at once)
         p = NULL;
@@ -11011,6 +11057,7 @@ struct pray_scene {
     Scene s;
     Scratch w;    // pray_intersect's
     int render;   // prepared for rendering (pray_prepare_render)
+    Accel *all;   // pray_intersect's lists, where the render's leave faces out (Accel::left_out)
 };
 
 // pray_prepare's and pray_prepare_render's work, between call_enter and call_leave
@@ -11109,7 +11156,19 @@ int pray_intersect(pray_ctx *c, pray_scene *q, pray_vec origin, pray_vec dir, do
     ch.max = max_hits;
     ch.n = 0;
     real t = tmax >= HUGE_VAL ? REAL_INF : (real)tmax;
-    find_hits(&q->s, &q->w, ch.ray, t, -1, ch);
+    const Scene *s = &q->s;
+    Scene all;  // (the scene with lists of every face: built at the first query that needs them)
+    if (q->s.accel && q->s.accel->left_out) {
+        memcpy(&all, &q->s, sizeof all);
+        all.accel = q->all;
+        if (!q->all && accel_build(c, &all, false)) {
+            accel_release(c, all.accel);
+            return -1;
+        }
+        q->all = all.accel;
+        s = &all;
+    }
+    find_hits(s, &q->w, ch.ray, t, -1, ch);
     return ch.n;
 }
 
@@ -11121,6 +11180,7 @@ void pray_scene_free(pray_ctx *c, pray_scene *q) {
     }
     scratch_release(c, &q->w);
     scene_release(c, &q->s);
+    accel_release(c, q->all);
     mem_free(c, q);
 }
 

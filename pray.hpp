@@ -613,10 +613,12 @@ typedef struct pray_buffers {
    its grid), and the next render of the same root and lights with the same options, camera and
    background uses it again, so that bands, tiles and passes cost what the whole image costs. It
    holds a reference to root and lights meanwhile (releasing yours is safe). Of the preparation
-   only the eye's buffer depends on the camera, so a new camera of the same kind (parallel or
+   only the eye's buffer and, for a solid of several materials that lets no light through, the
+   faces between them depend on the camera. So a new camera of the same kind (parallel or
    perspective) keeps it, taking the new camera, when the eye stays where it was (the camera
    turned about its eye) or the scene has no eye's buffer (option eyebuffer 0, a parallel
-   camera, or too few samples for one: pray_stats.eyebuf_voxels 0). Rendering another scene or
+   camera, or too few samples for one: pray_stats.eyebuf_voxels 0), unless primary rays of the
+   new camera start inside such a solid prepared without those faces. Rendering another scene or
    lights, changing an option or the background, any other new camera, setting an id
    (pray_object_set_id), the start or the end of a program's run, or pray_free drops it. To
    render one scene from several threads at once, see pray_prepare_render. */
@@ -624,8 +626,9 @@ pray_status pray_render_into(pray_ctx *ctx, pray_object *root, pray_light *light
                              const pray_buffers *out);
 /* A scene prepared for rendering, with the context's options, camera and background as they are
    now, as pray_render_into prepares it; NULL on error (those of pray_render_into). pray_intersect
-   takes it too. It belongs to the context (pray_scene_free, pray_free), which must outlive every
-   render of it; it keeps no reference to root or lights. */
+   takes it too (where the render's lists leave out the faces between materials that no ray of
+   it can meet, the first query builds them, once). It belongs to the context (pray_scene_free,
+   pray_free), which must outlive every render of it; it keeps no reference to root or lights. */
 pray_scene *pray_prepare_render(pray_ctx *ctx, pray_object *root, pray_light *lights);
 /* Render rectangle `rect` (NULL: the whole image) of a scene from pray_prepare_render into the
    caller's buffers, as pray_render_into would with the options, camera and background the scene
