@@ -1930,10 +1930,7 @@ struct R3 {
     real x, y, z;
 };
 inline R3 r3(real x, real y, real z) {
-    R3 v;
-    v.x = x;
-    v.y = y;
-    v.z = z;
+    R3 v = {x, y, z};
     return v;
 }
 typedef real R3::*Axis;  // one of a vector's components
@@ -2456,7 +2453,8 @@ Axis plane_axis(R3 n) {
 
 // Flatten the object into the scene's arrays in post-order (children before parents), folding
 // `one` and `nothing` away and merging chains; with s->prune, also dropping what bounds prove
-// cannot matter. Parts left out stay in the arrays without a parent until scene_compact.
+// cannot matter (not under a complement: all of space, that a union's later children fill with
+// their materials, language 12). Parts left out stay without a parent until scene_compact.
 // Returns the element code, or -3 when out of memory.
 int flatten_in(pray_ctx *c, Scene *s, const pray_object *o);
 int flatten(pray_ctx *c, Scene *s, const pray_object *o) {  // (with the id around each part)
@@ -2524,8 +2522,9 @@ int flatten_in(pray_ctx *c, Scene *s, const pray_object *o) {
     }
     Array<int> kids;
     kids.init();
-    int op = o->kind;
+    int op = o->kind, prune = s->prune;
     int result = -4;  // undecided
+    s->prune = prune && op != O_COMPL;
     for (int i = 0; i < o->nkids; i++) {
         if (result != -4) {  // decided: the rest is not needed, but keeps its primitives' numbers
             s->leaves += (int)kid(o, i)->nprims;
@@ -2552,6 +2551,7 @@ int flatten_in(pray_ctx *c, Scene *s, const pray_object *o) {
             else if (!kids.push(c, e)) result = -3;
         }
     }
+    s->prune = prune;
     if (result == -4 && op == O_INTER && s->prune) {
         Box b = box_all();
         for (int i = 0; i < kids.n; i++) box_clip(&b, elem_box(s, kids[i]));

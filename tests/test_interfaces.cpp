@@ -367,3 +367,34 @@ TEST_CASE("interfaces: faces between materials that let no light through, left o
     CHECK(h[0].entering == 2);
     pray_free(c);
 }
+
+TEST_CASE("interfaces: all of space as a complement of nothing the bounds can see, then two balls of two materials: "
+          "the face between the balls, as --brute finds it") {
+    // the complement of two balls' intersection (empty: their boxes are apart) is all of space;
+    // the balls written after it fill it with their materials where they are, so that where they
+    // meet is a face, while the rest of space has no material and no face
+    pray_ctx *c = pray_new();
+    REQUIRE(c);
+    pray_rgb red = {0.8, 0.2, 0.2}, blue = {0.2, 0.3, 0.8}, z = {0, 0, 0};
+    pray_model *mr = pray_phong(c, red, z, z, 10), *mb = pray_phong(c, blue, z, z, 10);
+    pray_object *none = pray_csg(c, PRAY_INTERSECTION, pray_sphere(c, mr, vec(-5, 0, 0), 1), pray_sphere(c, mr, vec(5, 0, 0), 1));
+    pray_object *root = pray_csg(c, PRAY_UNION, pray_complement(c, none), pray_sphere(c, mr, vec(0, 0, 0), 1));
+    root = pray_csg(c, PRAY_UNION, root, pray_sphere(c, mb, vec(1, 0, 0), 1));
+    REQUIRE(root);
+    std::vector<std::vector<pray_hit>> got;
+    for (int brute : {1, 0}) {
+        REQUIRE(pray_option(c, "brute", brute) == PRAY_OK);
+        pray_scene *s = pray_prepare(c, root);
+        REQUIRE(s);
+        got.push_back(hits_of(c, s, vec(-3, 0.2, 0), vec(1, 0, 0)));
+        pray_scene_free(c, s);
+    }
+    REQUIRE(got[0].size() == 1);
+    CHECK(got[0][0].entering == 2);  // red into blue, at x = 1 - sqrt(1 - 0.04)
+    CHECK(got[0][0].t == doctest::Approx(3 + 1 - std::sqrt(0.96)));
+    REQUIRE(got[1].size() == 1);
+    CHECK(got[1][0].entering == 2);
+    CHECK(got[1][0].t == got[0][0].t);
+    CHECK(got[1][0].primitive == got[0][0].primitive);
+    pray_free(c);
+}
