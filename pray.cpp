@@ -3350,7 +3350,7 @@ int framed_span(const Prim &q, const Ray &ray, bool self, real *t0, real *t1, re
     R3 o = ray.o, d = ray.d;
     if (!f.plain) o = to_local(f, o), d = dir_local(f, d);
     if (q.kind == O_TORUS) {
-        real t[4];
+        real t[4] = {0, 0, 0, 0};
         int k = torus_span(q, o, d, self, t);
         *t0 = t[0];
         *t1 = t[1];
