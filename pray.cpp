@@ -29,7 +29,7 @@
    [SECTION] 14   1650  PRAY interpreter: values, operators, builtins, statements
    [SECTION] 15    200  One-call helpers and the running of programs
    [SECTION] 16    800  Command-line program (PRAY_MAIN)
-   The whole file: at most 15435 lines.
+   The whole file: at most 15440 lines.
 */
 
 // =============================================================================================
@@ -3796,9 +3796,10 @@ bool starts_inside(const Scene *s, Scratch *w, const Ray &ray) {
     return sweep_start(s, w, ray, 0, -1, &nc);
 }
 
-// May a primary ray of the render start inside the solid? The eye of a perspective camera
-// (starts_inside), any point of a parallel camera's window in the solid's box. -1 when out of
-// memory.
+// May a primary ray of the render start inside the solid? Any point of a parallel camera's
+// window in the solid's box; a perspective camera's eye inside it along the view or along one of
+// the window's corners (starts_inside: an eye on a face has the solid on one side of it, which
+// holds a corner's ray if it holds any of the image's). -1 when out of memory.
 int primaries_inside(pray_ctx *c, const Scene *s) {
     if (s->root < 0) return s->root == E_ALL;
     const Box &b = elem_box(s, s->root);
@@ -3808,10 +3809,14 @@ int primaries_inside(pray_ctx *c, const Scene *s) {
     }
     if (s->parallel) return 1;
     Scratch w;
-    Ray eye;
-    eye.o = s->eye;
-    eye.d = s->dir;
-    int in = scratch_init(c, &w, s) ? starts_inside(s, &w, eye) : -1;
+    Ray r;  // (camera_ray's, through the window's centre and its corners)
+    r.o = s->eye;
+    int in = scratch_init(c, &w, s) ? 0 : -1;
+    for (int k = 0; k < 5 && in == 0; k++) {
+        real u = k < 4 ? (real)(k & 1 ? 1 : -1) : 0, v = k < 4 ? (real)(k & 2 ? 1 : -1) : 0;
+        r.d = unit(s->kpoint + s->kcx * u + s->kcy * v - s->keye);
+        in = starts_inside(s, &w, r);
+    }
     scratch_release(c, &w);
     return in;
 }

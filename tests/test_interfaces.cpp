@@ -309,8 +309,8 @@ long pixels_differing(const std::vector<float> &a, const std::vector<float> &b) 
 
 TEST_CASE("interfaces: faces between materials that let no light through, left out of a render's lists, "
           "where a ray starts inside the solid: the eye, a parallel window, bumped shadow rays, a moved eye, queries") {
-    // A bumped red block and a blue one sharing the face x = 0 on a floor, a lamp inside the blue
-    // one just under its top: a render's lists leave out the face between them (no ray from
+    // A bumped red block sunk into a floor and a blue one standing on it, sharing the face x = 0,
+    // a lamp inside the blue one just under its top: a render's lists leave out the face between them (no ray from
     // outside the solid can meet it), yet every ray that starts inside sees it as --brute does.
     pray_ctx *c = pray_new();
     REQUIRE(c);
@@ -323,8 +323,8 @@ TEST_CASE("interfaces: faces between materials that let no light through, left o
     pray_rgb red = {0.8, 0.2, 0.2}, blue = {0.2, 0.3, 0.8}, grey = {0.5, 0.5, 0.5}, spec = {0.3, 0.3, 0.3};
     pray_model *mr = pray_tiffbump(c, pray_phong(c, red, spec, grey, 20), 0.6, tex);
     pray_model *mb = pray_phong(c, blue, spec, grey, 20), *mf = pray_phong(c, grey, spec, grey, 5);
-    pray_object *root = pray_csg(c, PRAY_UNION, pray_box(c, mr, vec(-1, -1, 0), vec(0, 1, 1)), pray_box(c, mb, vec(0, -1, 0), vec(1, 1, 1)));
-    root = pray_csg(c, PRAY_UNION, root, pray_plane(c, mf, vec(0, 0, 0), vec(0, 0, 1)));
+    pray_object *root = pray_csg(c, PRAY_UNION, pray_box(c, mr, vec(-1, -1, -0.3), vec(0, 1, 1)), pray_box(c, mb, vec(0, -1, 0), vec(1, 1, 1)));
+    root = pray_csg(c, PRAY_UNION, pray_plane(c, mf, vec(0, 0, 0), vec(0, 0, 1)), root);  // (the red block wins under the floor)
     pray_rgb lamp = {0.9, 0.9, 0.9}, sun = {0.5, 0.5, 0.5};
     pray_light *lights = pray_light_add(c, pray_pointlight(c, lamp, vec(0.5, 0, 0.9)), pray_dirlight(c, sun, vec(1, 0.5, -2)));
     REQUIRE(root);
@@ -337,6 +337,7 @@ TEST_CASE("interfaces: faces between materials that let no light through, left o
         {"outside, looking at the bumped top", false, vec(-2.5, -3, 3), vec(0, 0, 0.8)},
         {"the eye inside the red block", false, vec(-0.5, 0.2, 0.5), vec(1, 0, 0.5)},
         {"a parallel window through both blocks", true, vec(-0.5, 0, 0.6), vec(1, 0, 0.6)},
+        {"the eye on the floor, looking a little up", false, vec(-0.5, -4, 0), vec(0, 0, 0.3)},
     };
     for (const Camera &k : cams) {
         CAPTURE(k.what);
