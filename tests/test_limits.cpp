@@ -779,6 +779,19 @@ pray_status exercise(Failing &f, const std::string &prog, int threads) {
         if (st == PRAY_OK) st = pray_write_tiff(c, &img, 8, no_print, NULL);
         if (st == PRAY_OK) st = pray_write_ppm(c, &img, 16, no_print, NULL);
         if (st == PRAY_OK && std::strstr(pray_features(), "png")) st = pray_write_png(c, &img, no_print, NULL);
+        // a scene of two opaque materials prepared for a render (whose lists leave out the face
+        // between them), and a query on it (which builds them)
+        pray_model *m2 = pray_phong(c, pray_rgb{0.2f, 0.2f, 0.8f}, pray_rgb{0, 0, 0}, pray_rgb{0, 0, 0}, 5);
+        pray_object *e = m2 ? pray_sphere(c, m2, pray_vec{0.5, 0, 0}, 0.6) : NULL, *de = d && e ? pray_csg(c, PRAY_UNION, d, e) : NULL;
+        if (st == PRAY_OK) {
+            pray_scene *q = de ? pray_prepare_render(c, de, l) : NULL;
+            pray_hit h[4];
+            if (!q || pray_intersect(c, q, pray_vec{-3, 0.1, 0}, pray_vec{1, 0, 0}, HUGE_VAL, h, 4) < 0) st = pray_last_status(c);
+            pray_scene_free(c, q);
+        }
+        pray_release(c, m2);
+        pray_release(c, e);
+        pray_release(c, de);
         pray_image_free(c, &img);
         pray_release(c, m);
         pray_release(c, a);
