@@ -29,7 +29,7 @@
    [SECTION] 14   1650  PRAY interpreter: values, operators, builtins, statements
    [SECTION] 15    200  One-call helpers and the running of programs
    [SECTION] 16    800  Command-line program (PRAY_MAIN)
-   The whole file: at most 15440 lines.
+   The whole file: at most 15439 lines.
 */
 
 // =============================================================================================
@@ -8203,9 +8203,8 @@ pray_rgb trace(Tracer &tr, const Ray &ray, int level, int self, int kind, Seen *
             sh.ray = &sr;
             sh.f = cmake(1, 1, 1);
             tr.w->k.rays[RAY_SHADOW] += 1;
-            // (a shadow ray is filtered at the faces of the solid it crosses; a face between two
-            // materials inside the solid lets the light through as it is, ShadowHit: so that a
-            // shadow ray never needs the reference sweep, whatever materials meet)
+            // (filtered at every surface it crosses, a face between two materials by the one it
+            // enters: ShadowHit)
             if (!(bumped && shadow_beyond(s, tr.w, h, x, ray.d, sr, dist, sh)))
                 shadow_hits(s, tr.w, sr, dist, h.prim, i, sh);
             li = cmul(li, sh.f);
