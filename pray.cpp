@@ -29,7 +29,7 @@
    [SECTION] 14   1650  PRAY interpreter: values, operators, builtins, statements
    [SECTION] 15    200  One-call helpers and the running of programs
    [SECTION] 16    800  Command-line program (PRAY_MAIN)
-   The whole file: at most 15439 lines.
+   The whole file: at most 15438 lines.
 */
 
 // =============================================================================================
@@ -3796,6 +3796,8 @@ bool starts_inside(const Scene *s, Scratch *w, const Ray &ray) {
     return sweep_start(s, w, ray, 0, -1, &nc);
 }
 
+Ray camera_ray(const Scene *s, real u, real v);
+
 // May a primary ray of the render start inside the solid? Any point of a parallel camera's
 // window in the solid's box; a perspective camera's eye inside it along the view or along one of
 // the window's corners (starts_inside: an eye on a face has the solid on one side of it, which
@@ -3809,13 +3811,10 @@ int primaries_inside(pray_ctx *c, const Scene *s) {
     }
     if (s->parallel) return 1;
     Scratch w;
-    Ray r;  // (camera_ray's, through the window's centre and its corners)
-    r.o = s->eye;
     int in = scratch_init(c, &w, s) ? 0 : -1;
-    for (int k = 0; k < 5 && in == 0; k++) {
+    for (int k = 0; k < 5 && in == 0; k++) {  // (the window's four corners, then its centre)
         real u = k < 4 ? (real)(k & 1 ? 1 : -1) : 0, v = k < 4 ? (real)(k & 2 ? 1 : -1) : 0;
-        r.d = unit(s->kpoint + s->kcx * u + s->kcy * v - s->keye);
-        in = starts_inside(s, &w, r);
+        in = starts_inside(s, &w, camera_ray(s, u, v));
     }
     scratch_release(c, &w);
     return in;
@@ -5788,13 +5787,13 @@ pray_status accel_build(pray_ctx *c, Scene *s, bool render) {
     a->cache = opt_int(c, OPT_SHADOWCACHE);
     for (int i = 0; a->cache && i < s->prims.n; i++) a->cache = model_clear(s->prims[i].mat) <= 1;
     a->bounds = opt_int(c, OPT_BOUNDS);
-    // (a ray is inside the solid only where a surface lets light through, or at its start)
-    a->faces = s->iface && !render;
-    for (int i = 0; s->iface && !a->faces && i < s->prims.n; i++) a->faces = model_clear(s->prims[i].mat) != 0;
-    int inside = s->iface && !a->faces ? primaries_inside(c, s) : 0;
+    // (a render's ray is inside the solid only past a surface letting light through, or at start)
+    bool lit = !render;
+    for (int i = 0; s->iface && !lit && i < s->prims.n; i++) lit = model_clear(s->prims[i].mat) != 0;
+    int inside = s->iface && !lit ? primaries_inside(c, s) : 1;
     if (inside < 0) return c->status;
-    a->faces = a->faces || inside;
-    a->left_out = s->iface && !a->faces;
+    a->faces = s->iface && inside;
+    a->left_out = s->iface && !inside;
     if (!a->off.push(c, 0)) return c->status;  // list 0: nothing can be hit
     for (int i = 0; i < LIST_HEAD; i++)
         if (!a->data.push(c, 0)) return c->status;
